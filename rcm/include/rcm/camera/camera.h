@@ -1,0 +1,123 @@
+// Camera: one calibrated in-air camera (lens model, intrinsics, image size),
+// chosen at run time. Dispatches to the static models of lens_models.h.
+#ifndef RCM_CAMERA_CAMERA_H_
+#define RCM_CAMERA_CAMERA_H_
+
+#include <array>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Core>
+#include <glog/logging.h>
+
+#include "rcm/camera/lens_models.h"
+#include "rcm/util/status.h"
+
+namespace rcm {
+
+// Kalibr's distortion_model names: "none", "radtan", "equidistant".
+std::string_view LensModelName(LensModelId model);
+std::optional<LensModelId> LensModelFromName(std::string_view name);
+// Number of distortion coefficients of a model (0 or 4).
+int NumDistortionParams(LensModelId model);
+
+// Calls `body` with `LensModel` bound to the static model struct of `id`,
+// e.g. RCM_LENS_MODEL_SWITCH(model_, return LensModel::kNumParams;)
+#define RCM_LENS_MODEL_SWITCH(id, ...)          \
+  switch (id) {                                 \
+    case ::rcm::LensModelId::kPinhole: {        \
+      using LensModel = ::rcm::PinholeLens;     \
+      __VA_ARGS__                               \
+    }                                           \
+    case ::rcm::LensModelId::kRadTan: {         \
+      using LensModel = ::rcm::RadTanLens;      \
+      __VA_ARGS__                               \
+    }                                           \
+    case ::rcm::LensModelId::kEquidistant: {    \
+      using LensModel = ::rcm::EquidistantLens; \
+      __VA_ARGS__                               \
+    }                                           \
+  }
+
+class Camera {
+ public:
+  // Validates and builds a camera. `intrinsics` = [fx, fy, cx, cy];
+  // `distortion` has NumDistortionParams(model) entries. Errors name the
+  // problem: non-positive or non-finite focal length, wrong coefficient
+  // count, non-finite value, non-positive image size.
+  static StatusOr<Camera> Create(LensModelId model, int width, int height,
+                                 const std::array<double, 4>& intrinsics,
+                                 const std::vector<double>& distortion);
+
+  LensModelId model() const { return model_; }
+  int width() const { return width_; }
+  int height() const { return height_; }
+  double fx() const { return params_[0]; }
+  double fy() const { return params_[1]; }
+  double cx() const { return params_[2]; }
+  double cy() const { return params_[3]; }
+  // [fx, fy, cx, cy, d...] as in lens_models.h; num_params() entries.
+  const double* params() const { return params_.data(); }
+  int num_params() const { return 4 + NumDistortionParams(model_); }
+  std::vector<double> Distortion() const;
+
+  // Pixel of a normalized point (z = 1 plane, before distortion).
+  template <typename T>
+  void ImageFromNormalized(const T* normalized, T* pixel) const;
+  Eigen::Vector2d ImageFromNormalized(const Eigen::Vector2d& normalized) const;
+
+  // Normalized point of a pixel; false / nullopt when undistortion fails.
+  template <typename T>
+  bool NormalizedFromImage(const T* pixel, T* normalized) const;
+  std::optional<Eigen::Vector2d> NormalizedFromImage(
+      const Eigen::Vector2d& pixel) const;
+
+  // d pixel / d normalized at a normalized point (row-major 2x2): the
+  // analytic lens Jacobian scaled by the focal lengths.
+  Eigen::Matrix2d ImageFromNormalizedJacobian(
+      const Eigen::Vector2d& normalized) const;
+
+  // True when the pixel lies on the sensor: [-0.5, width - 0.5] x
+  // [-0.5, height - 0.5] with pixel centers at integers.
+  bool InImage(const Eigen::Vector2d& pixel) const;
+
+  bool operator==(const Camera& other) const;
+  bool operator!=(const Camera& other) const { return !(*this == other); }
+
+ private:
+  Camera() = default;
+
+  LensModelId model_ = LensModelId::kPinhole;
+  int width_ = 0;
+  int height_ = 0;
+  std::array<double, kMaxLensParams> params_{};
+};
+
+// ---------------------------------------------------------------------------
+// Template implementations.
+
+template <typename T>
+void Camera::ImageFromNormalized(const T* normalized, T* pixel) const {
+  T params[kMaxLensParams];
+  for (int i = 0; i < kMaxLensParams; ++i) params[i] = T(params_[i]);
+  RCM_LENS_MODEL_SWITCH(model_, LensModel::ImgFromCam(
+                                    params, normalized[0], normalized[1],
+                                    &pixel[0], &pixel[1]);
+                        return;)
+}
+
+template <typename T>
+bool Camera::NormalizedFromImage(const T* pixel, T* normalized) const {
+  T params[kMaxLensParams];
+  for (int i = 0; i < kMaxLensParams; ++i) params[i] = T(params_[i]);
+  RCM_LENS_MODEL_SWITCH(model_, return LensModel::CamFromImg(
+                                    params, pixel[0], pixel[1],
+                                    &normalized[0], &normalized[1]);)
+  return false;
+}
+
+}  // namespace rcm
+
+#endif  // RCM_CAMERA_CAMERA_H_

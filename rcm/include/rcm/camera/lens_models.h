@@ -1,0 +1,394 @@
+// Lens models: the in-air part of the camera, calibrated before the dive.
+//
+// Written in the style of COLMAP's sensor/models.h: one struct per model,
+// static functions templated on the scalar so that they run on double and
+// on ceres::Jet, raw parameter arrays, failure reported by a bool.
+//
+// Coordinates:
+//   normalized (x, y)  a point on the plane z = 1 of the camera frame
+//                      (x right, y down, z forward), before lens distortion;
+//   distorted (xd, yd) the same ray after lens distortion, still divided by
+//                      the focal length;
+//   pixel (u, v)       u = fx * xd + cx, v = fy * yd + cy; pixel centers at
+//                      integer coordinates (OpenCV, Kalibr).
+//
+// Parameter order of every model (a raw array):
+//   params = [fx, fy, cx, cy, d_0, ..., d_{kNumDistortionParams - 1}]
+// and `dist` below points at params + 4.
+//
+//   PinholeLens       no distortion                    (Kalibr "none")
+//   RadTanLens        k1, k2, p1, p2                    (Kalibr "radtan",
+//                                                        OpenCV plumb bob k3=0)
+//   EquidistantLens   k1, k2, k3, k4                    (Kalibr "equidistant",
+//                                                        OpenCV fisheye)
+//
+// Undistortion is iterative. It is solved in double precision (safeguarded
+// Newton), then one Newton step is taken in the scalar type T from the
+// converged point; for a Jet that step makes the derivative parts exact
+// (the implicit-function derivative), for a double it changes nothing.
+#ifndef RCM_CAMERA_LENS_MODELS_H_
+#define RCM_CAMERA_LENS_MODELS_H_
+
+#include <algorithm>
+#include <cmath>
+
+#include "rcm/util/scalar.h"
+
+namespace rcm {
+
+enum class LensModelId { kPinhole = 0, kRadTan = 1, kEquidistant = 2 };
+
+// The largest number of parameters of any lens model (fx, fy, cx, cy + 4).
+inline constexpr int kMaxLensParams = 8;
+
+namespace lens_internal {
+
+// Residual (in normalized units) below which undistortion has converged.
+// Floating-point evaluation of the distortion polynomials carries a few ulp
+// of error, so ~1e-15 is the floor; 1e-14 leaves margin and is 1e-11 px at
+// a 1000 px focal length.
+inline constexpr double kUndistortTolerance = 1e-14;
+inline constexpr int kMaxUndistortIterations = 100;
+
+// Solves a * x = b for a 2x2 row-major a; false when a is singular.
+template <typename T>
+bool Solve2x2(const T a[4], const T b[2], T x[2]) {
+  const T det = a[0] * a[3] - a[1] * a[2];
+  const double scale = std::abs(ScalarPart(a[0])) + std::abs(ScalarPart(a[1])) +
+                       std::abs(ScalarPart(a[2])) + std::abs(ScalarPart(a[3]));
+  if (!(std::abs(ScalarPart(det)) > 1e-12 * scale * scale)) return false;
+  x[0] = (a[3] * b[0] - a[1] * b[1]) / det;
+  x[1] = (a[0] * b[1] - a[2] * b[0]) / det;
+  return true;
+}
+
+}  // namespace lens_internal
+
+// What every model shares: pixel <-> distorted normalized, and the 2-D
+// Newton undistortion used by models that have no cheaper inverse.
+template <typename Derived>
+struct BaseLens {
+  // Pixel of a normalized point.
+  template <typename T>
+  static void ImgFromCam(const T* params, const T& x, const T& y, T* u, T* v) {
+    T xd, yd;
+    Derived::Distort(params + 4, x, y, &xd, &yd);
+    *u = params[0] * xd + params[2];
+    *v = params[1] * yd + params[3];
+  }
+
+  // Normalized point of a pixel; false when undistortion does not converge
+  // (a pixel outside the region where the lens model is invertible).
+  template <typename T>
+  static bool CamFromImg(const T* params, const T& u, const T& v, T* x, T* y) {
+    const T xd = (u - params[2]) / params[0];
+    const T yd = (v - params[3]) / params[1];
+    return Derived::Undistort(params + 4, xd, yd, x, y);
+  }
+
+  // Inverse of Distort by Newton's method on the 2x2 Jacobian of
+  // Derived::DistortWithJacobian, with step halving when a step does not
+  // reduce the residual.
+  template <typename T>
+  static bool Undistort(const T* dist, const T& xd, const T& yd, T* x, T* y) {
+    constexpr int kNumDist = Derived::kNumDistortionParams;
+    double dist_value[kNumDist > 0 ? kNumDist : 1] = {0.0};
+    for (int i = 0; i < kNumDist; ++i) dist_value[i] = ScalarPart(dist[i]);
+    const double target[2] = {ScalarPart(xd), ScalarPart(yd)};
+    double point[2];
+    if (!UndistortScalar(dist_value, target, point)) return false;
+
+    // One Newton step in T from the converged point (see file comment).
+    T fx, fy, jacobian[4];
+    Derived::DistortWithJacobian(dist, T(point[0]), T(point[1]), &fx, &fy,
+                                 jacobian);
+    const T residual[2] = {xd - fx, yd - fy};
+    T step[2];
+    if (!lens_internal::Solve2x2(jacobian, residual, step)) return false;
+    *x = T(point[0]) + step[0];
+    *y = T(point[1]) + step[1];
+    return true;
+  }
+
+  // The double-precision solve behind Undistort.
+  static bool UndistortScalar(const double* dist, const double target[2],
+                              double point[2]) {
+    using lens_internal::kUndistortTolerance;
+    if (!std::isfinite(target[0]) || !std::isfinite(target[1])) return false;
+    const double tolerance =
+        kUndistortTolerance * (1.0 + std::hypot(target[0], target[1]));
+    point[0] = target[0];
+    point[1] = target[1];
+    double f[2], jacobian[4];
+    Derived::DistortWithJacobian(dist, point[0], point[1], &f[0], &f[1],
+                                 jacobian);
+    double residual[2] = {target[0] - f[0], target[1] - f[1]};
+    double norm = std::hypot(residual[0], residual[1]);
+    for (int it = 0; it < lens_internal::kMaxUndistortIterations; ++it) {
+      if (norm <= tolerance) return true;
+      double step[2];
+      if (!lens_internal::Solve2x2(jacobian, residual, step)) return false;
+      // Step halving: accept the first step that reduces the residual.
+      bool improved = false;
+      for (int halvings = 0; halvings < 40 && !improved; ++halvings) {
+        const double trial[2] = {point[0] + step[0], point[1] + step[1]};
+        double trial_f[2], trial_jacobian[4];
+        Derived::DistortWithJacobian(dist, trial[0], trial[1], &trial_f[0],
+                                     &trial_f[1], trial_jacobian);
+        const double trial_residual[2] = {target[0] - trial_f[0],
+                                          target[1] - trial_f[1]};
+        const double trial_norm =
+            std::hypot(trial_residual[0], trial_residual[1]);
+        if (trial_norm < norm) {
+          point[0] = trial[0];
+          point[1] = trial[1];
+          residual[0] = trial_residual[0];
+          residual[1] = trial_residual[1];
+          for (int k = 0; k < 4; ++k) jacobian[k] = trial_jacobian[k];
+          norm = trial_norm;
+          improved = true;
+        } else {
+          step[0] *= 0.5;
+          step[1] *= 0.5;
+        }
+      }
+      if (!improved) break;  // Stalled at the floating-point floor.
+    }
+    return norm <= tolerance;
+  }
+};
+
+// No distortion: (xd, yd) = (x, y).
+struct PinholeLens : public BaseLens<PinholeLens> {
+  static constexpr LensModelId kModelId = LensModelId::kPinhole;
+  static constexpr int kNumDistortionParams = 0;
+  static constexpr int kNumParams = 4;
+  static constexpr const char* kParamsInfo = "fx, fy, cx, cy";
+
+  template <typename T>
+  static void Distort(const T* /*dist*/, const T& x, const T& y, T* xd,
+                      T* yd) {
+    *xd = x;
+    *yd = y;
+  }
+  // jacobian = d(xd, yd) / d(x, y), row-major 2x2.
+  template <typename T>
+  static void DistortWithJacobian(const T* dist, const T& x, const T& y,
+                                  T* xd, T* yd, T jacobian[4]) {
+    Distort(dist, x, y, xd, yd);
+    jacobian[0] = T(1.0);
+    jacobian[1] = T(0.0);
+    jacobian[2] = T(0.0);
+    jacobian[3] = T(1.0);
+  }
+  template <typename T>
+  static bool Undistort(const T* /*dist*/, const T& xd, const T& yd, T* x,
+                        T* y) {
+    *x = xd;
+    *y = yd;
+    return true;
+  }
+};
+
+// Radial-tangential (Brown-Conrady with k3 = 0), as OpenCV and Kalibr:
+//   r^2 = x^2 + y^2,  radial = 1 + k1 r^2 + k2 r^4
+//   xd = x radial + 2 p1 x y + p2 (r^2 + 2 x^2)
+//   yd = y radial + p1 (r^2 + 2 y^2) + 2 p2 x y
+struct RadTanLens : public BaseLens<RadTanLens> {
+  static constexpr LensModelId kModelId = LensModelId::kRadTan;
+  static constexpr int kNumDistortionParams = 4;
+  static constexpr int kNumParams = 8;
+  static constexpr const char* kParamsInfo = "fx, fy, cx, cy, k1, k2, p1, p2";
+
+  template <typename T>
+  static void Distort(const T* dist, const T& x, const T& y, T* xd, T* yd) {
+    const T& k1 = dist[0];
+    const T& k2 = dist[1];
+    const T& p1 = dist[2];
+    const T& p2 = dist[3];
+    const T x2 = x * x;
+    const T y2 = y * y;
+    const T xy = x * y;
+    const T r2 = x2 + y2;
+    const T radial = T(1.0) + r2 * (k1 + k2 * r2);
+    *xd = x * radial + T(2.0) * p1 * xy + p2 * (r2 + T(2.0) * x2);
+    *yd = y * radial + p1 * (r2 + T(2.0) * y2) + T(2.0) * p2 * xy;
+  }
+
+  // Analytic jacobian = d(xd, yd) / d(x, y), row-major 2x2:
+  //   with g = 2 (k1 + 2 k2 r^2) (so d radial / dx = g x),
+  //   dxd/dx = radial + g x^2 + 2 p1 y + 6 p2 x
+  //   dxd/dy = g x y + 2 p1 x + 2 p2 y = dyd/dx
+  //   dyd/dy = radial + g y^2 + 6 p1 y + 2 p2 x
+  template <typename T>
+  static void DistortWithJacobian(const T* dist, const T& x, const T& y,
+                                  T* xd, T* yd, T jacobian[4]) {
+    const T& k1 = dist[0];
+    const T& k2 = dist[1];
+    const T& p1 = dist[2];
+    const T& p2 = dist[3];
+    const T x2 = x * x;
+    const T y2 = y * y;
+    const T xy = x * y;
+    const T r2 = x2 + y2;
+    const T radial = T(1.0) + r2 * (k1 + k2 * r2);
+    *xd = x * radial + T(2.0) * p1 * xy + p2 * (r2 + T(2.0) * x2);
+    *yd = y * radial + p1 * (r2 + T(2.0) * y2) + T(2.0) * p2 * xy;
+    const T g = T(2.0) * (k1 + T(2.0) * k2 * r2);
+    const T cross = g * xy + T(2.0) * (p1 * x + p2 * y);
+    jacobian[0] = radial + g * x2 + T(2.0) * p1 * y + T(6.0) * p2 * x;
+    jacobian[1] = cross;
+    jacobian[2] = cross;
+    jacobian[3] = radial + g * y2 + T(6.0) * p1 * y + T(2.0) * p2 * x;
+  }
+};
+
+// Equidistant (Kannala-Brandt), as OpenCV fisheye and Kalibr:
+//   r = |(x, y)|,  theta = atan(r)   (angle of the ray to the optical axis)
+//   theta_d = theta (1 + k1 theta^2 + k2 theta^4 + k3 theta^6 + k4 theta^8)
+//   (xd, yd) = (theta_d / r) (x, y)
+// A normalized point exists only for theta < 90 degrees, so undistortion
+// fails for pixels whose ray is at or beyond 90 degrees off axis.
+struct EquidistantLens : public BaseLens<EquidistantLens> {
+  static constexpr LensModelId kModelId = LensModelId::kEquidistant;
+  static constexpr int kNumDistortionParams = 4;
+  static constexpr int kNumParams = 8;
+  static constexpr const char* kParamsInfo = "fx, fy, cx, cy, k1, k2, k3, k4";
+
+  // Below this r^2 the series theta_d / r = 1 + (k1 - 1/3) r^2 + O(r^4) is
+  // exact in double precision and avoids sqrt(0) in the derivative parts.
+  static constexpr double kSeriesRadiusSquared = 1e-16;
+
+  // theta_d(theta) and, optionally, d theta_d / d theta.
+  template <typename T>
+  static T DistortedAngle(const T* dist, const T& theta,
+                          T* derivative = nullptr) {
+    const T t2 = theta * theta;
+    const T poly =
+        T(1.0) + t2 * (dist[0] + t2 * (dist[1] + t2 * (dist[2] + t2 * dist[3])));
+    if (derivative != nullptr) {
+      *derivative =
+          T(1.0) + t2 * (T(3.0) * dist[0] +
+                         t2 * (T(5.0) * dist[1] +
+                               t2 * (T(7.0) * dist[2] + t2 * T(9.0) * dist[3])));
+    }
+    return theta * poly;
+  }
+
+  template <typename T>
+  static void Distort(const T* dist, const T& x, const T& y, T* xd, T* yd) {
+    const T r2 = x * x + y * y;
+    T scale;
+    if (ScalarPart(r2) < kSeriesRadiusSquared) {
+      scale = T(1.0) + (dist[0] - T(1.0 / 3.0)) * r2;
+    } else {
+      using std::atan;
+      using std::sqrt;
+      const T r = sqrt(r2);
+      scale = DistortedAngle(dist, atan(r)) / r;
+    }
+    *xd = scale * x;
+    *yd = scale * y;
+  }
+
+  // Analytic jacobian = d(xd, yd) / d(x, y), row-major 2x2:
+  //   s(r) = theta_d / r,  J = s I + (s'(r) / r) (x, y)^T (x, y)
+  //   s'(r) / r = (theta_d'(theta) r / (1 + r^2) - theta_d) / r^3
+  //             -> 2 (k1 - 1/3) as r -> 0.
+  template <typename T>
+  static void DistortWithJacobian(const T* dist, const T& x, const T& y,
+                                  T* xd, T* yd, T jacobian[4]) {
+    const T r2 = x * x + y * y;
+    T scale, radial_term;
+    if (ScalarPart(r2) < kSeriesRadiusSquared) {
+      scale = T(1.0) + (dist[0] - T(1.0 / 3.0)) * r2;
+      radial_term = T(2.0) * (dist[0] - T(1.0 / 3.0));
+    } else {
+      using std::atan;
+      using std::sqrt;
+      const T r = sqrt(r2);
+      T derivative;
+      const T theta_d = DistortedAngle(dist, atan(r), &derivative);
+      scale = theta_d / r;
+      radial_term = (derivative * r / (T(1.0) + r2) - theta_d) / (r2 * r);
+    }
+    *xd = scale * x;
+    *yd = scale * y;
+    jacobian[0] = scale + radial_term * x * x;
+    jacobian[1] = radial_term * x * y;
+    jacobian[2] = jacobian[1];
+    jacobian[3] = scale + radial_term * y * y;
+  }
+
+  // Solves theta_d(theta) = |(xd, yd)| for theta in [0, pi/2) by Newton's
+  // method safeguarded by bisection on that bracket, then returns
+  // (x, y) = (tan(theta) / theta_d) (xd, yd).
+  template <typename T>
+  static bool Undistort(const T* dist, const T& xd, const T& yd, T* x, T* y) {
+    using std::sqrt;
+    using std::tan;
+    const T theta_d2 = xd * xd + yd * yd;
+    if (!std::isfinite(ScalarPart(theta_d2))) return false;
+    if (ScalarPart(theta_d2) < kSeriesRadiusSquared) {
+      // theta_d / r = 1 + O(r^2): identity to double precision; its
+      // derivative d(x, y)/d(xd, yd) = I holds at the origin.
+      *x = xd;
+      *y = yd;
+      return true;
+    }
+    double dist_value[4];
+    for (int i = 0; i < 4; ++i) dist_value[i] = ScalarPart(dist[i]);
+    const double target = std::sqrt(ScalarPart(theta_d2));
+    double theta;
+    if (!SolveTheta(dist_value, target, &theta)) return false;
+
+    // One Newton step in T from the converged angle (see file comment).
+    const T theta_d = sqrt(theta_d2);
+    T derivative;
+    const T value = DistortedAngle(dist, T(theta), &derivative);
+    const T theta_t = T(theta) - (value - theta_d) / derivative;
+    const T scale = tan(theta_t) / theta_d;
+    *x = scale * xd;
+    *y = scale * yd;
+    return true;
+  }
+
+  // The double-precision angle solve behind Undistort.
+  static bool SolveTheta(const double* dist, double target, double* theta) {
+    constexpr double kHalfPi = 1.5707963267948966;
+    double lo = 0.0;
+    double hi = kHalfPi;
+    // The bracket holds a root only if theta_d(pi/2) exceeds the target.
+    if (!(DistortedAngle(dist, hi) > target)) return false;
+    double t = std::min(target, 0.5 * (lo + hi));
+    for (int it = 0; it < 200; ++it) {
+      double derivative;
+      const double f = DistortedAngle(dist, t, &derivative) - target;
+      if (std::abs(f) <= lens_internal::kUndistortTolerance * (1.0 + target)) {
+        *theta = t;
+        return t < kHalfPi;
+      }
+      if (f < 0.0) {
+        lo = t;
+      } else {
+        hi = t;
+      }
+      double next = t - f / derivative;
+      if (!(derivative > 0.0) || !(next > lo && next < hi)) {
+        next = 0.5 * (lo + hi);  // Bisection when Newton leaves the bracket.
+      }
+      if (next == t) break;
+      t = next;
+    }
+    double derivative;
+    const double f = DistortedAngle(dist, t, &derivative) - target;
+    *theta = t;
+    return std::abs(f) <= 1e3 * lens_internal::kUndistortTolerance *
+                              (1.0 + target) &&
+           t < kHalfPi;
+  }
+};
+
+}  // namespace rcm
+
+#endif  // RCM_CAMERA_LENS_MODELS_H_

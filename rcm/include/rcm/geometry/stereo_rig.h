@@ -1,0 +1,55 @@
+// StereoRig: the two in-air calibrated cameras of a pair and the transform
+// between them. The left camera is the reference frame (cam0 by default).
+#ifndef RCM_GEOMETRY_STEREO_RIG_H_
+#define RCM_GEOMETRY_STEREO_RIG_H_
+
+#include <optional>
+
+#include "rcm/camera/camera.h"
+#include "rcm/geometry/rigid3d.h"
+#include "rcm/geometry/stereo_correspondence.h"
+#include "rcm/util/status.h"
+
+namespace rcm {
+
+class StereoRig {
+ public:
+  // Shortest accepted baseline in meters: below it the two cameras see the
+  // same rays and n is unobservable.
+  static constexpr double kMinBaseline = 1e-6;
+
+  // Fails on a zero (< kMinBaseline) or non-finite baseline.
+  static StatusOr<StereoRig> Create(const Camera& left, const Camera& right,
+                                    const Rigid3d& right_from_left);
+
+  const Camera& left() const { return left_; }
+  const Camera& right() const { return right_; }
+  const Rigid3d& right_from_left() const { return right_from_left_; }
+  double Baseline() const { return right_from_left_.translation.norm(); }
+
+  // How far the rig is from the ideal rectified pair (R = I, t = [tx, 0, 0])
+  // that the paper's closed form (eq. 14) assumes.
+  struct RectificationDeviation {
+    double rotation = 0.0;          // radians, angle of right_from_left
+    double baseline_off_axis = 0.0;  // radians, angle between t and +-x
+  };
+  RectificationDeviation DeviationFromRectified() const;
+
+  // Lens-undistorted normalized coordinates of both pixels; nullopt when
+  // either pixel cannot be undistorted.
+  std::optional<NormalizedCorrespondence> Normalize(
+      const StereoCorrespondence& correspondence) const;
+
+ private:
+  StereoRig(const Camera& left, const Camera& right,
+            const Rigid3d& right_from_left)
+      : left_(left), right_(right), right_from_left_(right_from_left) {}
+
+  Camera left_;
+  Camera right_;
+  Rigid3d right_from_left_;
+};
+
+}  // namespace rcm
+
+#endif  // RCM_GEOMETRY_STEREO_RIG_H_

@@ -1,0 +1,44 @@
+#include "rcm/geometry/stereo_rig.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace rcm {
+
+StatusOr<StereoRig> StereoRig::Create(const Camera& left, const Camera& right,
+                                      const Rigid3d& right_from_left) {
+  const double baseline = right_from_left.translation.norm();
+  if (!std::isfinite(baseline) || !right_from_left.rotation.allFinite()) {
+    return Status::Error("stereo extrinsics are not finite");
+  }
+  if (baseline < kMinBaseline) {
+    std::ostringstream message;
+    message << "zero baseline (|t| = " << baseline
+            << " m): the refractive index is unobservable without one";
+    return Status::Error(message.str());
+  }
+  return StereoRig(left, right, right_from_left);
+}
+
+StereoRig::RectificationDeviation StereoRig::DeviationFromRectified() const {
+  RectificationDeviation deviation;
+  deviation.rotation = right_from_left_.RotationAngle();
+  const Eigen::Vector3d& t = right_from_left_.translation;
+  deviation.baseline_off_axis =
+      std::atan2(t.tail<2>().norm(), std::abs(t.x()));
+  return deviation;
+}
+
+std::optional<NormalizedCorrespondence> StereoRig::Normalize(
+    const StereoCorrespondence& correspondence) const {
+  NormalizedCorrespondence normalized;
+  if (!left_.NormalizedFromImage(correspondence.left_pixel.data(),
+                                 normalized.left.data()) ||
+      !right_.NormalizedFromImage(correspondence.right_pixel.data(),
+                                  normalized.right.data())) {
+    return std::nullopt;
+  }
+  return normalized;
+}
+
+}  // namespace rcm

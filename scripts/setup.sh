@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Installs the Debian bookworm packages rcm builds against, when they are
+# missing. Safe to run repeatedly: it only calls apt-get when something is
+# absent. Must run as root (or with sudo available) on a machine that lacks
+# a package.
+set -euo pipefail
+
+# Why each package is here: see README.md, section "Dependencies".
+packages=(
+  build-essential cmake pkg-config
+  libeigen3-dev        # linear algebra, fixed-size math in the model
+  libceres-dev         # nonlinear least squares, ceres::Jet autodiff
+  libgflags-dev        # command-line flags of the rcm executable
+  libgoogle-glog-dev   # CHECK macros for programmer errors
+  libyaml-cpp-dev      # Kalibr camchain / ROS camera_info YAML
+  nlohmann-json3-dev   # --json output
+  libgtest-dev libgmock-dev  # tests
+  libbenchmark-dev     # benchmarks
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if ((${#missing[@]} == 0)); then
+  exit 0
+fi
+
+echo "rcm setup: installing ${missing[*]}" >&2
+sudo_cmd=()
+if [[ $(id -u) -ne 0 ]]; then
+  if command -v sudo >/dev/null; then
+    sudo_cmd=(sudo)
+  else
+    echo "rcm setup: missing packages (${missing[*]}) and not root; install them or rerun as root" >&2
+    exit 1
+  fi
+fi
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -qq
+"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
