@@ -1,1 +1,114 @@
-// Placeholder until the file is written; see rcm/CMakeLists.txt.
+#include "rcm/camera/camera.h"
+
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "support/test_rigs.h"
+
+namespace rcm {
+namespace {
+
+TEST(Camera, CreatesValidCamera) {
+  const StatusOr<Camera> camera = Camera::Create(
+      LensModelId::kRadTan, 752, 480, {458.0, 457.0, 367.0, 248.0},
+      {-0.28, 0.07, 0.0002, 0.00002});
+  ASSERT_TRUE(camera.ok()) << camera.status().message();
+  EXPECT_EQ(camera->num_params(), 8);
+  EXPECT_EQ(camera->fx(), 458.0);
+  EXPECT_EQ(camera->cy(), 248.0);
+  EXPECT_EQ(camera->Distortion(),
+            (std::vector<double>{-0.28, 0.07, 0.0002, 0.00002}));
+}
+
+TEST(Camera, RejectsNonPositiveFocalLength) {
+  const StatusOr<Camera> camera = Camera::Create(
+      LensModelId::kPinhole, 640, 480, {-300.0, 300.0, 320.0, 240.0}, {});
+  ASSERT_FALSE(camera.ok());
+  EXPECT_EQ(camera.status().message(),
+            "focal length must be positive, got fx = -300");
+  EXPECT_FALSE(Camera::Create(LensModelId::kPinhole, 640, 480,
+                              {300.0, 0.0, 320.0, 240.0}, {})
+                   .ok());
+}
+
+TEST(Camera, RejectsNonFiniteIntrinsics) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const StatusOr<Camera> camera = Camera::Create(
+      LensModelId::kPinhole, 640, 480, {300.0, 300.0, nan, 240.0}, {});
+  ASSERT_FALSE(camera.ok());
+  EXPECT_EQ(camera.status().message(), "cx is not a finite number");
+}
+
+TEST(Camera, RejectsWrongCoefficientCount) {
+  const StatusOr<Camera> camera = Camera::Create(
+      LensModelId::kEquidistant, 640, 480, {300.0, 300.0, 320.0, 240.0},
+      {0.1, 0.2, 0.3});
+  ASSERT_FALSE(camera.ok());
+  EXPECT_EQ(camera.status().message(),
+            "distortion model 'equidistant' takes 4 coefficients, got 3");
+}
+
+TEST(Camera, RejectsNonFiniteCoefficient) {
+  const StatusOr<Camera> camera = Camera::Create(
+      LensModelId::kRadTan, 640, 480, {300.0, 300.0, 320.0, 240.0},
+      {0.1, std::numeric_limits<double>::infinity(), 0.0, 0.0});
+  ASSERT_FALSE(camera.ok());
+  EXPECT_EQ(camera.status().message(),
+            "distortion coefficient 1 is not a finite number");
+}
+
+TEST(Camera, RejectsNonPositiveImageSize) {
+  const StatusOr<Camera> camera = Camera::Create(
+      LensModelId::kPinhole, 0, 480, {300.0, 300.0, 320.0, 240.0}, {});
+  ASSERT_FALSE(camera.ok());
+  EXPECT_EQ(camera.status().message(),
+            "image size must be positive, got 0 x 480");
+}
+
+TEST(Camera, LensModelNamesRoundTrip) {
+  for (LensModelId id : {LensModelId::kPinhole, LensModelId::kRadTan,
+                         LensModelId::kEquidistant}) {
+    EXPECT_EQ(LensModelFromName(LensModelName(id)), id);
+  }
+  EXPECT_FALSE(LensModelFromName("fov").has_value());
+  EXPECT_FALSE(LensModelFromName("").has_value());
+}
+
+TEST(Camera, InImageUsesPixelCenterConvention) {
+  const Camera camera = test::PinholeCamera();  // 640 x 480
+  EXPECT_TRUE(camera.InImage({-0.5, -0.5}));
+  EXPECT_TRUE(camera.InImage({639.5, 479.5}));
+  EXPECT_FALSE(camera.InImage({-0.51, 10.0}));
+  EXPECT_FALSE(camera.InImage({10.0, 479.51}));
+  EXPECT_FALSE(camera.InImage({std::nan(""), 10.0}));
+}
+
+TEST(Camera, ImageFromNormalizedJacobianMatchesCentralDifferences) {
+  for (const Camera& camera : test::AllTestCameras()) {
+    const Eigen::Vector2d p(0.31, -0.22);
+    const Eigen::Matrix2d jacobian = camera.ImageFromNormalizedJacobian(p);
+    const double h = 1e-6;  // truncation ~1e-12 * f, rounding ~1e-10 * f
+    for (int k = 0; k < 2; ++k) {
+      const Eigen::Vector2d step = h * Eigen::Vector2d::Unit(k);
+      const Eigen::Vector2d column = (camera.ImageFromNormalized(p + step) -
+                                      camera.ImageFromNormalized(p - step)) /
+                                     (2 * h);
+      EXPECT_NEAR((jacobian.col(k) - column).norm(), 0.0, 1e-6 * camera.fx());
+    }
+  }
+}
+
+TEST(Camera, LensInvertibleAtDetectsFold) {
+  const Camera folded =
+      Camera::Create(LensModelId::kRadTan, 640, 480,
+                     {300.0, 300.0, 320.0, 240.0}, {-0.5, 0.0, 0.0, 0.0})
+          .value();
+  // d/dr [r (1 - 0.5 r^2)] = 1 - 1.5 r^2 vanishes at r = 0.816.
+  EXPECT_TRUE(folded.LensInvertibleAt({0.8, 0.0}));
+  EXPECT_FALSE(folded.LensInvertibleAt({0.83, 0.0}));
+}
+
+}  // namespace
+}  // namespace rcm

@@ -1,1 +1,263 @@
-// Placeholder until the file is written; see rcm/CMakeLists.txt.
+#include "rcm/camera/lens_models.h"
+
+#include <cmath>
+#include <random>
+
+#include <Eigen/LU>
+#include <ceres/jet.h>
+#include <gtest/gtest.h>
+
+#include "rcm/camera/camera.h"
+#include "support/test_rigs.h"
+
+namespace rcm {
+namespace {
+
+// Pixel round trips: undistortion converges to a residual of 1e-14 in
+// normalized units (lens_models.h), i.e. ~1e-11 px at these focal lengths,
+// so 1e-9 px leaves two orders of margin.
+constexpr double kRoundTripPixelTolerance = 1e-9;
+// Analytic vs Jet derivatives evaluate the same expressions in another
+// order: agreement to rounding, relative to the entry's magnitude.
+constexpr double kJacobianTolerance = 1e-12;
+
+void ExpectPixelRoundTrip(const Camera& camera, double step) {
+  double worst = 0.0;
+  int failures = 0;
+  for (const Eigen::Vector2d& pixel : test::ImageGrid(camera, step)) {
+    const std::optional<Eigen::Vector2d> normalized =
+        camera.NormalizedFromImage(pixel);
+    if (!normalized) {
+      ++failures;
+      continue;
+    }
+    worst = std::max(worst,
+                     (camera.ImageFromNormalized(*normalized) - pixel).norm());
+  }
+  EXPECT_EQ(failures, 0) << "pixels that did not undistort";
+  EXPECT_LT(worst, kRoundTripPixelTolerance);
+}
+
+TEST(LensModels, PinholeRoundTripFullImage) {
+  ExpectPixelRoundTrip(test::PinholeCamera(), 4.0);
+}
+
+TEST(LensModels, RadTanRoundTripFullImage) {
+  ExpectPixelRoundTrip(test::EurocRadtanCamera(), 4.0);
+}
+
+TEST(LensModels, EquidistantRoundTripFullImage) {
+  ExpectPixelRoundTrip(test::AlphasenseCam0(), 4.0);
+  ExpectPixelRoundTrip(test::AlphasenseCam1(), 4.0);
+}
+
+TEST(LensModels, EquidistantRoundTripNinetyDegreeFieldOfView) {
+  const Camera camera = test::WideEquidistantCamera();
+  ExpectPixelRoundTrip(camera, 8.0);
+  // The corners do reach 89.5 degrees off axis.
+  const Eigen::Vector2d corner = camera.NormalizedFromImage({-0.5, -0.5}).value();
+  EXPECT_NEAR(std::atan(corner.norm()) * 180.0 / M_PI, 89.5, 1e-9);
+}
+
+TEST(LensModels, NormalizedRoundTripUpToEightyNineDegrees) {
+  // The other direction: normalized -> pixel -> normalized, on rays up to
+  // 89 degrees off axis for the equidistant models and over the image for
+  // the others, relative to the normalized radius.
+  for (const Camera& camera : test::AllTestCameras()) {
+    const double max_angle =
+        camera.model() == LensModelId::kEquidistant ? 89.0 : 40.0;
+    for (double angle = 0.0; angle <= max_angle; angle += 0.5) {
+      for (double azimuth = 0.0; azimuth < 360.0; azimuth += 15.0) {
+        const double r = std::tan(angle * M_PI / 180.0);
+        const Eigen::Vector2d normalized(r * std::cos(azimuth * M_PI / 180.0),
+                                         r * std::sin(azimuth * M_PI / 180.0));
+        const std::optional<Eigen::Vector2d> back =
+            camera.NormalizedFromImage(camera.ImageFromNormalized(normalized));
+        ASSERT_TRUE(back.has_value()) << angle << " deg";
+        EXPECT_LT((*back - normalized).norm(), 1e-12 * (1.0 + r))
+            << LensModelName(camera.model()) << " at " << angle << " deg";
+      }
+    }
+  }
+}
+
+TEST(LensModels, CenterPixelIsOpticalAxis) {
+  for (const Camera& camera : test::AllTestCameras()) {
+    const Eigen::Vector2d normalized =
+        camera.NormalizedFromImage({camera.cx(), camera.cy()}).value();
+    EXPECT_EQ(normalized, Eigen::Vector2d::Zero());
+  }
+}
+
+// Analytic DistortWithJacobian vs the derivative parts of a Jet run of
+// Distort, at points from the axis (series branch) to the image corners.
+template <typename Lens>
+void ExpectJacobianMatchesJets(const double* dist,
+                               const std::vector<Eigen::Vector2d>& points) {
+  using Jet = ceres::Jet<double, 2>;
+  Jet dist_jet[4];
+  for (int i = 0; i < 4; ++i) dist_jet[i] = Jet(dist[i]);
+  for (const Eigen::Vector2d& p : points) {
+    Jet xd, yd;
+    Lens::Distort(dist_jet, Jet(p.x(), 0), Jet(p.y(), 1), &xd, &yd);
+    double fx, fy, jacobian[4];
+    Lens::DistortWithJacobian(dist, p.x(), p.y(), &fx, &fy, jacobian);
+    // Jet arithmetic rounds divisions differently: a few ulp.
+    EXPECT_DOUBLE_EQ(fx, xd.a);
+    EXPECT_DOUBLE_EQ(fy, yd.a);
+    const double expected[4] = {xd.v[0], xd.v[1], yd.v[0], yd.v[1]};
+    for (int k = 0; k < 4; ++k) {
+      EXPECT_NEAR(jacobian[k], expected[k],
+                  kJacobianTolerance * (1.0 + std::abs(expected[k])))
+          << "entry " << k << " at (" << p.x() << ", " << p.y() << ")";
+    }
+  }
+}
+
+std::vector<Eigen::Vector2d> JacobianTestPoints() {
+  std::vector<Eigen::Vector2d> points = {
+      {0.0, 0.0}, {1e-9, -2e-9}, {3e-5, 1e-5}, {-0.2, 0.1}, {0.7, -0.45},
+      {-1.1, -0.8}, {2.0, 1.5}, {-30.0, 12.0}};
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> uniform(-1.5, 1.5);
+  for (int i = 0; i < 50; ++i) points.emplace_back(uniform(rng), uniform(rng));
+  return points;
+}
+
+TEST(RadTanLens, JacobianMatchesJets) {
+  const Camera camera = test::EurocRadtanCamera();
+  ExpectJacobianMatchesJets<RadTanLens>(camera.params() + 4,
+                                        JacobianTestPoints());
+}
+
+TEST(EquidistantLens, JacobianMatchesJets) {
+  const Camera camera = test::AlphasenseCam1();
+  ExpectJacobianMatchesJets<EquidistantLens>(camera.params() + 4,
+                                             JacobianTestPoints());
+}
+
+TEST(PinholeLens, JacobianIsIdentity) {
+  ExpectJacobianMatchesJets<PinholeLens>(nullptr, JacobianTestPoints());
+}
+
+TEST(EquidistantLens, JacobianMatchesCentralDifferencesNearAxis) {
+  // The series branch (r^2 < 1e-16) and the closed branch must agree where
+  // they meet; central differences of Distort check both.
+  const Camera camera = test::AlphasenseCam0();
+  const double* dist = camera.params() + 4;
+  for (double r : {1e-9, 0.99e-8, 1.01e-8, 1e-6}) {
+    const double x = 0.6 * r, y = -0.8 * r;
+    double fx, fy, jacobian[4];
+    EquidistantLens::DistortWithJacobian(dist, x, y, &fx, &fy, jacobian);
+    const double h = 1e-3;  // Distort is affine to 1e-16 at this scale.
+    double xp, yp, xm, ym;
+    EquidistantLens::Distort(dist, x + h * r, y, &xp, &yp);
+    EquidistantLens::Distort(dist, x - h * r, y, &xm, &ym);
+    EXPECT_NEAR(jacobian[0], (xp - xm) / (2 * h * r), 1e-7) << r;
+    EXPECT_NEAR(jacobian[2], (yp - ym) / (2 * h * r), 1e-7) << r;
+  }
+}
+
+// d(undistorted)/d(distorted) from a Jet run of Undistort must be the
+// inverse of the analytic distortion Jacobian (implicit function theorem).
+template <typename Lens>
+void ExpectUndistortDerivativeIsInverseJacobian(const double* dist) {
+  using Jet = ceres::Jet<double, 2>;
+  Jet dist_jet[4];
+  for (int i = 0; i < 4; ++i) dist_jet[i] = Jet(dist[i]);
+  for (const Eigen::Vector2d& p :
+       std::vector<Eigen::Vector2d>{{0.3, -0.2}, {-0.9, 0.7}, {1e-5, 2e-5}}) {
+    double xd, yd, jacobian[4];
+    Lens::DistortWithJacobian(dist, p.x(), p.y(), &xd, &yd, jacobian);
+    Jet x, y;
+    ASSERT_TRUE(Lens::Undistort(dist_jet, Jet(xd, 0), Jet(yd, 1), &x, &y));
+    EXPECT_NEAR(x.a, p.x(), 1e-13);
+    EXPECT_NEAR(y.a, p.y(), 1e-13);
+    const Eigen::Matrix2d inverse =
+        Eigen::Map<const Eigen::Matrix<double, 2, 2, Eigen::RowMajor>>(jacobian)
+            .inverse();
+    EXPECT_NEAR(x.v[0], inverse(0, 0), 1e-10);
+    EXPECT_NEAR(x.v[1], inverse(0, 1), 1e-10);
+    EXPECT_NEAR(y.v[0], inverse(1, 0), 1e-10);
+    EXPECT_NEAR(y.v[1], inverse(1, 1), 1e-10);
+  }
+}
+
+TEST(RadTanLens, UndistortDerivativeIsInverseJacobian) {
+  ExpectUndistortDerivativeIsInverseJacobian<RadTanLens>(
+      test::EurocRadtanCamera().params() + 4);
+}
+
+TEST(EquidistantLens, UndistortDerivativeIsInverseJacobian) {
+  ExpectUndistortDerivativeIsInverseJacobian<EquidistantLens>(
+      test::AlphasenseCam0().params() + 4);
+}
+
+// The derivative of Undistort with respect to the distortion coefficients
+// (what calibration needs) against central differences.
+template <typename Lens>
+void ExpectUndistortParameterDerivative(const double* dist) {
+  using Jet = ceres::Jet<double, 4>;
+  const double xd = 0.55, yd = -0.42;
+  Jet dist_jet[4];
+  for (int i = 0; i < 4; ++i) dist_jet[i] = Jet(dist[i], i);
+  Jet x, y;
+  ASSERT_TRUE(Lens::Undistort(dist_jet, Jet(xd), Jet(yd), &x, &y));
+  for (int i = 0; i < 4; ++i) {
+    // Central differences: truncation O(h^2) ~ 1e-12, rounding 1e-16 / h.
+    const double h = 1e-6;
+    double plus[4], minus[4];
+    for (int k = 0; k < 4; ++k) plus[k] = minus[k] = dist[k];
+    plus[i] += h;
+    minus[i] -= h;
+    double xp, yp, xm, ym;
+    ASSERT_TRUE(Lens::Undistort(plus, xd, yd, &xp, &yp));
+    ASSERT_TRUE(Lens::Undistort(minus, xd, yd, &xm, &ym));
+    EXPECT_NEAR(x.v[i], (xp - xm) / (2 * h), 1e-8) << "coefficient " << i;
+    EXPECT_NEAR(y.v[i], (yp - ym) / (2 * h), 1e-8) << "coefficient " << i;
+  }
+}
+
+TEST(RadTanLens, UndistortParameterDerivativeMatchesCentralDifferences) {
+  ExpectUndistortParameterDerivative<RadTanLens>(
+      test::EurocRadtanCamera().params() + 4);
+}
+
+TEST(EquidistantLens, UndistortParameterDerivativeMatchesCentralDifferences) {
+  ExpectUndistortParameterDerivative<EquidistantLens>(
+      test::AlphasenseCam0().params() + 4);
+}
+
+TEST(EquidistantLens, UndistortFailsAtAndBeyondNinetyDegrees) {
+  const double* dist = test::AlphasenseCam0().params() + 4;
+  const double theta_d_90 = EquidistantLens::DistortedAngle(dist, M_PI / 2);
+  double x, y;
+  EXPECT_TRUE(EquidistantLens::Undistort(dist, 0.999 * theta_d_90, 0.0, &x, &y));
+  EXPECT_GT(x, 100.0);  // 89.9+ degrees: far out on the normalized plane.
+  EXPECT_FALSE(EquidistantLens::Undistort(dist, theta_d_90, 0.0, &x, &y));
+  EXPECT_FALSE(
+      EquidistantLens::Undistort(dist, 0.8 * theta_d_90, 0.8 * theta_d_90, &x, &y));
+}
+
+TEST(RadTanLens, UndistortFailsBeyondFold) {
+  // r (1 - 0.5 r^2) peaks at 0.544 for r = 0.816: larger distorted radii
+  // have no preimage.
+  const double dist[4] = {-0.5, 0.0, 0.0, 0.0};
+  double x, y;
+  EXPECT_TRUE(RadTanLens::Undistort(dist, 0.5, 0.0, &x, &y));
+  EXPECT_FALSE(RadTanLens::Undistort(dist, 0.6, 0.0, &x, &y));
+}
+
+TEST(LensModels, UndistortRejectsNonFinite) {
+  const double dist[4] = {0.01, 0.001, 0.0, 0.0};
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  double x, y;
+  EXPECT_FALSE(RadTanLens::Undistort(dist, nan, 0.1, &x, &y));
+  EXPECT_FALSE(RadTanLens::Undistort(dist, 0.1, inf, &x, &y));
+  EXPECT_FALSE(EquidistantLens::Undistort(dist, nan, 0.1, &x, &y));
+  EXPECT_FALSE(EquidistantLens::Undistort(dist, inf, 0.1, &x, &y));
+}
+
+}  // namespace
+}  // namespace rcm

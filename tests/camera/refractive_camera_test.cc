@@ -1,1 +1,171 @@
-// Placeholder until the file is written; see rcm/CMakeLists.txt.
+#include "rcm/camera/refractive_camera.h"
+
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include "support/test_rigs.h"
+
+namespace rcm {
+namespace {
+
+// Pixel round trips go through the iterative undistortion (1e-14 residual
+// in normalized units, ~1e-11 px): 1e-9 px leaves two orders of margin.
+constexpr double kPixelTolerance = 1e-9;
+const double kIndices[] = {1.0, 1.33, 1.5};
+
+TEST(RefractiveCamera, RoundTripWideFov) {
+  // Every pixel of every test camera, including the 89.5-degree fisheye,
+  // to a point in the medium at several depths and back.
+  for (const Camera& camera : test::AllTestCameras()) {
+    for (double n : kIndices) {
+      const RefractiveCamera refractive =
+          RefractiveCamera::Create(camera, n).value();
+      double worst = 0.0;
+      for (const Eigen::Vector2d& pixel : test::ImageGrid(camera, 8.0)) {
+        const std::optional<Eigen::Vector3d> bearing =
+            refractive.BearingInWaterFromImage(pixel);
+        ASSERT_TRUE(bearing.has_value());
+        EXPECT_NEAR(bearing->norm(), 1.0, 1e-15);
+        for (double distance : {0.3, 2.0, 50.0}) {
+          const std::optional<Eigen::Vector2d> back =
+              refractive.ImageFromPointInWater(distance * *bearing);
+          ASSERT_TRUE(back.has_value())
+              << LensModelName(camera.model()) << " n = " << n << " at ("
+              << pixel.transpose() << ")";
+          worst = std::max(worst, (*back - pixel).norm());
+        }
+      }
+      EXPECT_LT(worst, kPixelTolerance)
+          << LensModelName(camera.model()) << " " << camera.width()
+          << " px wide, n = " << n;
+    }
+  }
+}
+
+TEST(RefractiveCamera, BearingInvertsProjection) {
+  // Points in the medium up to 40 degrees off axis (the critical angle is
+  // 48.8 degrees): the bearing of their pixel points back at them.
+  const RefractiveCamera refractive =
+      RefractiveCamera::Create(test::AlphasenseCam0(), 1.33).value();
+  for (double x = -1.0; x <= 1.0; x += 0.125) {
+    for (double y = -0.75; y <= 0.75; y += 0.125) {
+      const Eigen::Vector3d point(x, y, 1.5);
+      const std::optional<Eigen::Vector2d> pixel =
+          refractive.ImageFromPointInWater(point);
+      ASSERT_TRUE(pixel.has_value());
+      const Eigen::Vector3d bearing =
+          refractive.BearingInWaterFromImage(*pixel).value();
+      EXPECT_LT((bearing - point.normalized()).norm(), 1e-12);
+    }
+  }
+}
+
+TEST(RefractiveCamera, ReducesToPinholeAtNEqualsOne) {
+  const Camera camera = test::PinholeCamera();
+  const RefractiveCamera refractive = RefractiveCamera::Create(camera, 1.0).value();
+  Eigen::Matrix3d k;
+  k << camera.fx(), 0.0, camera.cx(), 0.0, camera.fy(), camera.cy(), 0, 0, 1;
+  EXPECT_EQ(refractive.VirtualPinholeMatrix(), k);
+  for (double x = -1.0; x <= 1.0; x += 0.1) {
+    for (double y = -0.8; y <= 0.8; y += 0.1) {
+      const Eigen::Vector3d point(x, y, 1.3);
+      const Eigen::Vector2d pinhole = (k * point).hnormalized();
+      const Eigen::Vector2d pixel = refractive.ImageFromPointInWater(point).value();
+      // 1e-12 relative to the pixel magnitude (a few hundred px).
+      EXPECT_LT((pixel - pinhole).norm(), 1e-12 * pinhole.norm());
+      const Eigen::Vector3d bearing =
+          refractive.BearingInWaterFromImage(pinhole).value();
+      EXPECT_LT((bearing - point.normalized()).norm(), 1e-12);
+    }
+  }
+}
+
+TEST(RefractiveCamera, RejectsIndexOutsideOneToTwo) {
+  const Camera camera = test::PinholeCamera();
+  for (double n : {0.99, 2.01, -1.33, std::numeric_limits<double>::quiet_NaN(),
+                   std::numeric_limits<double>::infinity()}) {
+    const StatusOr<RefractiveCamera> refractive = RefractiveCamera::Create(camera, n);
+    ASSERT_FALSE(refractive.ok()) << n;
+    EXPECT_NE(refractive.status().message().find("is outside [1, 2]"),
+              std::string::npos)
+        << refractive.status().message();
+  }
+  EXPECT_TRUE(RefractiveCamera::Create(camera, 1.0).ok());
+  EXPECT_TRUE(RefractiveCamera::Create(camera, 2.0).ok());
+}
+
+TEST(RefractiveCamera, ProjectionFailsBehindCameraAndPastCriticalAngle) {
+  const RefractiveCamera refractive =
+      RefractiveCamera::Create(test::WideEquidistantCamera(), 1.33).value();
+  EXPECT_FALSE(refractive.ImageFromPointInWater({0.0, 0.0, -1.0}).has_value());
+  const double critical = std::asin(1.0 / 1.33);
+  EXPECT_TRUE(refractive
+                  .ImageFromPointInWater(
+                      {std::sin(critical - 1e-3), 0.0, std::cos(critical - 1e-3)})
+                  .has_value());
+  EXPECT_FALSE(refractive
+                   .ImageFromPointInWater(
+                       {std::sin(critical + 1e-3), 0.0, std::cos(critical + 1e-3)})
+                   .has_value());
+}
+
+TEST(RefractiveCamera, ProjectionRefusesFoldedLensBranch) {
+  // A radtan lens that folds at r = 0.816: points beyond the fold would land
+  // on wrong pixels inside the image.
+  const Camera folded =
+      Camera::Create(LensModelId::kRadTan, 640, 480,
+                     {300.0, 300.0, 319.5, 239.5}, {-0.5, 0.0, 0.0, 0.0})
+          .value();
+  const RefractiveCamera refractive = RefractiveCamera::Create(folded, 1.0).value();
+  EXPECT_TRUE(refractive.ImageFromPointInWater({0.8, 0.0, 1.0}).has_value());
+  EXPECT_FALSE(refractive.ImageFromPointInWater({1.2, 0.0, 1.0}).has_value());
+}
+
+TEST(RefractiveCamera, VirtualPinholeRoundTrip) {
+  for (double n : kIndices) {
+    const RefractiveCamera refractive =
+        RefractiveCamera::Create(test::AlphasenseCam1(), n).value();
+    for (const Eigen::Vector2d& pixel :
+         test::ImageGrid(test::AlphasenseCam1(), 16.0)) {
+      const Eigen::Vector2d virtual_pixel =
+          refractive.VirtualPinholeFromImage(pixel).value();
+      const Eigen::Vector2d back =
+          refractive.ImageFromVirtualPinhole(virtual_pixel).value();
+      EXPECT_LT((back - pixel).norm(), kPixelTolerance);
+    }
+  }
+}
+
+TEST(RefractiveCamera, VirtualPinholeProjectsWithKn) {
+  // The virtual image is the pinhole K_n of the medium (eq. 9).
+  const RefractiveCamera refractive =
+      RefractiveCamera::Create(test::EurocRadtanCamera(), 1.34).value();
+  const Eigen::Matrix3d k_n = refractive.VirtualPinholeMatrix();
+  EXPECT_DOUBLE_EQ(k_n(0, 0), 1.34 * test::EurocRadtanCamera().fx());
+  for (const Eigen::Vector3d& point :
+       {Eigen::Vector3d(0.3, -0.2, 2.0), Eigen::Vector3d(-0.9, 0.5, 1.1)}) {
+    const Eigen::Vector2d pixel = refractive.ImageFromPointInWater(point).value();
+    const Eigen::Vector2d virtual_pixel =
+        refractive.VirtualPinholeFromImage(pixel).value();
+    EXPECT_LT((virtual_pixel - (k_n * point).hnormalized()).norm(), 1e-9);
+  }
+}
+
+TEST(RefractiveCamera, VirtualPinholeBeyondCriticalAngleHasNoSource) {
+  // The virtual pinhole image is unbounded, the camera's view is not: a
+  // virtual pixel past the critical angle has no raw pixel.
+  const RefractiveCamera refractive =
+      RefractiveCamera::Create(test::PinholeCamera(), 1.33).value();
+  const double critical_tan = std::tan(std::asin(1.0 / 1.33));
+  const double fx = test::PinholeCamera().fx() * 1.33;
+  EXPECT_FALSE(refractive
+                   .ImageFromVirtualPinhole(
+                       {319.5 + 1.01 * critical_tan * fx, 239.5})
+                   .has_value());
+}
+
+}  // namespace
+}  // namespace rcm

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <sstream>
 
+#include <Eigen/LU>
+
 namespace rcm {
 
 std::string_view LensModelName(LensModelId model) {
@@ -113,6 +115,10 @@ Eigen::Matrix2d Camera::ImageFromNormalizedJacobian(
   result << fx() * jacobian[0], fx() * jacobian[1], fy() * jacobian[2],
       fy() * jacobian[3];
   return result;
+}
+
+bool Camera::LensInvertibleAt(const Eigen::Vector2d& normalized) const {
+  return ImageFromNormalizedJacobian(normalized).determinant() > 0.0;
 }
 
 bool Camera::InImage(const Eigen::Vector2d& pixel) const {

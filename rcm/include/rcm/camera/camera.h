@@ -79,6 +79,12 @@ class Camera {
   Eigen::Matrix2d ImageFromNormalizedJacobian(
       const Eigen::Vector2d& normalized) const;
 
+  // True where the lens map is locally invertible (det of its Jacobian
+  // > 0). Beyond the radius where a radial polynomial folds back, a point
+  // would project onto a wrong pixel inside the image; projection refuses
+  // such points.
+  bool LensInvertibleAt(const Eigen::Vector2d& normalized) const;
+
   // True when the pixel lies on the sensor: [-0.5, width - 0.5] x
   // [-0.5, height - 0.5] with pixel centers at integers.
   bool InImage(const Eigen::Vector2d& pixel) const;

@@ -1,0 +1,48 @@
+// Correspondences sampled from the refractive model itself: exact up to
+// floating point, for tests, examples and benchmarks. (An independent
+// flat-port ray tracer, which does not share code with the model, is the
+// job of the simulator; this sampler is the model's own forward map.)
+//
+// Sampling: a left pixel uniform over the image, a depth Z (left camera
+// frame) uniform in [min_depth, max_depth]; the scene point is the left
+// pixel's ray in the medium at that depth, and both pixels are obtained by
+// projecting it (RefractiveCamera::ImageFromPointInWater). Points whose
+// right pixel falls outside the right image are redrawn.
+#ifndef RCM_SIM_STEREO_SAMPLER_H_
+#define RCM_SIM_STEREO_SAMPLER_H_
+
+#include <cstdint>
+#include <vector>
+
+#include "rcm/geometry/stereo_correspondence.h"
+#include "rcm/geometry/stereo_rig.h"
+#include "rcm/util/status.h"
+
+namespace rcm {
+
+struct StereoSamplerOptions {
+  double n = 1.333;          // refractive index of the medium, in [1, 2]
+  double min_depth = 0.6;    // meters, Z in the left camera frame, > 0
+  double max_depth = 6.0;    // meters, >= min_depth
+  int num_frames = 1;        // >= 1; frames are numbered 0, 1, ...
+  int per_frame = 100;       // correspondences per frame, >= 1
+  double frame_rate = 20.0;  // Hz; timestamps t = frame / frame_rate, > 0
+  uint64_t seed = 1;         // the sample depends only on the seed
+
+  Status Check() const;
+};
+
+// Exact correspondences, per_frame for each frame, with timestamps. Fails
+// when options are invalid or the rig's images barely overlap (fewer than
+// one in 100 draws lands in both images).
+StatusOr<std::vector<StereoCorrespondence>> SampleStereoCorrespondences(
+    const StereoRig& rig, const StereoSamplerOptions& options);
+
+// Adds independent zero-mean Gaussian noise of standard deviation sigma_px
+// to all four pixel coordinates.
+void AddPixelNoise(double sigma_px, uint64_t seed,
+                   std::vector<StereoCorrespondence>* correspondences);
+
+}  // namespace rcm
+
+#endif  // RCM_SIM_STEREO_SAMPLER_H_

@@ -1,0 +1,103 @@
+#include "rcm/sim/stereo_sampler.h"
+
+#include <cmath>
+#include <random>
+#include <sstream>
+
+#include "rcm/camera/refractive_camera.h"
+
+namespace rcm {
+
+Status StereoSamplerOptions::Check() const {
+  std::ostringstream message;
+  if (!std::isfinite(n) || n < RefractiveCamera::kMinIndex ||
+      n > RefractiveCamera::kMaxIndex) {
+    message << "n = " << n << " is outside [" << RefractiveCamera::kMinIndex
+            << ", " << RefractiveCamera::kMaxIndex << "]";
+  } else if (!(min_depth > 0.0) || !std::isfinite(max_depth) ||
+             !(max_depth >= min_depth)) {
+    message << "depth range [" << min_depth << ", " << max_depth
+            << "] must satisfy 0 < min_depth <= max_depth < inf";
+  } else if (num_frames < 1 || per_frame < 1) {
+    message << "num_frames = " << num_frames << " and per_frame = " << per_frame
+            << " must be >= 1";
+  } else if (!(frame_rate > 0.0) || !std::isfinite(frame_rate)) {
+    message << "frame_rate = " << frame_rate << " must be > 0";
+  } else {
+    return Status::Ok();
+  }
+  return Status::Error(message.str());
+}
+
+StatusOr<std::vector<StereoCorrespondence>> SampleStereoCorrespondences(
+    const StereoRig& rig, const StereoSamplerOptions& options) {
+  RCM_RETURN_IF_ERROR(options.Check());
+  const RefractiveCamera left =
+      RefractiveCamera::Create(rig.left(), options.n).value();
+  const RefractiveCamera right =
+      RefractiveCamera::Create(rig.right(), options.n).value();
+
+  std::mt19937_64 rng(options.seed);
+  std::uniform_real_distribution<double> u_dist(-0.5, rig.left().width() - 0.5);
+  std::uniform_real_distribution<double> v_dist(-0.5,
+                                                rig.left().height() - 0.5);
+  std::uniform_real_distribution<double> depth_dist(options.min_depth,
+                                                    options.max_depth);
+
+  const int64_t total =
+      static_cast<int64_t>(options.num_frames) * options.per_frame;
+  const int64_t max_draws = 100 * total;
+  std::vector<StereoCorrespondence> correspondences;
+  correspondences.reserve(total);
+  int64_t draws = 0;
+  for (int frame = 0; frame < options.num_frames; ++frame) {
+    for (int i = 0; i < options.per_frame;) {
+      if (++draws > max_draws) {
+        std::ostringstream message;
+        message << "only " << correspondences.size() << " of " << total
+                << " sampled points are visible in both images; do the "
+                   "cameras overlap at depths ["
+                << options.min_depth << ", " << options.max_depth << "] m?";
+        return Status::Error(message.str());
+      }
+      const Eigen::Vector2d drawn(u_dist(rng), v_dist(rng));
+      const double depth = depth_dist(rng);
+      const std::optional<Eigen::Vector3d> bearing =
+          left.BearingInWaterFromImage(drawn);
+      if (!bearing) continue;
+      const Eigen::Vector3d point_in_left = *bearing * (depth / bearing->z());
+      const std::optional<Eigen::Vector2d> left_pixel =
+          left.ImageFromPointInWater(point_in_left);
+      const std::optional<Eigen::Vector2d> right_pixel =
+          right.ImageFromPointInWater(rig.right_from_left() * point_in_left);
+      if (!left_pixel || !right_pixel || !rig.left().InImage(*left_pixel) ||
+          !rig.right().InImage(*right_pixel)) {
+        continue;
+      }
+      StereoCorrespondence correspondence;
+      correspondence.frame = frame;
+      correspondence.timestamp = frame / options.frame_rate;
+      correspondence.left_pixel = *left_pixel;
+      correspondence.right_pixel = *right_pixel;
+      correspondences.push_back(correspondence);
+      ++i;
+    }
+  }
+  return correspondences;
+}
+
+void AddPixelNoise(double sigma_px, uint64_t seed,
+                   std::vector<StereoCorrespondence>* correspondences) {
+  CHECK(correspondences != nullptr);
+  CHECK_GE(sigma_px, 0.0);
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, sigma_px);
+  for (StereoCorrespondence& c : *correspondences) {
+    c.left_pixel.x() += noise(rng);
+    c.left_pixel.y() += noise(rng);
+    c.right_pixel.x() += noise(rng);
+    c.right_pixel.y() += noise(rng);
+  }
+}
+
+}  // namespace rcm

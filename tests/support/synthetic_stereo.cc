@@ -1,1 +1,0 @@
-// Placeholder until the file is written; see rcm/CMakeLists.txt.

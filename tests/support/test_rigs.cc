@@ -1,0 +1,91 @@
+#include "support/test_rigs.h"
+
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+namespace rcm::test {
+
+Camera AlphasenseCam0() {
+  return Camera::Create(LensModelId::kEquidistant, 720, 540,
+                        {346.68681661781403, 346.7780959214622,
+                         360.53325988648163, 271.0179819820658},
+                        {-0.037934508908317364, -0.0009855550912794707,
+                         -0.0009622185860956224, 2.365797666527927e-05})
+      .value();
+}
+
+Camera AlphasenseCam1() {
+  return Camera::Create(LensModelId::kEquidistant, 720, 540,
+                        {344.3933991977547, 344.2292927278568,
+                         358.725925185576, 262.02195974034373},
+                        {-0.03970881800919102, 0.0016107591002609727,
+                         -0.002331667784337188, 0.00035009066006595556})
+      .value();
+}
+
+Camera EurocRadtanCamera() {
+  return Camera::Create(LensModelId::kRadTan, 752, 480,
+                        {458.654, 457.296, 367.215, 248.375},
+                        {-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05})
+      .value();
+}
+
+Camera PinholeCamera() {
+  return Camera::Create(LensModelId::kPinhole, 640, 480,
+                        {400.0, 400.0, 319.5, 239.5}, {})
+      .value();
+}
+
+Camera WideEquidistantCamera() {
+  const std::vector<double> k = AlphasenseCam0().Distortion();
+  const double theta = 89.5 * M_PI / 180.0;
+  const double theta_d = EquidistantLens::DistortedAngle(k.data(), theta);
+  const double corner_distance = std::hypot(512.0, 512.0);
+  const double f = corner_distance / theta_d;
+  return Camera::Create(LensModelId::kEquidistant, 1024, 1024,
+                        {f, f, 511.5, 511.5}, k)
+      .value();
+}
+
+std::vector<Camera> AllTestCameras() {
+  return {PinholeCamera(), EurocRadtanCamera(), AlphasenseCam0(),
+          AlphasenseCam1(), WideEquidistantCamera()};
+}
+
+StereoRig IdealRig(const Camera& left, const Camera& right, double baseline) {
+  Rigid3d right_from_left;
+  right_from_left.translation = Eigen::Vector3d(-baseline, 0.0, 0.0);
+  return StereoRig::Create(left, right, right_from_left).value();
+}
+
+StereoRig AlphasenseIdealRig() {
+  return IdealRig(AlphasenseCam0(), AlphasenseCam1());
+}
+
+StereoRig AlphasenseRealisticRig() {
+  Rigid3d right_from_left;
+  right_from_left.rotation =
+      Eigen::AngleAxisd(0.5 * M_PI / 180.0,
+                        Eigen::Vector3d(0.3, 1.0, -0.4).normalized())
+          .toRotationMatrix();
+  right_from_left.translation = Eigen::Vector3d(-0.11, 0.0015, -0.002);
+  return StereoRig::Create(AlphasenseCam0(), AlphasenseCam1(), right_from_left)
+      .value();
+}
+
+std::vector<Eigen::Vector2d> ImageGrid(const Camera& camera, double step) {
+  std::vector<double> us, vs;
+  for (double u = -0.5; u < camera.width() - 0.5; u += step) us.push_back(u);
+  us.push_back(camera.width() - 0.5);
+  for (double v = -0.5; v < camera.height() - 0.5; v += step) vs.push_back(v);
+  vs.push_back(camera.height() - 0.5);
+  std::vector<Eigen::Vector2d> grid;
+  grid.reserve(us.size() * vs.size());
+  for (double v : vs) {
+    for (double u : us) grid.emplace_back(u, v);
+  }
+  return grid;
+}
+
+}  // namespace rcm::test

@@ -1,0 +1,44 @@
+// Cameras and rigs shared by the tests: the paper's real calibration, a
+// radtan camera, a pinhole, a fisheye reaching 89.5 degrees, and stereo
+// rigs built from them.
+#ifndef RCM_TESTS_SUPPORT_TEST_RIGS_H_
+#define RCM_TESTS_SUPPORT_TEST_RIGS_H_
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "rcm/camera/camera.h"
+#include "rcm/geometry/stereo_rig.h"
+
+namespace rcm::test {
+
+// The paper's Alphasense front pair, 720x540, equidistant (DESIGN.md Sec. 5).
+Camera AlphasenseCam0();
+Camera AlphasenseCam1();
+// EuRoC MAV cam0, 752x480, radtan.
+Camera EurocRadtanCamera();
+// 640x480, f = 400, no distortion.
+Camera PinholeCamera();
+// 1024x1024 equidistant (Alphasense coefficients) whose image corners see
+// rays 89.5 degrees off axis.
+Camera WideEquidistantCamera();
+// Every camera above, for tests that sweep them.
+std::vector<Camera> AllTestCameras();
+
+// The ideal rectified pair of the paper: right_from_left = (I, (-b, 0, 0)).
+StereoRig IdealRig(const Camera& left, const Camera& right,
+                   double baseline = 0.11);
+// The Alphasense intrinsics on the ideal rectified extrinsics.
+StereoRig AlphasenseIdealRig();
+// The Alphasense intrinsics, 0.5 degrees of rotation about a skew axis and
+// a baseline slightly off the x axis: a real, unrectified rig.
+StereoRig AlphasenseRealisticRig();
+
+// Pixels on a grid covering the whole image with `step` spacing, plus the
+// four borders (-0.5 and size - 0.5) and the exact corners.
+std::vector<Eigen::Vector2d> ImageGrid(const Camera& camera, double step);
+
+}  // namespace rcm::test
+
+#endif  // RCM_TESTS_SUPPORT_TEST_RIGS_H_
