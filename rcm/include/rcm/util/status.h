@@ -67,7 +67,8 @@ class [[nodiscard]] StatusOr {
     CHECK(ok()) << "value() of a failed StatusOr: " << status().message();
     return std::get<T>(data_);
   }
-  T&& value() && {
+  // By value, not T&&: `for (x : Make().value())` must not dangle.
+  T value() && {
     CHECK(ok()) << "value() of a failed StatusOr: " << status().message();
     return std::get<T>(std::move(data_));
   }
