@@ -1,1 +1,474 @@
-// Placeholder until the file is written; see rcm/CMakeLists.txt.
+#include "rcm/io/camera_info.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+#include "rcm/io/number_format.h"
+
+namespace rcm {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+// A camera_info as camera_calibration_parsers writes it (the ROS stereo
+// calibrator's left.yaml). Line numbers for the error tests:
+//   7 camera_matrix.data   8 distortion_model   12 distortion data
+//  16 rectification data  20 projection data
+constexpr char kLeft[] = R"(image_width: 720
+image_height: 540
+camera_name: left
+camera_matrix:
+  rows: 3
+  cols: 3
+  data: [346.7, 0, 360.5, 0, 346.8, 271.0, 0, 0, 1]
+distortion_model: plumb_bob
+distortion_coefficients:
+  rows: 1
+  cols: 5
+  data: [-0.28, 0.07, 0.0002, -0.00003, 0]
+rectification_matrix:
+  rows: 3
+  cols: 3
+  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]
+projection_matrix:
+  rows: 3
+  cols: 4
+  data: [350.0, 0, 362.0, 0, 0, 350.0, 270.0, 0, 0, 0, 1, 0]
+)";
+
+std::string ReplaceOnce(const std::string& text, const std::string& from,
+                        const std::string& to) {
+  const size_t position = text.find(from);
+  if (position == std::string::npos ||
+      text.find(from, position + 1) != std::string::npos) {
+    ADD_FAILURE() << "'" << from << "' does not occur exactly once";
+    return text;
+  }
+  std::string result = text;
+  result.replace(position, from.size(), to);
+  return result;
+}
+
+std::string ParseError(const std::string& text) {
+  const StatusOr<CameraInfo> info = ParseCameraInfo(text, "left.yaml");
+  if (info.ok()) return "";
+  return info.status().message();
+}
+
+std::string FlowList(const double* values, int size) {
+  std::string text = "[";
+  for (int i = 0; i < size; ++i) {
+    text += (i == 0 ? "" : ", ") + FormatDouble(values[i]);
+  }
+  return text + "]";
+}
+
+// The camera_info text of one camera of a ROS-rectified pair.
+std::string FormatCameraInfo(const std::string& name,
+                             const Eigen::Matrix3d& camera_matrix,
+                             const std::vector<double>& distortion,
+                             const Eigen::Matrix3d& rectification,
+                             const Eigen::Matrix<double, 3, 4>& projection) {
+  const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> k = camera_matrix;
+  const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> r = rectification;
+  const Eigen::Matrix<double, 3, 4, Eigen::RowMajor> p = projection;
+  return "image_width: 720\n"
+         "image_height: 540\n"
+         "camera_name: " +
+         name +
+         "\n"
+         "camera_matrix:\n"
+         "  rows: 3\n"
+         "  cols: 3\n"
+         "  data: " +
+         FlowList(k.data(), 9) +
+         "\n"
+         "distortion_model: plumb_bob\n"
+         "distortion_coefficients:\n"
+         "  rows: 1\n"
+         "  cols: 5\n"
+         "  data: " +
+         FlowList(distortion.data(), static_cast<int>(distortion.size())) +
+         "\n"
+         "rectification_matrix:\n"
+         "  rows: 3\n"
+         "  cols: 3\n"
+         "  data: " +
+         FlowList(r.data(), 9) +
+         "\n"
+         "projection_matrix:\n"
+         "  rows: 3\n"
+         "  cols: 4\n"
+         "  data: " +
+         FlowList(p.data(), 12) + "\n";
+}
+
+// A stereo pair rectified the way OpenCV's stereoRectify / ROS do it, from
+// a known rig: R_l turns the baseline onto the x axis (plus a roll about
+// it), R_r = R_l R^T, both P share K' and the right one has Tx = -fx' B.
+class CameraInfoStereo : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const Eigen::Vector3d angle_axis(0.004, -0.012, 0.002);
+    right_from_left_.rotation =
+        Eigen::AngleAxisd(angle_axis.norm(), angle_axis.normalized())
+            .toRotationMatrix();
+    right_from_left_.translation = Eigen::Vector3d(-0.11, 0.0015, -0.0008);
+    // Right camera center in the left frame.
+    const Eigen::Vector3d center =
+        -(right_from_left_.rotation.transpose() * right_from_left_.translation);
+    const Eigen::Matrix3d rect_left =
+        Eigen::AngleAxisd(0.003, Eigen::Vector3d::UnitX()).toRotationMatrix() *
+        Eigen::Quaterniond::FromTwoVectors(center, Eigen::Vector3d::UnitX())
+            .toRotationMatrix();
+    const Eigen::Matrix3d rect_right =
+        rect_left * right_from_left_.rotation.transpose();
+    const double baseline = center.norm();
+
+    Eigen::Matrix3d k_left;
+    k_left << 346.68681661781403, 0.0, 360.53325988648163, 0.0,
+        346.7780959214622, 271.0179819820658, 0.0, 0.0, 1.0;
+    Eigen::Matrix3d k_right;
+    k_right << 344.3933991977547, 0.0, 358.725925185576, 0.0, 344.2292927278568,
+        262.02195974034373, 0.0, 0.0, 1.0;
+    const double fx_rect = 345.123456789;
+    Eigen::Matrix<double, 3, 4> p_left;
+    p_left << fx_rect, 0.0, 352.25, 0.0, 0.0, fx_rect, 268.5, 0.0, 0.0, 0.0,
+        1.0, 0.0;
+    Eigen::Matrix<double, 3, 4> p_right = p_left;
+    p_right(0, 3) = -fx_rect * baseline;
+
+    left_text_ = FormatCameraInfo("alphasense/left", k_left,
+                                  {-0.28, 0.07, 0.0002, -0.00003, 0.0},
+                                  rect_left, p_left);
+    right_text_ = FormatCameraInfo("alphasense/right", k_right,
+                                   {-0.27, 0.068, -0.0001, 0.00005, 0.0},
+                                   rect_right, p_right);
+  }
+
+  Rigid3d right_from_left_;
+  std::string left_text_;
+  std::string right_text_;
+};
+
+TEST_F(CameraInfoStereo, ParsesCameraInfo) {
+  const StatusOr<CameraInfo> info = ParseCameraInfo(left_text_, "left.yaml");
+  ASSERT_TRUE(info.ok()) << info.status().message();
+  EXPECT_EQ(info->camera_name, "alphasense/left");
+  EXPECT_EQ(info->camera.model(), LensModelId::kRadTan);
+  EXPECT_EQ(info->camera.width(), 720);
+  EXPECT_EQ(info->camera.height(), 540);
+  EXPECT_EQ(info->camera.fx(), 346.68681661781403);
+  EXPECT_EQ(info->camera.fy(), 346.7780959214622);
+  EXPECT_EQ(info->camera.cx(), 360.53325988648163);
+  EXPECT_EQ(info->camera.cy(), 271.0179819820658);
+  EXPECT_EQ(info->camera.Distortion(),
+            (std::vector<double>{-0.28, 0.07, 0.0002, -0.00003}));
+  EXPECT_EQ(info->projection(0, 0), 345.123456789);
+  EXPECT_EQ(info->projection(1, 2), 268.5);
+  EXPECT_LT((info->rectification.transpose() * info->rectification -
+             Eigen::Matrix3d::Identity())
+                .cwiseAbs()
+                .maxCoeff(),
+            1e-15);
+}
+
+TEST_F(CameraInfoStereo, RecoversRightFromLeft) {
+  const StatusOr<CameraInfo> left = ParseCameraInfo(left_text_, "left.yaml");
+  const StatusOr<CameraInfo> right = ParseCameraInfo(right_text_, "right.yaml");
+  ASSERT_TRUE(left.ok()) << left.status().message();
+  ASSERT_TRUE(right.ok()) << right.status().message();
+  const StatusOr<StereoRig> rig = StereoRigFromCameraInfo(*left, *right);
+  ASSERT_TRUE(rig.ok()) << rig.status().message();
+  EXPECT_LT((rig->right_from_left().rotation - right_from_left_.rotation)
+                .cwiseAbs()
+                .maxCoeff(),
+            1e-12);
+  EXPECT_LT((rig->right_from_left().translation - right_from_left_.translation)
+                .cwiseAbs()
+                .maxCoeff(),
+            1e-12);
+  EXPECT_EQ(rig->left().fx(), 346.68681661781403);
+  EXPECT_EQ(rig->right().fx(), 344.3933991977547);
+}
+
+TEST_F(CameraInfoStereo, RejectsSwappedPair) {
+  const StatusOr<CameraInfo> left = ParseCameraInfo(left_text_, "left.yaml");
+  const StatusOr<CameraInfo> right = ParseCameraInfo(right_text_, "right.yaml");
+  ASSERT_TRUE(left.ok() && right.ok());
+  const StatusOr<StereoRig> rig = StereoRigFromCameraInfo(*right, *left);
+  ASSERT_FALSE(rig.ok());
+  EXPECT_THAT(rig.status().message(),
+              StartsWith("left projection_matrix has a nonzero 4th column "
+                         "(Tx = -"));
+  EXPECT_THAT(rig.status().message(), HasSubstr("give the left camera first"));
+}
+
+TEST(CameraInfo, StereoRigRejectsMalformedProjection) {
+  const StatusOr<CameraInfo> left = ParseCameraInfo(kLeft, "left.yaml");
+  const StatusOr<CameraInfo> right = ParseCameraInfo(
+      ReplaceOnce(kLeft, "[350.0, 0, 362.0, 0, 0, 350.0, 270.0, 0, 0, 0, 1, 0]",
+                  "[350.0, 0, 362.0, -38.5, 0, 350.0, 270.0, 0, 0, 0, 2, 0]"),
+      "right.yaml");
+  ASSERT_TRUE(left.ok() && right.ok());
+  const StatusOr<StereoRig> rig = StereoRigFromCameraInfo(*left, *right);
+  ASSERT_FALSE(rig.ok());
+  EXPECT_EQ(rig.status().message(),
+            "right projection_matrix: expected [fx' 0 cx' Tx; 0 fy' cy' Ty; 0 "
+            "0 1 0] with fx', fy' > 0, got [350.0 0.0 362.0 -38.5; 0.0 350.0 "
+            "270.0 0.0; 0.0 0.0 2.0 0.0]");
+}
+
+TEST(CameraInfo, StereoRigRejectsZeroBaseline) {
+  const StatusOr<CameraInfo> info = ParseCameraInfo(kLeft, "left.yaml");
+  ASSERT_TRUE(info.ok()) << info.status().message();
+  const StatusOr<StereoRig> rig = StereoRigFromCameraInfo(*info, *info);
+  ASSERT_FALSE(rig.ok());
+  EXPECT_THAT(rig.status().message(), StartsWith("zero baseline"));
+}
+
+TEST(CameraInfo, DefaultsRectificationAndProjection) {
+  const std::string text = kLeft;
+  const std::string without = text.substr(0, text.find("rectification_matrix"));
+  const StatusOr<CameraInfo> info = ParseCameraInfo(without, "left.yaml");
+  ASSERT_TRUE(info.ok()) << info.status().message();
+  EXPECT_EQ(info->rectification, Eigen::Matrix3d::Identity());
+  Eigen::Matrix<double, 3, 4> expected;
+  expected << 346.7, 0.0, 360.5, 0.0, 0.0, 346.8, 271.0, 0.0, 0.0, 0.0, 1.0,
+      0.0;
+  EXPECT_EQ(info->projection, expected);
+}
+
+TEST(CameraInfo, AcceptsFourPlumbBobCoefficients) {
+  const StatusOr<CameraInfo> info =
+      ParseCameraInfo(ReplaceOnce(ReplaceOnce(kLeft, "cols: 5", "cols: 4"),
+                                  "[-0.28, 0.07, 0.0002, -0.00003, 0]",
+                                  "[-0.28, 0.07, 0.0002, -0.00003]"),
+                      "left.yaml");
+  ASSERT_TRUE(info.ok()) << info.status().message();
+  EXPECT_EQ(info->camera.Distortion(),
+            (std::vector<double>{-0.28, 0.07, 0.0002, -0.00003}));
+}
+
+TEST(CameraInfo, AllZeroPlumbBobIsRadTan) {
+  const StatusOr<CameraInfo> info =
+      ParseCameraInfo(ReplaceOnce(kLeft, "[-0.28, 0.07, 0.0002, -0.00003, 0]",
+                                  "[0.0, 0.0, 0.0, 0.0, 0.0]"),
+                      "left.yaml");
+  ASSERT_TRUE(info.ok()) << info.status().message();
+  EXPECT_EQ(info->camera.model(), LensModelId::kRadTan);
+  EXPECT_EQ(info->camera.Distortion(), std::vector<double>(4, 0.0));
+}
+
+TEST(CameraInfo, RadTanNameIsAccepted) {
+  const StatusOr<CameraInfo> info =
+      ParseCameraInfo(ReplaceOnce(kLeft, "plumb_bob", "radtan"), "left.yaml");
+  ASSERT_TRUE(info.ok()) << info.status().message();
+  EXPECT_EQ(info->camera.model(), LensModelId::kRadTan);
+}
+
+TEST(CameraInfo, MissingDistortionModelMeansPlumbBob) {
+  const StatusOr<CameraInfo> info = ParseCameraInfo(
+      ReplaceOnce(kLeft, "distortion_model: plumb_bob\n", ""), "left.yaml");
+  ASSERT_TRUE(info.ok()) << info.status().message();
+  EXPECT_EQ(info->camera.model(), LensModelId::kRadTan);
+}
+
+TEST(CameraInfo, EquidistantTakesFourCoefficients) {
+  const StatusOr<CameraInfo> info = ParseCameraInfo(
+      ReplaceOnce(ReplaceOnce(ReplaceOnce(kLeft, "plumb_bob", "equidistant"),
+                              "cols: 5", "cols: 4"),
+                  "[-0.28, 0.07, 0.0002, -0.00003, 0]",
+                  "[-0.0379, -0.00098, -0.00096, 2.36e-05]"),
+      "left.yaml");
+  ASSERT_TRUE(info.ok()) << info.status().message();
+  EXPECT_EQ(info->camera.model(), LensModelId::kEquidistant);
+  EXPECT_EQ(info->camera.Distortion(),
+            (std::vector<double>{-0.0379, -0.00098, -0.00096, 2.36e-05}));
+}
+
+TEST(CameraInfo, NoneModelIsPinhole) {
+  const StatusOr<CameraInfo> info = ParseCameraInfo(
+      ReplaceOnce(ReplaceOnce(kLeft, "plumb_bob", "none"),
+                  "[-0.28, 0.07, 0.0002, -0.00003, 0]", "[0, 0, 0, 0, 0]"),
+      "left.yaml");
+  ASSERT_TRUE(info.ok()) << info.status().message();
+  EXPECT_EQ(info->camera.model(), LensModelId::kPinhole);
+  EXPECT_TRUE(info->camera.Distortion().empty());
+}
+
+TEST(CameraInfo, EmptyModelNameIsPinhole) {
+  const std::string text = kLeft;
+  const std::string head = text.substr(0, text.find("distortion_model"));
+  const std::string tail = text.substr(text.find("rectification_matrix"));
+  const StatusOr<CameraInfo> info =
+      ParseCameraInfo(head + "distortion_model: \"\"\n" + tail, "left.yaml");
+  ASSERT_TRUE(info.ok()) << info.status().message();
+  EXPECT_EQ(info->camera.model(), LensModelId::kPinhole);
+}
+
+// --- Malformed input
+// ----------------------------------------------------------
+
+TEST(CameraInfo, FixtureIsValid) { EXPECT_EQ(ParseError(kLeft), ""); }
+
+TEST(CameraInfo, RejectsMissingCameraMatrix) {
+  const std::string text = kLeft;
+  const std::string without = text.substr(0, text.find("camera_matrix")) +
+                              text.substr(text.find("distortion_model"));
+  EXPECT_EQ(ParseError(without), "left.yaml: missing key 'camera_matrix'");
+}
+
+TEST(CameraInfo, RejectsMissingImageWidth) {
+  EXPECT_EQ(ParseError(ReplaceOnce(kLeft, "image_width: 720\n", "")),
+            "left.yaml: missing key 'image_width'");
+}
+
+TEST(CameraInfo, RejectsMissingData) {
+  EXPECT_EQ(
+      ParseError(ReplaceOnce(
+          kLeft, "  data: [346.7, 0, 360.5, 0, 346.8, 271.0, 0, 0, 1]\n", "")),
+      "left.yaml: camera_matrix: missing key 'data'");
+}
+
+TEST(CameraInfo, RejectsWrongDataLength) {
+  EXPECT_EQ(ParseError(ReplaceOnce(kLeft,
+                                   "[346.7, 0, 360.5, 0, 346.8, 271.0, "
+                                   "0, 0, 1]",
+                                   "[346.7, 0, 360.5, 0, 346.8, 271.0, 0, 0]")),
+            "left.yaml:7: camera_matrix.data: expected 9 numbers (3x3), got 8");
+}
+
+TEST(CameraInfo, RejectsWrongRowCount) {
+  EXPECT_EQ(ParseError(ReplaceOnce(kLeft, "  rows: 3\n  cols: 4",
+                                   "  rows: 4\n  cols: 4")),
+            "left.yaml:18: projection_matrix.rows: expected 3, got 4");
+}
+
+TEST(CameraInfo, RejectsColsThatDisagreeWithData) {
+  EXPECT_EQ(ParseError(ReplaceOnce(kLeft, "cols: 5", "cols: 4")),
+            "left.yaml:11: distortion_coefficients.cols: expected 5, got 4");
+}
+
+TEST(CameraInfo, RejectsUnknownModel) {
+  EXPECT_EQ(ParseError(ReplaceOnce(kLeft, "plumb_bob", "rational_polynomial")),
+            "left.yaml:8: distortion_model: unknown model "
+            "'rational_polynomial' (supported: plumb_bob, radtan, "
+            "equidistant, none)");
+}
+
+TEST(CameraInfo, RejectsNonzeroK3) {
+  EXPECT_EQ(ParseError(ReplaceOnce(kLeft, "-0.00003, 0]", "-0.00003, 0.01]")),
+            "left.yaml:12: distortion_coefficients.data: k3 = 0.01 is not "
+            "supported: rcm's radtan model has k1, k2, p1, p2; recalibrate "
+            "with k3 fixed to 0");
+}
+
+TEST(CameraInfo, RejectsWrongPlumbBobCount) {
+  EXPECT_EQ(ParseError(ReplaceOnce(ReplaceOnce(kLeft, "cols: 5", "cols: 8"),
+                                   "-0.00003, 0]", "-0.00003, 0, 0, 0, 0]")),
+            "left.yaml:12: distortion_coefficients.data: expected 4 or 5 "
+            "numbers (k1, k2, p1, p2[, k3]) for distortion_model 'plumb_bob', "
+            "got 8");
+}
+
+TEST(CameraInfo, RejectsWrongEquidistantCount) {
+  EXPECT_EQ(ParseError(ReplaceOnce(kLeft, "plumb_bob", "equidistant")),
+            "left.yaml:12: distortion_coefficients.data: expected 4 numbers "
+            "(k1, k2, k3, k4) for distortion_model 'equidistant', got 5");
+}
+
+TEST(CameraInfo, RejectsCoefficientsForNoneModel) {
+  EXPECT_EQ(ParseError(ReplaceOnce(kLeft, "plumb_bob", "none")),
+            "left.yaml:12: distortion_coefficients.data: distortion_model "
+            "'none' takes no coefficients, got nonzero -0.28");
+}
+
+TEST(CameraInfo, RejectsMissingCoefficients) {
+  const std::string text = kLeft;
+  const std::string without =
+      text.substr(0, text.find("distortion_coefficients")) +
+      text.substr(text.find("rectification_matrix"));
+  EXPECT_EQ(ParseError(without),
+            "left.yaml: missing key 'distortion_coefficients'");
+}
+
+TEST(CameraInfo, RejectsSkew) {
+  EXPECT_EQ(ParseError(
+                ReplaceOnce(kLeft, "[346.7, 0, 360.5,", "[346.7, 0.5, 360.5,")),
+            "left.yaml:7: camera_matrix.data: nonzero skew K[0][1] = 0.5 is "
+            "not supported");
+}
+
+TEST(CameraInfo, RejectsBadCameraMatrixLastRow) {
+  EXPECT_EQ(
+      ParseError(ReplaceOnce(kLeft, "271.0, 0, 0, 1]", "271.0, 0, 0, 2]")),
+      "left.yaml:7: camera_matrix.data: expected [fx, 0, cx, 0, fy, cy, "
+      "0, 0, 1], but K[2][2] = 2.0");
+}
+
+TEST(CameraInfo, RejectsNonRotationRectification) {
+  EXPECT_THAT(ParseError(ReplaceOnce(kLeft, "[1, 0, 0, 0, 1, 0, 0, 0, 1]",
+                                     "[1, 0, 0, 0, 1.1, 0, 0, 0, 1]")),
+              StartsWith("left.yaml:16: rectification_matrix.data: not a rigid "
+                         "transform: rotation is not orthonormal"));
+}
+
+TEST(CameraInfo, RejectsReflectionRectification) {
+  EXPECT_EQ(ParseError(ReplaceOnce(kLeft, "[1, 0, 0, 0, 1, 0, 0, 0, 1]",
+                                   "[1, 0, 0, 0, 1, 0, 0, 0, -1]")),
+            "left.yaml:16: rectification_matrix.data: not a rigid transform: "
+            "rotation has determinant -1 (a reflection)");
+}
+
+TEST(CameraInfo, RejectsNonPositiveFocalLength) {
+  EXPECT_EQ(ParseError(ReplaceOnce(kLeft, "0, 346.8, 271.0,", "0, 0, 271.0,")),
+            "left.yaml:7: camera_matrix.data: focal length must be positive, "
+            "got fy = 0");
+}
+
+TEST(CameraInfo, RejectsNonPositiveImageSize) {
+  EXPECT_EQ(ParseError(ReplaceOnce(kLeft, "image_height: 540",
+                                   "image_height: "
+                                   "-540")),
+            "left.yaml:2: image_height: image size must be positive, got 720 x "
+            "-540");
+}
+
+TEST(CameraInfo, RejectsNonNumber) {
+  EXPECT_EQ(
+      ParseError(ReplaceOnce(kLeft, "[346.7, 0, 360.5,", "[346.7, 0, abc,")),
+      "left.yaml:7: camera_matrix.data: 'abc' is not a number");
+}
+
+TEST(CameraInfo, RejectsYamlSyntaxError) {
+  EXPECT_THAT(
+      ParseError(ReplaceOnce(kLeft, "camera_name: left", "camera_name: [left")),
+      StartsWith("left.yaml:4: YAML syntax error: "));
+}
+
+TEST(CameraInfo, RejectsEmptyFile) {
+  EXPECT_EQ(ParseError(""), "left.yaml: empty file");
+}
+
+TEST(CameraInfo, RejectsTopLevelScalar) {
+  EXPECT_EQ(ParseError("camera_info\n"),
+            "left.yaml:1: top level is not a map (expected a ROS camera_info "
+            "with image_width, camera_matrix, ...), got 'camera_info'");
+}
+
+TEST(CameraInfo, ReadRejectsMissingFile) {
+  const std::string path = ::testing::TempDir() + "/camera_info_missing.yaml";
+  const StatusOr<CameraInfo> info = ReadCameraInfo(path);
+  ASSERT_FALSE(info.ok());
+  EXPECT_EQ(info.status().message(),
+            path + ": cannot open: No such file or directory");
+}
+
+}  // namespace
+}  // namespace rcm

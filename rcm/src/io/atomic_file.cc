@@ -45,13 +45,14 @@ Status WriteFileAtomically(const std::string& path,
   const bool closed = std::fclose(file) == 0;
   if (written != contents.size() || !flushed || !closed) {
     std::remove(temporary.c_str());
-    return Status::Error(path + ": write failed: " + std::strerror(write_errno));
+    return Status::Error(path +
+                         ": write failed: " + std::strerror(write_errno));
   }
   if (std::rename(temporary.c_str(), path.c_str()) != 0) {
     const int rename_errno = errno;
     std::remove(temporary.c_str());
-    return Status::Error(path + ": cannot write: " +
-                         std::strerror(rename_errno));
+    return Status::Error(path +
+                         ": cannot write: " + std::strerror(rename_errno));
   }
   return Status::Ok();
 }

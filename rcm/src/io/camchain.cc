@@ -1,1 +1,741 @@
-// Placeholder until the file is written; see rcm/CMakeLists.txt.
+#include "rcm/io/camchain.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <exception>
+#include <map>
+#include <system_error>
+#include <utility>
+
+#include "rcm/io/atomic_file.h"
+#include "rcm/io/number_format.h"
+
+namespace rcm {
+namespace {
+
+// ---------------------------------------------------------------------------
+// Reading.
+
+// A scalar as it appears in an error message: quoted, control characters
+// escaped (so that the message stays on one line), long values shortened.
+std::string Quote(const std::string& scalar) {
+  constexpr size_t kMaxShown = 40;
+  std::string shown;
+  for (size_t i = 0; i < scalar.size() && i < kMaxShown; ++i) {
+    const unsigned char c = static_cast<unsigned char>(scalar[i]);
+    if (c < 0x20 || c == 0x7f) {
+      static const char kHex[] = "0123456789abcdef";
+      shown += "\\x";
+      shown += kHex[c >> 4];
+      shown += kHex[c & 0xf];
+    } else {
+      shown += static_cast<char>(c);
+    }
+  }
+  if (scalar.size() > kMaxShown) shown += "...";
+  return "'" + shown + "'";
+}
+
+// What a node is, for "expected X, got <Describe>" messages.
+std::string Describe(const YAML::Node& node) {
+  switch (node.Type()) {
+    case YAML::NodeType::Scalar:
+      return Quote(node.Scalar());
+    case YAML::NodeType::Sequence:
+      return "a list";
+    case YAML::NodeType::Map:
+      return "a map";
+    case YAML::NodeType::Null:
+    case YAML::NodeType::Undefined:
+      break;
+  }
+  return "nothing";
+}
+
+// YAML 1.1's spellings of infinity and NaN (which from_chars does not
+// read).
+bool IsYamlNonFinite(const std::string& text) {
+  static const char* const kSpellings[] = {".nan",  ".NaN",  ".NAN",  ".inf",
+                                           ".Inf",  ".INF",  "+.inf", "+.Inf",
+                                           "+.INF", "-.inf", "-.Inf", "-.INF"};
+  for (const char* spelling : kSpellings) {
+    if (text == spelling) return true;
+  }
+  return false;
+}
+
+// The keys of a YAML map, each with its key node (for its line) and value.
+struct MapEntry {
+  YAML::Node key;
+  YAML::Node value;
+};
+using MapEntries = std::map<std::string, MapEntry>;
+
+// Reads fields of one camchain file and words the errors.
+class FieldReader {
+ public:
+  explicit FieldReader(const std::string& source) : source_(source) {}
+
+  // "SOURCE:LINE: FIELD: MESSAGE" (no line when the node has none).
+  Status Error(const YAML::Node& at, const std::string& field,
+               const std::string& message) const {
+    std::string text = source_;
+    const YAML::Mark mark = at.Mark();
+    if (!mark.is_null()) text += ":" + std::to_string(mark.line + 1);
+    if (!field.empty()) text += ": " + field;
+    return Status::Error(text + ": " + message);
+  }
+  Status MissingKey(const std::string& field, const std::string& key) const {
+    return Status::Error(source_ + ": " + field + ": missing key '" + key +
+                         "'");
+  }
+
+  // The scalar-keyed entries of a map; fails on a duplicated key. Keys that
+  // are not scalars are skipped (no camchain key is one).
+  StatusOr<MapEntries> Entries(const YAML::Node& map,
+                               const std::string& field) const {
+    MapEntries entries;
+    for (auto it = map.begin(); it != map.end(); ++it) {
+      if (!it->first.IsScalar()) continue;
+      const std::string& key = it->first.Scalar();
+      if (entries.count(key) > 0) {
+        return Error(it->first, field, "duplicate key " + Quote(key));
+      }
+      entries.emplace(key, MapEntry{it->first, it->second});
+    }
+    return entries;
+  }
+
+  StatusOr<double> Number(const YAML::Node& node,
+                          const std::string& field) const {
+    if (!node.IsScalar()) {
+      return Error(node, field, "expected a number, got " + Describe(node));
+    }
+    const std::string& text = node.Scalar();
+    // from_chars does not take the '+' that YAML allows.
+    const size_t start = (text.size() > 1 && text[0] == '+') ? 1 : 0;
+    double value = 0.0;
+    const char* end = text.data() + text.size();
+    const std::from_chars_result result =
+        std::from_chars(text.data() + start, end, value);
+    if (result.ec == std::errc::result_out_of_range) {
+      return Error(node, field, Quote(text) + " is out of range");
+    }
+    if (IsYamlNonFinite(text)) {
+      return Error(node, field, Quote(text) + " is not a finite number");
+    }
+    if (text.empty() || result.ec != std::errc() || result.ptr != end) {
+      return Error(node, field, Quote(text) + " is not a number");
+    }
+    if (!std::isfinite(value)) {
+      return Error(node, field, Quote(text) + " is not a finite number");
+    }
+    return value;
+  }
+
+  StatusOr<int> Integer(const YAML::Node& node,
+                        const std::string& field) const {
+    if (!node.IsScalar()) {
+      return Error(node, field, "expected an integer, got " + Describe(node));
+    }
+    const std::string& text = node.Scalar();
+    const size_t start = (text.size() > 1 && text[0] == '+') ? 1 : 0;
+    int value = 0;
+    const char* end = text.data() + text.size();
+    const std::from_chars_result result =
+        std::from_chars(text.data() + start, end, value);
+    if (result.ec == std::errc::result_out_of_range) {
+      return Error(node, field, Quote(text) + " is out of range");
+    }
+    if (text.empty() || result.ec != std::errc() || result.ptr != end) {
+      return Error(node, field, Quote(text) + " is not an integer");
+    }
+    return value;
+  }
+
+  StatusOr<std::string> String(const YAML::Node& node,
+                               const std::string& field) const {
+    if (!node.IsScalar()) {
+      return Error(node, field, "expected a string, got " + Describe(node));
+    }
+    return node.Scalar();
+  }
+
+  // A list of numbers; `expected_size` < 0 accepts any length.
+  StatusOr<std::vector<double>> NumberList(const YAML::Node& node,
+                                           const std::string& field,
+                                           int expected_size) const {
+    if (!node.IsSequence()) {
+      return Error(node, field,
+                   ListExpectation(expected_size, "numbers") + ", got " +
+                       Describe(node));
+    }
+    if (expected_size >= 0 && static_cast<int>(node.size()) != expected_size) {
+      return Error(node, field,
+                   ListExpectation(expected_size, "numbers") + ", got " +
+                       std::to_string(node.size()));
+    }
+    std::vector<double> values;
+    for (const YAML::Node& element : node) {
+      const StatusOr<double> value = Number(element, field);
+      if (!value.ok()) return value.status();
+      values.push_back(*value);
+    }
+    return values;
+  }
+
+  StatusOr<std::vector<int>> IntegerList(const YAML::Node& node,
+                                         const std::string& field,
+                                         int expected_size) const {
+    if (!node.IsSequence()) {
+      return Error(node, field,
+                   ListExpectation(expected_size, "integers") + ", got " +
+                       Describe(node));
+    }
+    if (expected_size >= 0 && static_cast<int>(node.size()) != expected_size) {
+      return Error(node, field,
+                   ListExpectation(expected_size, "integers") + ", got " +
+                       std::to_string(node.size()));
+    }
+    std::vector<int> values;
+    for (const YAML::Node& element : node) {
+      const StatusOr<int> value = Integer(element, field);
+      if (!value.ok()) return value.status();
+      values.push_back(*value);
+    }
+    return values;
+  }
+
+  // A homogeneous 4x4 transform written as 4 rows of 4 numbers, validated
+  // by Rigid3d::FromMatrix.
+  StatusOr<Rigid3d> Transform(const YAML::Node& node,
+                              const std::string& field) const {
+    constexpr char kExpected[] = "expected a 4x4 matrix (4 rows of 4 numbers)";
+    if (!node.IsSequence()) {
+      return Error(node, field,
+                   std::string(kExpected) + ", got " + Describe(node));
+    }
+    if (node.size() != 4) {
+      return Error(node, field,
+                   std::string(kExpected) + ", got " +
+                       std::to_string(node.size()) + " rows");
+    }
+    Eigen::Matrix4d matrix;
+    for (int row = 0; row < 4; ++row) {
+      const YAML::Node row_node = node[row];
+      const StatusOr<std::vector<double>> values =
+          NumberList(row_node, field + " row " + std::to_string(row + 1), 4);
+      if (!values.ok()) return values.status();
+      for (int col = 0; col < 4; ++col) matrix(row, col) = (*values)[col];
+    }
+    const StatusOr<Rigid3d> transform = Rigid3d::FromMatrix(matrix);
+    if (!transform.ok()) {
+      return Error(node, field, transform.status().message());
+    }
+    return *transform;
+  }
+
+ private:
+  static std::string ListExpectation(int expected_size, const char* what) {
+    if (expected_size < 0) return std::string("expected a list of ") + what;
+    return "expected " + std::to_string(expected_size) + " " + what;
+  }
+
+  std::string source_;
+};
+
+const YAML::Node* Find(const MapEntries& entries, const std::string& key) {
+  const auto it = entries.find(key);
+  return it == entries.end() ? nullptr : &it->second.value;
+}
+
+StatusOr<CamchainCamera> ParseCamera(const FieldReader& reader, int index,
+                                     const YAML::Node& node) {
+  const std::string name = "cam" + std::to_string(index);
+  if (!node.IsMap()) {
+    return reader.Error(
+        node, name,
+        "expected a map of camera parameters, got " + Describe(node));
+  }
+  const StatusOr<MapEntries> entries = reader.Entries(node, name);
+  if (!entries.ok()) return entries.status();
+  const auto required =
+      [&](const std::string& key) -> StatusOr<const YAML::Node*> {
+    const YAML::Node* value = Find(*entries, key);
+    if (value == nullptr) return reader.MissingKey(name, key);
+    return value;
+  };
+  const auto field = [&](const std::string& key) { return name + "." + key; };
+
+  const StatusOr<const YAML::Node*> camera_model_node =
+      required("camera_model");
+  if (!camera_model_node.ok()) return camera_model_node.status();
+  const StatusOr<std::string> camera_model =
+      reader.String(**camera_model_node, field("camera_model"));
+  if (!camera_model.ok()) return camera_model.status();
+  if (*camera_model != "pinhole") {
+    return reader.Error(
+        **camera_model_node, field("camera_model"),
+        "unknown model " + Quote(*camera_model) + " (supported: pinhole)");
+  }
+
+  // The distortion model is read before its coefficients, whose number it
+  // fixes.
+  const StatusOr<const YAML::Node*> model_node = required("distortion_model");
+  if (!model_node.ok()) return model_node.status();
+  const StatusOr<std::string> model_name =
+      reader.String(**model_node, field("distortion_model"));
+  if (!model_name.ok()) return model_name.status();
+  const std::optional<LensModelId> model = LensModelFromName(*model_name);
+  if (!model.has_value()) {
+    return reader.Error(**model_node, field("distortion_model"),
+                        "unknown model " + Quote(*model_name) +
+                            " (supported: none, radtan, equidistant)");
+  }
+
+  std::vector<double> distortion;
+  const YAML::Node* coeffs_node = Find(*entries, "distortion_coeffs");
+  if (coeffs_node == nullptr) {
+    if (NumDistortionParams(*model) > 0) {
+      return reader.MissingKey(name, "distortion_coeffs");
+    }
+  } else {
+    const StatusOr<std::vector<double>> coeffs =
+        reader.NumberList(*coeffs_node, field("distortion_coeffs"), -1);
+    if (!coeffs.ok()) return coeffs.status();
+    const int expected = NumDistortionParams(*model);
+    if (static_cast<int>(coeffs->size()) != expected) {
+      return reader.Error(*coeffs_node, field("distortion_coeffs"),
+                          "expected " + std::to_string(expected) +
+                              " numbers for distortion_model '" + *model_name +
+                              "', got " + std::to_string(coeffs->size()));
+    }
+    distortion = *coeffs;
+  }
+
+  const StatusOr<const YAML::Node*> intrinsics_node = required("intrinsics");
+  if (!intrinsics_node.ok()) return intrinsics_node.status();
+  const StatusOr<std::vector<double>> intrinsics =
+      reader.NumberList(**intrinsics_node, field("intrinsics"), 4);
+  if (!intrinsics.ok()) return intrinsics.status();
+
+  const StatusOr<const YAML::Node*> resolution_node = required("resolution");
+  if (!resolution_node.ok()) return resolution_node.status();
+  const StatusOr<std::vector<int>> resolution =
+      reader.IntegerList(**resolution_node, field("resolution"), 2);
+  if (!resolution.ok()) return resolution.status();
+
+  // Camera::Create validates everything at once; build it in stages so
+  // that its message can be attributed to the key it is about.
+  const int width = (*resolution)[0];
+  const int height = (*resolution)[1];
+  const std::array<double, 4> fx_fy_cx_cy = {
+      (*intrinsics)[0], (*intrinsics)[1], (*intrinsics)[2], (*intrinsics)[3]};
+  StatusOr<Camera> camera = Camera::Create(LensModelId::kPinhole, width, height,
+                                           {1.0, 1.0, 0.0, 0.0}, {});
+  if (!camera.ok()) {
+    return reader.Error(**resolution_node, field("resolution"),
+                        camera.status().message());
+  }
+  camera =
+      Camera::Create(LensModelId::kPinhole, width, height, fx_fy_cx_cy, {});
+  if (!camera.ok()) {
+    return reader.Error(**intrinsics_node, field("intrinsics"),
+                        camera.status().message());
+  }
+  camera = Camera::Create(*model, width, height, fx_fy_cx_cy, distortion);
+  if (!camera.ok()) {
+    return reader.Error(coeffs_node != nullptr ? *coeffs_node : node,
+                        field("distortion_coeffs"), camera.status().message());
+  }
+
+  CamchainCamera result{*camera,      std::nullopt, std::nullopt,
+                        std::nullopt, {},           ""};
+
+  if (const YAML::Node* value = Find(*entries, "T_cam_imu")) {
+    const StatusOr<Rigid3d> transform =
+        reader.Transform(*value, field("T_cam_imu"));
+    if (!transform.ok()) return transform.status();
+    result.cam_from_imu = *transform;
+  }
+
+  const YAML::Node* previous = Find(*entries, "T_cn_cnm1");
+  if (index == 0 && previous != nullptr) {
+    return reader.Error(*previous, field("T_cn_cnm1"),
+                        "cam0 is the first camera and has no previous "
+                        "camera; T_cn_cnm1 belongs on cam1 and later");
+  }
+  if (index > 0) {
+    if (previous == nullptr) return reader.MissingKey(name, "T_cn_cnm1");
+    const StatusOr<Rigid3d> transform =
+        reader.Transform(*previous, field("T_cn_cnm1"));
+    if (!transform.ok()) return transform.status();
+    result.cam_from_previous = *transform;
+  }
+
+  if (const YAML::Node* value = Find(*entries, "cam_overlaps")) {
+    const StatusOr<std::vector<int>> overlaps =
+        reader.IntegerList(*value, field("cam_overlaps"), -1);
+    if (!overlaps.ok()) return overlaps.status();
+    result.cam_overlaps = *overlaps;
+  }
+  if (const YAML::Node* value = Find(*entries, "rostopic")) {
+    const StatusOr<std::string> rostopic =
+        reader.String(*value, field("rostopic"));
+    if (!rostopic.ok()) return rostopic.status();
+    result.rostopic = *rostopic;
+  }
+  if (const YAML::Node* value = Find(*entries, "timeshift_cam_imu")) {
+    const StatusOr<double> shift =
+        reader.Number(*value, field("timeshift_cam_imu"));
+    if (!shift.ok()) return shift.status();
+    result.timeshift_cam_imu = *shift;
+  }
+  return result;
+}
+
+// The camera index of a top-level key "camN"; nullopt for any other key.
+// A malformed index ("cam01", an overflowing number) is an error rather
+// than an ignored key, since it was clearly meant as a camera.
+StatusOr<std::optional<int>> CameraIndex(const FieldReader& reader,
+                                         const std::string& key,
+                                         const YAML::Node& key_node) {
+  if (key.size() <= 3 || key.compare(0, 3, "cam") != 0) {
+    return std::optional<int>();
+  }
+  const std::string digits = key.substr(3);
+  if (!std::all_of(digits.begin(), digits.end(),
+                   [](char c) { return c >= '0' && c <= '9'; })) {
+    return std::optional<int>();
+  }
+  int index = 0;
+  const std::from_chars_result result =
+      std::from_chars(digits.data(), digits.data() + digits.size(), index);
+  if (result.ec != std::errc() || (digits.size() > 1 && digits[0] == '0')) {
+    return reader.Error(
+        key_node, "",
+        "malformed camera key " + Quote(key) + " (expected cam0, cam1, ...)");
+  }
+  return std::optional<int>(index);
+}
+
+StatusOr<Camchain> ParseCamchainNode(const FieldReader& reader,
+                                     const std::string& source_name,
+                                     const YAML::Node& root) {
+  if (root.IsNull()) return Status::Error(source_name + ": empty file");
+  if (!root.IsMap()) {
+    return reader.Error(root, "",
+                        "top level is not a map (expected cam0, cam1, ...), "
+                        "got " +
+                            Describe(root));
+  }
+  const StatusOr<MapEntries> entries = reader.Entries(root, "");
+  if (!entries.ok()) return entries.status();
+
+  std::map<int, std::pair<std::string, const MapEntry*>> cameras;
+  for (const auto& [key, entry] : *entries) {
+    const StatusOr<std::optional<int>> index =
+        CameraIndex(reader, key, entry.key);
+    if (!index.ok()) return index.status();
+    if (index->has_value()) cameras[**index] = {key, &entry};
+  }
+  if (cameras.count(0) == 0) {
+    return Status::Error(source_name +
+                         ": no 'cam0' key: not a Kalibr camchain");
+  }
+  int expected = 0;
+  for (const auto& [index, named_entry] : cameras) {
+    if (index != expected) {
+      return reader.Error(named_entry.second->key, "",
+                          "cameras must be numbered cam0, cam1, ... without "
+                          "gaps: found " +
+                              named_entry.first + " but no cam" +
+                              std::to_string(expected));
+    }
+    ++expected;
+  }
+
+  Camchain camchain;
+  for (const auto& [index, named_entry] : cameras) {
+    StatusOr<CamchainCamera> camera =
+        ParseCamera(reader, index, named_entry.second->value);
+    if (!camera.ok()) return camera.status();
+    camchain.cameras.push_back(std::move(camera).value());
+  }
+  return camchain;
+}
+
+// ---------------------------------------------------------------------------
+// Writing: a small emulation of PyYAML's emitter for the shapes a camchain
+// has (block maps of scalars and flow lists, block lists of flow lists).
+
+// PyYAML's defaults: wrap flow collections after column 80, indent by 2.
+constexpr int kBestWidth = 80;
+
+// A float as PyYAML's represent_float writes it.
+std::string YamlFloat(double value) {
+  if (std::isnan(value)) return ".nan";
+  if (std::isinf(value)) return value > 0.0 ? ".inf" : "-.inf";
+  std::string text = FormatDouble(value);
+  const size_t e = text.find('e');
+  if (e != std::string::npos && text.find('.') == std::string::npos) {
+    text.insert(e, ".0");
+  }
+  return text;
+}
+
+// A string as PyYAML writes it: plain when that reads back as the same
+// string, otherwise quoted. Plain style is used for the characters of ROS
+// names (which is what rostopic holds) and never for a YAML keyword;
+// anything else is single-quoted, or double-quoted with escapes when it
+// holds control characters. (PyYAML allows plain style for a few more
+// strings than this, and folds long quoted strings at spaces; neither
+// happens for a ROS topic name.)
+std::string YamlString(const std::string& text) {
+  static const char* const kKeywords[] = {
+      "yes",  "Yes",   "YES",   "no",    "No",   "NO", "true", "True",
+      "TRUE", "false", "False", "FALSE", "on",   "On", "ON",   "off",
+      "Off",  "OFF",   "null",  "Null",  "NULL", "~"};
+  bool plain = !text.empty();
+  if (plain) {
+    const char first = text.front();
+    plain = std::isalpha(static_cast<unsigned char>(first)) || first == '_' ||
+            first == '/' || first == '~';
+  }
+  for (char c : text) {
+    if (!plain) break;
+    plain = std::isalnum(static_cast<unsigned char>(c)) || c == '_' ||
+            c == '/' || c == '~' || c == '.' || c == '-';
+  }
+  for (const char* keyword : kKeywords) {
+    if (text == keyword) plain = false;
+  }
+  if (plain) return text;
+
+  const bool printable = std::all_of(text.begin(), text.end(), [](char c) {
+    const unsigned char u = static_cast<unsigned char>(c);
+    return u >= 0x20 && u != 0x7f;
+  });
+  if (printable) {
+    std::string quoted = "'";
+    for (char c : text) {
+      quoted += c;
+      if (c == '\'') quoted += '\'';
+    }
+    return quoted + "'";
+  }
+  std::string quoted = "\"";
+  for (char c : text) {
+    const unsigned char u = static_cast<unsigned char>(c);
+    if (c == '"' || c == '\\') {
+      quoted += '\\';
+      quoted += c;
+    } else if (u < 0x20 || u == 0x7f) {
+      static const char kHex[] = "0123456789ABCDEF";
+      quoted += "\\x";
+      quoted += kHex[u >> 4];
+      quoted += kHex[u & 0xf];
+    } else {
+      quoted += c;
+    }
+  }
+  return quoted + "\"";
+}
+
+// Appends "[a, b, c]" at the end of `out` the way PyYAML writes a flow
+// sequence: after each comma, when the line is already longer than
+// kBestWidth, the next item goes on a new line indented by `indent`.
+void AppendFlowList(const std::vector<std::string>& items, int indent,
+                    std::string* out) {
+  const auto column = [out]() {
+    const size_t newline = out->rfind('\n');
+    return static_cast<int>(
+        newline == std::string::npos ? out->size() : out->size() - newline - 1);
+  };
+  const auto break_line = [&]() {
+    *out += '\n';
+    out->append(indent, ' ');
+  };
+  *out += '[';
+  for (size_t i = 0; i < items.size(); ++i) {
+    if (i > 0) *out += ',';
+    if (column() > kBestWidth) {
+      break_line();
+    } else if (i > 0) {
+      *out += ' ';
+    }
+    *out += items[i];
+  }
+  *out += ']';
+}
+
+std::vector<std::string> FloatItems(const std::vector<double>& values) {
+  std::vector<std::string> items;
+  for (double value : values) items.push_back(YamlFloat(value));
+  return items;
+}
+
+// "  key: [a, b]\n" inside a camera map.
+void AppendListField(const std::string& key,
+                     const std::vector<std::string>& items, std::string* out) {
+  *out += "  " + key + ": ";
+  AppendFlowList(items, 4, out);
+  *out += '\n';
+}
+
+void AppendTransformField(const std::string& key, const Rigid3d& transform,
+                          std::string* out) {
+  const Eigen::Matrix4d matrix = transform.ToMatrix();
+  *out += "  " + key + ":\n";
+  for (int row = 0; row < 4; ++row) {
+    *out += "  - ";
+    AppendFlowList(FloatItems({matrix(row, 0), matrix(row, 1), matrix(row, 2),
+                               matrix(row, 3)}),
+                   4, out);
+    *out += '\n';
+  }
+}
+
+void AppendCamera(const std::string& name, const CamchainCamera& entry,
+                  std::string* out) {
+  const Camera& camera = entry.camera;
+  *out += name + ":\n";
+  if (entry.cam_from_imu.has_value()) {
+    AppendTransformField("T_cam_imu", *entry.cam_from_imu, out);
+  }
+  if (entry.cam_from_previous.has_value()) {
+    AppendTransformField("T_cn_cnm1", *entry.cam_from_previous, out);
+  }
+  std::vector<std::string> overlaps;
+  for (int index : entry.cam_overlaps)
+    overlaps.push_back(std::to_string(index));
+  AppendListField("cam_overlaps", overlaps, out);
+  *out += "  camera_model: pinhole\n";
+  AppendListField("distortion_coeffs", FloatItems(camera.Distortion()), out);
+  *out += "  distortion_model: " + std::string(LensModelName(camera.model())) +
+          "\n";
+  AppendListField(
+      "intrinsics",
+      FloatItems({camera.fx(), camera.fy(), camera.cx(), camera.cy()}), out);
+  AppendListField(
+      "resolution",
+      {std::to_string(camera.width()), std::to_string(camera.height())}, out);
+  if (!entry.rostopic.empty()) {
+    *out += "  rostopic: " + YamlString(entry.rostopic) + "\n";
+  }
+  if (entry.timeshift_cam_imu.has_value()) {
+    *out +=
+        "  timeshift_cam_imu: " + YamlFloat(*entry.timeshift_cam_imu) + "\n";
+  }
+}
+
+}  // namespace
+
+StatusOr<Camchain> ParseCamchain(const std::string& text,
+                                 const std::string& source_name) {
+  const FieldReader reader(source_name);
+  try {
+    YAML::Node root;
+    try {
+      root = YAML::Load(text);
+    } catch (const YAML::ParserException& e) {
+      std::string location = source_name;
+      if (!e.mark.is_null()) location += ":" + std::to_string(e.mark.line + 1);
+      return Status::Error(location + ": YAML syntax error: " + e.msg);
+    }
+    return ParseCamchainNode(reader, source_name, root);
+  } catch (const std::exception& e) {
+    // yaml-cpp reports misuse by exception; every access above is checked,
+    // so this is a last line of defence that keeps the no-throw promise.
+    return Status::Error(source_name +
+                         ": cannot read the camchain: " + e.what());
+  }
+}
+
+StatusOr<Camchain> ReadCamchain(const std::string& path) {
+  const StatusOr<std::string> text = ReadFileToString(path);
+  if (!text.ok()) return text.status();
+  return ParseCamchain(*text, path);
+}
+
+std::string FormatCamchain(const Camchain& camchain) {
+  // Python sorts the keys as strings: cam0, cam1, cam10, cam11, cam2, ...
+  std::vector<std::string> names;
+  for (size_t i = 0; i < camchain.cameras.size(); ++i) {
+    names.push_back("cam" + std::to_string(i));
+  }
+  std::vector<size_t> order(names.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(),
+            [&](size_t a, size_t b) { return names[a] < names[b]; });
+  std::string out;
+  for (size_t i : order) AppendCamera(names[i], camchain.cameras[i], &out);
+  return out;
+}
+
+Status WriteCamchain(const std::string& path, const Camchain& camchain) {
+  if (camchain.cameras.empty()) {
+    return Status::Error(path + ": cannot write a camchain without cameras");
+  }
+  if (camchain.cameras[0].cam_from_previous.has_value()) {
+    return Status::Error(path +
+                         ": cannot write: cam0 has a T_cn_cnm1 (cam0 is the "
+                         "first camera and has no previous one)");
+  }
+  for (size_t i = 1; i < camchain.cameras.size(); ++i) {
+    if (!camchain.cameras[i].cam_from_previous.has_value()) {
+      return Status::Error(path + ": cannot write: cam" + std::to_string(i) +
+                           " has no T_cn_cnm1");
+    }
+  }
+  return WriteFileAtomically(path, FormatCamchain(camchain));
+}
+
+StatusOr<StereoRig> StereoRigFromCamchain(const Camchain& camchain,
+                                          int left_index, int right_index) {
+  const int num_cameras = static_cast<int>(camchain.cameras.size());
+  for (int index : {left_index, right_index}) {
+    if (index < 0 || index >= num_cameras) {
+      return Status::Error(
+          "camera index " + std::to_string(index) +
+          " is out of range (the camchain has " +
+          (num_cameras == 0 ? std::string("no cameras")
+                            : "cam0..cam" + std::to_string(num_cameras - 1)) +
+          ")");
+    }
+  }
+  if (left_index == right_index) {
+    return Status::Error("left and right are the same camera (cam" +
+                         std::to_string(left_index) + ")");
+  }
+  // high_from_low = T(high) * ... * T(low + 1).
+  const int low = std::min(left_index, right_index);
+  const int high = std::max(left_index, right_index);
+  Rigid3d high_from_low;
+  for (int k = low + 1; k <= high; ++k) {
+    const std::optional<Rigid3d>& cam_from_previous =
+        camchain.cameras[k].cam_from_previous;
+    if (!cam_from_previous.has_value()) {
+      return Status::Error("cam" + std::to_string(k) + " has no T_cn_cnm1");
+    }
+    high_from_low =
+        k == low + 1 ? *cam_from_previous : *cam_from_previous * high_from_low;
+  }
+  const Rigid3d right_from_left =
+      right_index > left_index ? high_from_low : high_from_low.Inverse();
+  const StatusOr<StereoRig> rig =
+      StereoRig::Create(camchain.cameras[left_index].camera,
+                        camchain.cameras[right_index].camera, right_from_left);
+  if (!rig.ok()) {
+    return rig.status().WithContext("cam" + std::to_string(right_index) +
+                                    "_from_cam" + std::to_string(left_index));
+  }
+  return rig;
+}
+
+}  // namespace rcm

@@ -1,1 +1,162 @@
-// Placeholder until the file is written; see rcm/CMakeLists.txt.
+#include "rcm/io/stereo_rig_file.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <charconv>
+#include <exception>
+#include <optional>
+#include <system_error>
+#include <utility>
+
+#include "rcm/io/atomic_file.h"
+#include "rcm/io/camchain.h"
+#include "rcm/io/camera_info.h"
+
+namespace rcm {
+namespace {
+
+enum class RigFileFormat { kCamchain, kCameraInfo };
+
+// Recognises the format of a rig file from its top-level keys. Empty files
+// and YAML syntax errors are handed to the camchain parser, whose error
+// message describes the problem.
+StatusOr<RigFileFormat> DetectFormat(const std::string& path,
+                                     const std::string& text) {
+  try {
+    const YAML::Node root = YAML::Load(text);
+    if (root.IsNull()) return RigFileFormat::kCamchain;
+    bool has_cam0 = false;
+    bool has_camera_matrix = false;
+    if (root.IsMap()) {
+      for (auto it = root.begin(); it != root.end(); ++it) {
+        if (!it->first.IsScalar()) continue;
+        has_cam0 = has_cam0 || it->first.Scalar() == "cam0";
+        has_camera_matrix =
+            has_camera_matrix || it->first.Scalar() == "camera_matrix";
+      }
+    }
+    if (has_cam0) return RigFileFormat::kCamchain;
+    if (has_camera_matrix) return RigFileFormat::kCameraInfo;
+    return Status::Error(path +
+                         ": neither a Kalibr camchain (no 'cam0') nor a ROS "
+                         "camera_info (no 'camera_matrix')");
+  } catch (const std::exception&) {
+    return RigFileFormat::kCamchain;
+  }
+}
+
+// Reads a file and recognises its format.
+struct RigFile {
+  std::string text;
+  RigFileFormat format;
+};
+StatusOr<RigFile> ReadRigFile(const std::string& path) {
+  StatusOr<std::string> text = ReadFileToString(path);
+  if (!text.ok()) return text.status();
+  const StatusOr<RigFileFormat> format = DetectFormat(path, *text);
+  if (!format.ok()) return format.status();
+  return RigFile{std::move(text).value(), *format};
+}
+
+// The index N of a camera name "camN"; nullopt for anything else.
+std::optional<int> CameraIndexFromName(const std::string& name) {
+  if (name.size() <= 3 || name.compare(0, 3, "cam") != 0) return std::nullopt;
+  if (name.size() > 4 && name[3] == '0') return std::nullopt;
+  int index = 0;
+  const char* begin = name.data() + 3;
+  const char* end = name.data() + name.size();
+  const std::from_chars_result result = std::from_chars(begin, end, index);
+  if (result.ec != std::errc() || result.ptr != end || index < 0) {
+    return std::nullopt;
+  }
+  return index;
+}
+
+StatusOr<StereoRig> ReadCamchainRig(const std::string& path,
+                                    const std::string& text,
+                                    const std::string& left,
+                                    const std::string& right) {
+  const StatusOr<Camchain> camchain = ParseCamchain(text, path);
+  if (!camchain.ok()) return camchain.status();
+  const int num_cameras = static_cast<int>(camchain->cameras.size());
+  int indices[2];
+  const std::string* names[2] = {&left, &right};
+  for (int i = 0; i < 2; ++i) {
+    const std::optional<int> index = CameraIndexFromName(*names[i]);
+    if (!index.has_value() || *index >= num_cameras) {
+      std::string known;
+      for (int k = 0; k < num_cameras; ++k) {
+        known += (k == 0 ? "cam" : ", cam") + std::to_string(k);
+      }
+      return Status::Error(path + ": unknown camera '" + *names[i] +
+                           "' (the camchain has " + known + ")");
+    }
+    indices[i] = *index;
+  }
+  const StatusOr<StereoRig> rig =
+      StereoRigFromCamchain(*camchain, indices[0], indices[1]);
+  if (!rig.ok()) return rig.status().WithContext(path);
+  return rig;
+}
+
+StatusOr<StereoRig> ReadCameraInfoPair(const std::string& left_path,
+                                       const std::string& right_path) {
+  const std::string paths[2] = {left_path, right_path};
+  std::optional<CameraInfo> infos[2];
+  for (int i = 0; i < 2; ++i) {
+    const StatusOr<RigFile> file = ReadRigFile(paths[i]);
+    if (!file.ok()) return file.status();
+    if (file->format != RigFileFormat::kCameraInfo) {
+      return Status::Error(paths[i] +
+                           ": is a Kalibr camchain, expected a ROS "
+                           "camera_info (give a camchain alone, not in a "
+                           "comma-separated pair)");
+    }
+    StatusOr<CameraInfo> info = ParseCameraInfo(file->text, paths[i]);
+    if (!info.ok()) return info.status();
+    infos[i] = std::move(info).value();
+  }
+  const StatusOr<StereoRig> rig = StereoRigFromCameraInfo(*infos[0], *infos[1]);
+  if (!rig.ok()) {
+    return rig.status().WithContext(left_path + "," + right_path);
+  }
+  return rig;
+}
+
+}  // namespace
+
+StatusOr<StereoRig> ReadStereoRig(const std::string& spec,
+                                  const std::string& left,
+                                  const std::string& right) {
+  const size_t comma = spec.find(',');
+  if (comma != std::string::npos) {
+    const std::string left_path = spec.substr(0, comma);
+    const std::string right_path = spec.substr(comma + 1);
+    if (left_path.empty() || right_path.empty() ||
+        right_path.find(',') != std::string::npos) {
+      return Status::Error("'" + spec +
+                           "': expected one camchain path or two camera_info "
+                           "paths 'left.yaml,right.yaml'");
+    }
+    if (left != "cam0" || right != "cam1") {
+      return Status::Error(
+          "camera names ('" + left + "', '" + right +
+          "') select cameras of a Kalibr camchain; with two ROS camera_info "
+          "files '" +
+          spec + "' the first is the left camera and the second the right");
+    }
+    return ReadCameraInfoPair(left_path, right_path);
+  }
+
+  const StatusOr<RigFile> file = ReadRigFile(spec);
+  if (!file.ok()) return file.status();
+  if (file->format == RigFileFormat::kCameraInfo) {
+    return Status::Error(spec +
+                         ": is a ROS camera_info, which describes one camera; "
+                         "give the left and right files as "
+                         "'left.yaml,right.yaml'");
+  }
+  return ReadCamchainRig(spec, file->text, left, right);
+}
+
+}  // namespace rcm
