@@ -1,9 +1,9 @@
 #include "rcm/camera/camera.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <limits>
-
-#include <gtest/gtest.h>
 
 #include "support/test_rigs.h"
 
@@ -42,9 +42,9 @@ TEST(Camera, RejectsNonFiniteIntrinsics) {
 }
 
 TEST(Camera, RejectsWrongCoefficientCount) {
-  const StatusOr<Camera> camera = Camera::Create(
-      LensModelId::kEquidistant, 640, 480, {300.0, 300.0, 320.0, 240.0},
-      {0.1, 0.2, 0.3});
+  const StatusOr<Camera> camera =
+      Camera::Create(LensModelId::kEquidistant, 640, 480,
+                     {300.0, 300.0, 320.0, 240.0}, {0.1, 0.2, 0.3});
   ASSERT_FALSE(camera.ok());
   EXPECT_EQ(camera.status().message(),
             "distortion model 'equidistant' takes 4 coefficients, got 3");

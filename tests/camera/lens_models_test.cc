@@ -1,11 +1,11 @@
 #include "rcm/camera/lens_models.h"
 
-#include <cmath>
-#include <random>
-
-#include <Eigen/LU>
 #include <ceres/jet.h>
 #include <gtest/gtest.h>
+
+#include <Eigen/LU>
+#include <cmath>
+#include <random>
 
 #include "rcm/camera/camera.h"
 #include "support/test_rigs.h"
@@ -55,7 +55,8 @@ TEST(LensModels, EquidistantRoundTripNinetyDegreeFieldOfView) {
   const Camera camera = test::WideEquidistantCamera();
   ExpectPixelRoundTrip(camera, 8.0);
   // The corners do reach 89.5 degrees off axis.
-  const Eigen::Vector2d corner = camera.NormalizedFromImage({-0.5, -0.5}).value();
+  const Eigen::Vector2d corner =
+      camera.NormalizedFromImage({-0.5, -0.5}).value();
   EXPECT_NEAR(std::atan(corner.norm()) * 180.0 / M_PI, 89.5, 1e-9);
 }
 
@@ -116,8 +117,8 @@ void ExpectJacobianMatchesJets(const double* dist,
 
 std::vector<Eigen::Vector2d> JacobianTestPoints() {
   std::vector<Eigen::Vector2d> points = {
-      {0.0, 0.0}, {1e-9, -2e-9}, {3e-5, 1e-5}, {-0.2, 0.1}, {0.7, -0.45},
-      {-1.1, -0.8}, {2.0, 1.5}, {-30.0, 12.0}};
+      {0.0, 0.0},   {1e-9, -2e-9}, {3e-5, 1e-5}, {-0.2, 0.1},
+      {0.7, -0.45}, {-1.1, -0.8},  {2.0, 1.5},   {-30.0, 12.0}};
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> uniform(-1.5, 1.5);
   for (int i = 0; i < 50; ++i) points.emplace_back(uniform(rng), uniform(rng));
@@ -229,14 +230,16 @@ TEST(EquidistantLens, UndistortParameterDerivativeMatchesCentralDifferences) {
 }
 
 TEST(EquidistantLens, UndistortFailsAtAndBeyondNinetyDegrees) {
-  const double* dist = test::AlphasenseCam0().params() + 4;
+  const Camera camera = test::AlphasenseCam0();
+  const double* dist = camera.params() + 4;
   const double theta_d_90 = EquidistantLens::DistortedAngle(dist, M_PI / 2);
   double x, y;
-  EXPECT_TRUE(EquidistantLens::Undistort(dist, 0.999 * theta_d_90, 0.0, &x, &y));
+  EXPECT_TRUE(
+      EquidistantLens::Undistort(dist, 0.999 * theta_d_90, 0.0, &x, &y));
   EXPECT_GT(x, 100.0);  // 89.9+ degrees: far out on the normalized plane.
   EXPECT_FALSE(EquidistantLens::Undistort(dist, theta_d_90, 0.0, &x, &y));
-  EXPECT_FALSE(
-      EquidistantLens::Undistort(dist, 0.8 * theta_d_90, 0.8 * theta_d_90, &x, &y));
+  EXPECT_FALSE(EquidistantLens::Undistort(dist, 0.8 * theta_d_90,
+                                          0.8 * theta_d_90, &x, &y));
 }
 
 TEST(RadTanLens, UndistortFailsBeyondFold) {

@@ -1,10 +1,10 @@
 #include "rcm/camera/refractive_camera.h"
 
-#include <cmath>
-#include <limits>
+#include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-#include <gtest/gtest.h>
+#include <cmath>
+#include <limits>
 
 #include "support/test_rigs.h"
 
@@ -65,7 +65,8 @@ TEST(RefractiveCamera, BearingInvertsProjection) {
 
 TEST(RefractiveCamera, ReducesToPinholeAtNEqualsOne) {
   const Camera camera = test::PinholeCamera();
-  const RefractiveCamera refractive = RefractiveCamera::Create(camera, 1.0).value();
+  const RefractiveCamera refractive =
+      RefractiveCamera::Create(camera, 1.0).value();
   Eigen::Matrix3d k;
   k << camera.fx(), 0.0, camera.cx(), 0.0, camera.fy(), camera.cy(), 0, 0, 1;
   EXPECT_EQ(refractive.VirtualPinholeMatrix(), k);
@@ -73,7 +74,8 @@ TEST(RefractiveCamera, ReducesToPinholeAtNEqualsOne) {
     for (double y = -0.8; y <= 0.8; y += 0.1) {
       const Eigen::Vector3d point(x, y, 1.3);
       const Eigen::Vector2d pinhole = (k * point).hnormalized();
-      const Eigen::Vector2d pixel = refractive.ImageFromPointInWater(point).value();
+      const Eigen::Vector2d pixel =
+          refractive.ImageFromPointInWater(point).value();
       // 1e-12 relative to the pixel magnitude (a few hundred px).
       EXPECT_LT((pixel - pinhole).norm(), 1e-12 * pinhole.norm());
       const Eigen::Vector3d bearing =
@@ -87,7 +89,8 @@ TEST(RefractiveCamera, RejectsIndexOutsideOneToTwo) {
   const Camera camera = test::PinholeCamera();
   for (double n : {0.99, 2.01, -1.33, std::numeric_limits<double>::quiet_NaN(),
                    std::numeric_limits<double>::infinity()}) {
-    const StatusOr<RefractiveCamera> refractive = RefractiveCamera::Create(camera, n);
+    const StatusOr<RefractiveCamera> refractive =
+        RefractiveCamera::Create(camera, n);
     ASSERT_FALSE(refractive.ok()) << n;
     EXPECT_NE(refractive.status().message().find("is outside [1, 2]"),
               std::string::npos)
@@ -103,12 +106,12 @@ TEST(RefractiveCamera, ProjectionFailsBehindCameraAndPastCriticalAngle) {
   EXPECT_FALSE(refractive.ImageFromPointInWater({0.0, 0.0, -1.0}).has_value());
   const double critical = std::asin(1.0 / 1.33);
   EXPECT_TRUE(refractive
-                  .ImageFromPointInWater(
-                      {std::sin(critical - 1e-3), 0.0, std::cos(critical - 1e-3)})
+                  .ImageFromPointInWater({std::sin(critical - 1e-3), 0.0,
+                                          std::cos(critical - 1e-3)})
                   .has_value());
   EXPECT_FALSE(refractive
-                   .ImageFromPointInWater(
-                       {std::sin(critical + 1e-3), 0.0, std::cos(critical + 1e-3)})
+                   .ImageFromPointInWater({std::sin(critical + 1e-3), 0.0,
+                                           std::cos(critical + 1e-3)})
                    .has_value());
 }
 
@@ -119,7 +122,8 @@ TEST(RefractiveCamera, ProjectionRefusesFoldedLensBranch) {
       Camera::Create(LensModelId::kRadTan, 640, 480,
                      {300.0, 300.0, 319.5, 239.5}, {-0.5, 0.0, 0.0, 0.0})
           .value();
-  const RefractiveCamera refractive = RefractiveCamera::Create(folded, 1.0).value();
+  const RefractiveCamera refractive =
+      RefractiveCamera::Create(folded, 1.0).value();
   EXPECT_TRUE(refractive.ImageFromPointInWater({0.8, 0.0, 1.0}).has_value());
   EXPECT_FALSE(refractive.ImageFromPointInWater({1.2, 0.0, 1.0}).has_value());
 }
@@ -147,7 +151,8 @@ TEST(RefractiveCamera, VirtualPinholeProjectsWithKn) {
   EXPECT_DOUBLE_EQ(k_n(0, 0), 1.34 * test::EurocRadtanCamera().fx());
   for (const Eigen::Vector3d& point :
        {Eigen::Vector3d(0.3, -0.2, 2.0), Eigen::Vector3d(-0.9, 0.5, 1.1)}) {
-    const Eigen::Vector2d pixel = refractive.ImageFromPointInWater(point).value();
+    const Eigen::Vector2d pixel =
+        refractive.ImageFromPointInWater(point).value();
     const Eigen::Vector2d virtual_pixel =
         refractive.VirtualPinholeFromImage(pixel).value();
     EXPECT_LT((virtual_pixel - (k_n * point).hnormalized()).norm(), 1e-9);
@@ -161,10 +166,10 @@ TEST(RefractiveCamera, VirtualPinholeBeyondCriticalAngleHasNoSource) {
       RefractiveCamera::Create(test::PinholeCamera(), 1.33).value();
   const double critical_tan = std::tan(std::asin(1.0 / 1.33));
   const double fx = test::PinholeCamera().fx() * 1.33;
-  EXPECT_FALSE(refractive
-                   .ImageFromVirtualPinhole(
-                       {319.5 + 1.01 * critical_tan * fx, 239.5})
-                   .has_value());
+  EXPECT_FALSE(
+      refractive
+          .ImageFromVirtualPinhole({319.5 + 1.01 * critical_tan * fx, 239.5})
+          .has_value());
 }
 
 }  // namespace

@@ -1,9 +1,9 @@
 #include "rcm/camera/refractive_model.h"
 
-#include <cmath>
-
 #include <ceres/jet.h>
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 namespace rcm {
 namespace {
@@ -19,8 +19,7 @@ TEST(FlatPortRefraction, RadialFactorIsTangentRatioOfSnell) {
       const double theta_w = std::asin(std::sin(theta_a) / n);
       const double rb = std::tan(theta_a);
       EXPECT_NEAR(FlatPortRefraction::RadialFactor(n, rb * rb),
-                  rb / std::tan(theta_w),
-                  kTolerance * (1.0 + rb))
+                  rb / std::tan(theta_w), kTolerance * (1.0 + rb))
           << "n = " << n << ", theta_a = " << theta_a;
     }
   }
@@ -48,8 +47,8 @@ TEST(FlatPortRefraction, ReducesToPinholeAtNEqualsOne) {
 
       const double point[3] = {2.0 * xb, 2.0 * yb, 2.0};
       double x, y;
-      ASSERT_TRUE(FlatPortRefraction::NormalizedFromPointInWater(1.0, point,
-                                                                 &x, &y));
+      ASSERT_TRUE(
+          FlatPortRefraction::NormalizedFromPointInWater(1.0, point, &x, &y));
       EXPECT_NEAR(x, xb, kTolerance);
       EXPECT_NEAR(y, yb, kTolerance);
     }
@@ -82,11 +81,13 @@ TEST(FlatPortRefraction, ProjectedRayObeysSnell) {
   for (double n : kIndices) {
     const double point[3] = {0.8, -1.1, 2.0};
     double x, y;
-    ASSERT_TRUE(FlatPortRefraction::NormalizedFromPointInWater(n, point, &x, &y));
+    ASSERT_TRUE(
+        FlatPortRefraction::NormalizedFromPointInWater(n, point, &x, &y));
     const double sin_air = std::hypot(x, y) / std::sqrt(1.0 + x * x + y * y);
-    const double sin_water = std::hypot(point[0], point[1]) /
-                             std::sqrt(point[0] * point[0] +
-                                       point[1] * point[1] + point[2] * point[2]);
+    const double sin_water =
+        std::hypot(point[0], point[1]) /
+        std::sqrt(point[0] * point[0] + point[1] * point[1] +
+                  point[2] * point[2]);
     EXPECT_NEAR(sin_air, n * sin_water, kTolerance);
     // Refraction keeps the azimuth.
     EXPECT_NEAR(std::atan2(y, x), std::atan2(point[1], point[0]), kTolerance);
@@ -97,9 +98,12 @@ TEST(FlatPortRefraction, RejectsPointsBehindCamera) {
   const double behind[3] = {0.1, 0.2, -1.0};
   const double in_plane[3] = {0.1, 0.2, 0.0};
   double x, y;
-  EXPECT_FALSE(FlatPortRefraction::NormalizedFromPointInWater(1.33, behind, &x, &y));
-  EXPECT_FALSE(FlatPortRefraction::NormalizedFromPointInWater(1.33, in_plane, &x, &y));
-  EXPECT_FALSE(FlatPortRefraction::NormalizedFromPointInWater(1.0, behind, &x, &y));
+  EXPECT_FALSE(
+      FlatPortRefraction::NormalizedFromPointInWater(1.33, behind, &x, &y));
+  EXPECT_FALSE(
+      FlatPortRefraction::NormalizedFromPointInWater(1.33, in_plane, &x, &y));
+  EXPECT_FALSE(
+      FlatPortRefraction::NormalizedFromPointInWater(1.0, behind, &x, &y));
 }
 
 TEST(FlatPortRefraction, RejectsTotalInternalReflection) {
@@ -109,9 +113,11 @@ TEST(FlatPortRefraction, RejectsTotalInternalReflection) {
     double x, y;
     const double inside[3] = {std::tan(critical - 1e-6), 0.0, 1.0};
     const double outside[3] = {std::tan(critical + 1e-6), 0.0, 1.0};
-    EXPECT_TRUE(FlatPortRefraction::NormalizedFromPointInWater(n, inside, &x, &y));
+    EXPECT_TRUE(
+        FlatPortRefraction::NormalizedFromPointInWater(n, inside, &x, &y));
     EXPECT_GT(x, 100.0);  // Grazing in air.
-    EXPECT_FALSE(FlatPortRefraction::NormalizedFromPointInWater(n, outside, &x, &y));
+    EXPECT_FALSE(
+        FlatPortRefraction::NormalizedFromPointInWater(n, outside, &x, &y));
   }
 }
 
@@ -121,16 +127,19 @@ TEST(FlatPortRefraction, VirtualPinholeIsIdealPinholeInWater) {
   for (double n : kIndices) {
     const double point[3] = {-0.6, 0.9, 1.7};
     double xb, yb;
-    ASSERT_TRUE(FlatPortRefraction::NormalizedFromPointInWater(n, point, &xb, &yb));
+    ASSERT_TRUE(
+        FlatPortRefraction::NormalizedFromPointInWater(n, point, &xb, &yb));
     double xv, yv;
     FlatPortRefraction::VirtualFromNormalized(n, xb, yb, &xv, &yv);
     EXPECT_NEAR(xv, n * point[0] / point[2], kTolerance);
     EXPECT_NEAR(yv, n * point[1] / point[2], kTolerance);
-    const double m_over_n = FlatPortRefraction::RadialFactor(n, xb * xb + yb * yb) / n;
+    const double m_over_n =
+        FlatPortRefraction::RadialFactor(n, xb * xb + yb * yb) / n;
     EXPECT_NEAR(xv, xb / m_over_n, kTolerance);
 
     double xb_back, yb_back;
-    ASSERT_TRUE(FlatPortRefraction::NormalizedFromVirtual(n, xv, yv, &xb_back, &yb_back));
+    ASSERT_TRUE(FlatPortRefraction::NormalizedFromVirtual(n, xv, yv, &xb_back,
+                                                          &yb_back));
     EXPECT_NEAR(xb_back, xb, kTolerance);
     EXPECT_NEAR(yb_back, yb, kTolerance);
   }
@@ -143,9 +152,11 @@ TEST(FlatPortRefraction, JetDerivativesMatchCentralDifferences) {
   const double n = 1.33;
   const double point[4] = {0.4, -0.3, 1.2};
   const Jet n_jet(n, 0);
-  const Jet point_jet[3] = {Jet(point[0], 1), Jet(point[1], 2), Jet(point[2], 3)};
+  const Jet point_jet[3] = {Jet(point[0], 1), Jet(point[1], 2),
+                            Jet(point[2], 3)};
   Jet x, y;
-  ASSERT_TRUE(FlatPortRefraction::NormalizedFromPointInWater(n_jet, point_jet, &x, &y));
+  ASSERT_TRUE(
+      FlatPortRefraction::NormalizedFromPointInWater(n_jet, point_jet, &x, &y));
   const double h = 1e-6;
   for (int k = 0; k < 4; ++k) {
     double args_plus[4] = {n, point[0], point[1], point[2]};
@@ -153,8 +164,10 @@ TEST(FlatPortRefraction, JetDerivativesMatchCentralDifferences) {
     args_plus[k] += h;
     args_minus[k] -= h;
     double xp, yp, xm, ym;
-    ASSERT_TRUE(FlatPortRefraction::NormalizedFromPointInWater(args_plus[0], args_plus + 1, &xp, &yp));
-    ASSERT_TRUE(FlatPortRefraction::NormalizedFromPointInWater(args_minus[0], args_minus + 1, &xm, &ym));
+    ASSERT_TRUE(FlatPortRefraction::NormalizedFromPointInWater(
+        args_plus[0], args_plus + 1, &xp, &yp));
+    ASSERT_TRUE(FlatPortRefraction::NormalizedFromPointInWater(
+        args_minus[0], args_minus + 1, &xm, &ym));
     EXPECT_NEAR(x.v[k], (xp - xm) / (2 * h), 1e-8) << k;
     EXPECT_NEAR(y.v[k], (yp - ym) / (2 * h), 1e-8) << k;
   }
@@ -164,7 +177,7 @@ TEST(FlatPortRefraction, RadialFactorDerivativeFiniteOnAxis) {
   using Jet = ceres::Jet<double, 2>;
   const Jet m = FlatPortRefraction::RadialFactor(Jet(1.33, 0), Jet(0.0, 1));
   EXPECT_EQ(m.a, 1.33);
-  EXPECT_EQ(m.v[0], 1.0);                           // dm/dn = 1 on axis
+  EXPECT_EQ(m.v[0], 1.0);  // dm/dn = 1 on axis
   EXPECT_NEAR(m.v[1], (1.33 * 1.33 - 1.0) / (2 * 1.33), kTolerance);
 }
 

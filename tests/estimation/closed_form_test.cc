@@ -1,10 +1,10 @@
 #include "rcm/estimation/closed_form.h"
 
-#include <cmath>
-#include <random>
-
 #include <ceres/jet.h>
 #include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
 
 #include "rcm/estimation/paper_online_estimator.h"
 #include "rcm/geometry/observability.h"
@@ -20,20 +20,12 @@ namespace {
 // 6 m, 2e-13 inside the paper's mask). The bar is 1e-9.
 constexpr double kExactTolerance = 1e-9;
 
-std::vector<StereoCorrespondence> Sample(const StereoRig& rig, double n,
-                                         int count, uint64_t seed = 1) {
-  StereoSamplerOptions options;
-  options.n = n;
-  options.per_frame = count;
-  options.seed = seed;
-  return SampleStereoCorrespondences(rig, options).value();
-}
-
 TEST(ClosedForm, ExactOnIdealRig) {
   const StereoRig rig = test::AlphasenseIdealRig();
   for (double n : {1.0, 1.333, 1.5, 2.0}) {
-    for (const StereoCorrespondence& c : Sample(rig, n, 2000)) {
-      const std::optional<double> estimate = ClosedFormN(rig.Normalize(c).value());
+    for (const StereoCorrespondence& c : test::ExactMatches(rig, n, 2000)) {
+      const std::optional<double> estimate =
+          ClosedFormN(rig.Normalize(c).value());
       ASSERT_TRUE(estimate.has_value());
       EXPECT_NEAR(*estimate, n, kExactTolerance)
           << "left " << c.left_pixel.transpose() << " right "
@@ -43,11 +35,10 @@ TEST(ClosedForm, ExactOnIdealRig) {
 }
 
 TEST(ClosedForm, ExactOnIdealRigWithOtherLenses) {
-  for (const Camera& camera :
-       {test::PinholeCamera(), test::EurocRadtanCamera(),
-        test::WideEquidistantCamera()}) {
+  for (const Camera& camera : {test::PinholeCamera(), test::EurocRadtanCamera(),
+                               test::WideEquidistantCamera()}) {
     const StereoRig rig = test::IdealRig(camera, camera, 0.2);
-    for (const StereoCorrespondence& c : Sample(rig, 1.333, 500)) {
+    for (const StereoCorrespondence& c : test::ExactMatches(rig, 1.333, 500)) {
       EXPECT_NEAR(ClosedFormN(rig.Normalize(c).value()).value(), 1.333,
                   kExactTolerance);
     }
@@ -99,7 +90,8 @@ TEST(ClosedForm, JetDerivativeMatchesCentralDifferences) {
                                     Jet(x[3], 3));
   const double h = 1e-7;  // truncation ~1e-11 here, rounding ~1e-9
   for (int k = 0; k < 4; ++k) {
-    double plus[4] = {x[0], x[1], x[2], x[3]}, minus[4] = {x[0], x[1], x[2], x[3]};
+    double plus[4] = {x[0], x[1], x[2], x[3]},
+           minus[4] = {x[0], x[1], x[2], x[3]};
     plus[k] += h;
     minus[k] -= h;
     const double difference =
@@ -119,8 +111,9 @@ TEST(ClosedForm, NoisyMatchesSpreadAsFirstOrderSigma) {
   const StereoRig rig = test::AlphasenseIdealRig();
   const double n = 1.333, sigma_px = 0.02;
   std::vector<StereoCorrespondence> matches;
-  for (const StereoCorrespondence& c : Sample(rig, n, 1000)) {
-    if (PassesObservabilityMask(rig.Normalize(c)->left, 0.3)) matches.push_back(c);
+  for (const StereoCorrespondence& c : test::ExactMatches(rig, n, 1000)) {
+    if (PassesObservabilityMask(rig.Normalize(c)->left, 0.3))
+      matches.push_back(c);
   }
   matches.resize(400);
   std::vector<StereoCorrespondence> noisy = matches;
@@ -128,7 +121,8 @@ TEST(ClosedForm, NoisyMatchesSpreadAsFirstOrderSigma) {
   double sum_z2 = 0.0;
   for (size_t i = 0; i < matches.size(); ++i) {
     const double sigma = FirstOrderSigmaN(rig, matches[i], n, sigma_px).value();
-    const double z = (ClosedFormN(rig.Normalize(noisy[i]).value()).value() - n) / sigma;
+    const double z =
+        (ClosedFormN(rig.Normalize(noisy[i]).value()).value() - n) / sigma;
     EXPECT_LT(std::abs(z), 5.0);
     sum_z2 += z * z;
   }

@@ -1,9 +1,9 @@
 #include "rcm/estimation/paper_online_estimator.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <limits>
-
-#include <gtest/gtest.h>
 
 #include "rcm/estimation/closed_form.h"
 #include "rcm/geometry/observability.h"
@@ -17,17 +17,8 @@ namespace {
 // weighted mean of such values is as close.
 constexpr double kExactTolerance = 1e-9;
 
-std::vector<StereoCorrespondence> Sample(const StereoRig& rig, double n,
-                                         int count, uint64_t seed = 1) {
-  StereoSamplerOptions options;
-  options.n = n;
-  options.per_frame = count;
-  options.seed = seed;
-  return SampleStereoCorrespondences(rig, options).value();
-}
-
-PaperOnlineEstimator::Estimate EstimateAll(const StereoRig& rig,
-                                           const std::vector<StereoCorrespondence>& data) {
+PaperOnlineEstimator::Estimate EstimateAll(
+    const StereoRig& rig, const std::vector<StereoCorrespondence>& data) {
   PaperOnlineEstimator estimator(rig, PaperOnlineEstimatorOptions());
   for (const StereoCorrespondence& c : data) estimator.Add(c);
   return estimator.Current().value();
@@ -36,7 +27,8 @@ PaperOnlineEstimator::Estimate EstimateAll(const StereoRig& rig,
 TEST(PaperOnlineEstimator, ExactOnIdealRig) {
   const StereoRig rig = test::AlphasenseIdealRig();
   for (double n : {1.0, 1.333, 1.5}) {
-    const PaperOnlineEstimator::Estimate estimate = EstimateAll(rig, Sample(rig, n, 1000));
+    const PaperOnlineEstimator::Estimate estimate =
+        EstimateAll(rig, test::ExactMatches(rig, n, 1000));
     EXPECT_NEAR(estimate.n, n, kExactTolerance);
     EXPECT_LT(estimate.standard_error, kExactTolerance);
     EXPECT_GT(estimate.used, 500);
@@ -46,7 +38,7 @@ TEST(PaperOnlineEstimator, ExactOnIdealRig) {
 TEST(PaperOnlineEstimator, IsRadiallyWeightedMeanOfMaskedClosedForms) {
   // Eq. 17 recomputed from scratch on noisy data.
   const StereoRig rig = test::AlphasenseIdealRig();
-  std::vector<StereoCorrespondence> data = Sample(rig, 1.333, 500);
+  std::vector<StereoCorrespondence> data = test::ExactMatches(rig, 1.333, 500);
   AddPixelNoise(0.3, 5, &data);
   PaperOnlineEstimator estimator(rig, PaperOnlineEstimatorOptions());
   double sum_rn = 0.0, sum_r = 0.0;
@@ -89,7 +81,8 @@ TEST(PaperOnlineEstimator, NoisyEstimateWithinFirstOrderTolerance) {
   // sigma bounds the error.
   const StereoRig rig = test::AlphasenseIdealRig();
   const double n = 1.333, sigma_px = 0.02;
-  const std::vector<StereoCorrespondence> exact = Sample(rig, n, 2000);
+  const std::vector<StereoCorrespondence> exact =
+      test::ExactMatches(rig, n, 2000);
   std::vector<StereoCorrespondence> noisy = exact;
   AddPixelNoise(sigma_px, 11, &noisy);
   double sum_w = 0.0, sum_w2_sigma2 = 0.0;
@@ -114,7 +107,8 @@ TEST(PaperOnlineEstimator, StandardErrorIsHonestInMeanSquare) {
   // those. At 0.02 px the tails are light and the mean reported value is
   // honest too.
   const StereoRig rig = test::AlphasenseIdealRig();
-  const std::vector<StereoCorrespondence> exact = Sample(rig, 1.333, 2000, 5);
+  const std::vector<StereoCorrespondence> exact =
+      test::ExactMatches(rig, 1.333, 2000, 5);
   for (double sigma_px : {0.02, 0.1}) {
     const int kTrials = 400;
     double sum = 0.0, sum_squares = 0.0, sum_se = 0.0, sum_se2 = 0.0;
@@ -142,7 +136,7 @@ TEST(PaperOnlineEstimator, BiasedUpwardUnderHalfPixelNoise) {
   // reads ~1.42 for a true 1.333 (here 1.41). This pins the baseline: if it
   // ever reads right, it is no longer the paper's estimator.
   const StereoRig rig = test::AlphasenseIdealRig();
-  std::vector<StereoCorrespondence> data = Sample(rig, 1.333, 2000);
+  std::vector<StereoCorrespondence> data = test::ExactMatches(rig, 1.333, 2000);
   AddPixelNoise(0.5, 2, &data);
   const PaperOnlineEstimator::Estimate estimate = EstimateAll(rig, data);
   EXPECT_GT(estimate.n, 1.333 + 0.04);
@@ -152,7 +146,8 @@ TEST(PaperOnlineEstimator, BiasedUpwardUnderHalfPixelNoise) {
 TEST(PaperOnlineEstimator, BiasedOnUnrectifiedRig) {
   // Exact data of a rig 0.5 degrees from rectified: eq. 14 does not hold.
   const StereoRig rig = test::AlphasenseRealisticRig();
-  const PaperOnlineEstimator::Estimate estimate = EstimateAll(rig, Sample(rig, 1.333, 2000));
+  const PaperOnlineEstimator::Estimate estimate =
+      EstimateAll(rig, test::ExactMatches(rig, 1.333, 2000));
   EXPECT_GT(std::abs(estimate.n - 1.333), 0.01);
 }
 
@@ -166,7 +161,8 @@ TEST(PaperOnlineEstimator, MaskRemovesFeaturesNearAxes) {
   StereoCorrespondence on_axis;
   on_axis.left_pixel = Eigen::Vector2d(500.0, rig.left().cy());
   on_axis.right_pixel = Eigen::Vector2d(480.0, rig.right().cy());
-  EXPECT_EQ(estimator.Add(on_axis).outcome, PaperOnlineEstimator::Outcome::kMasked);
+  EXPECT_EQ(estimator.Add(on_axis).outcome,
+            PaperOnlineEstimator::Outcome::kMasked);
   EXPECT_FALSE(estimator.Current().has_value());
 }
 
@@ -174,7 +170,8 @@ TEST(PaperOnlineEstimator, NonFinitePixelIsInvalid) {
   const StereoRig rig = test::AlphasenseIdealRig();
   PaperOnlineEstimator estimator(rig, PaperOnlineEstimatorOptions());
   StereoCorrespondence c;
-  c.left_pixel = Eigen::Vector2d(std::numeric_limits<double>::quiet_NaN(), 10.0);
+  c.left_pixel =
+      Eigen::Vector2d(std::numeric_limits<double>::quiet_NaN(), 10.0);
   EXPECT_EQ(estimator.Add(c).outcome, PaperOnlineEstimator::Outcome::kInvalid);
   EXPECT_EQ(estimator.num_invalid(), 1);
 }
@@ -182,7 +179,7 @@ TEST(PaperOnlineEstimator, NonFinitePixelIsInvalid) {
 TEST(PaperOnlineEstimator, SingleValueHasNoStandardError) {
   const StereoRig rig = test::AlphasenseIdealRig();
   PaperOnlineEstimator estimator(rig, PaperOnlineEstimatorOptions());
-  for (const StereoCorrespondence& c : Sample(rig, 1.333, 50)) {
+  for (const StereoCorrespondence& c : test::ExactMatches(rig, 1.333, 50)) {
     if (estimator.Add(c).outcome == PaperOnlineEstimator::Outcome::kUsed) break;
   }
   ASSERT_EQ(estimator.num_used(), 1);
@@ -192,13 +189,15 @@ TEST(PaperOnlineEstimator, SingleValueHasNoStandardError) {
 TEST(PaperOnlineEstimator, ResetEmptiesTheBuffer) {
   const StereoRig rig = test::AlphasenseIdealRig();
   PaperOnlineEstimator estimator(rig, PaperOnlineEstimatorOptions());
-  for (const StereoCorrespondence& c : Sample(rig, 1.0, 300)) estimator.Add(c);
+  for (const StereoCorrespondence& c : test::ExactMatches(rig, 1.0, 300))
+    estimator.Add(c);
   ASSERT_TRUE(estimator.Current().has_value());
   estimator.Reset();
   EXPECT_FALSE(estimator.Current().has_value());
   EXPECT_EQ(estimator.num_added(), 0);
   // A new medium after the reset: the old values are gone.
-  for (const StereoCorrespondence& c : Sample(rig, 1.5, 300)) estimator.Add(c);
+  for (const StereoCorrespondence& c : test::ExactMatches(rig, 1.5, 300))
+    estimator.Add(c);
   EXPECT_NEAR(estimator.Current()->n, 1.5, kExactTolerance);
 }
 

@@ -1,8 +1,8 @@
 #include "rcm/geometry/epipolar.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "rcm/sim/stereo_sampler.h"
 #include "support/test_rigs.h"
@@ -15,12 +15,8 @@ namespace {
 constexpr double kResidualTolerance = 1e-12;
 
 std::vector<NormalizedCorrespondence> Sample(const StereoRig& rig, double n) {
-  StereoSamplerOptions options;
-  options.n = n;
-  options.per_frame = 300;
   std::vector<NormalizedCorrespondence> normalized;
-  for (const StereoCorrespondence& c :
-       SampleStereoCorrespondences(rig, options).value()) {
+  for (const StereoCorrespondence& c : test::ExactMatches(rig, n, 300)) {
     normalized.push_back(rig.Normalize(c).value());
   }
   return normalized;
@@ -46,7 +42,8 @@ TEST(Epipolar, ResidualDetectsWrongIndex) {
   double sum_squares = 0.0;
   const std::vector<NormalizedCorrespondence> data = Sample(rig, 1.333);
   for (const NormalizedCorrespondence& c : data) {
-    const double e = CoplanarityResidual(essential, 1.2, c.left.data(), c.right.data());
+    const double e =
+        CoplanarityResidual(essential, 1.2, c.left.data(), c.right.data());
     sum_squares += e * e;
   }
   EXPECT_GT(std::sqrt(sum_squares / data.size()), 1e-4);

@@ -1,8 +1,8 @@
 #include "rcm/geometry/locus.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "rcm/camera/refractive_model.h"
 #include "rcm/sim/stereo_sampler.h"
@@ -18,11 +18,7 @@ constexpr double kTolerance = 1e-12;
 TEST(RectifiedLocus, ExactMatchesLieOnTheLocus) {
   const StereoRig rig = test::AlphasenseIdealRig();
   for (double n : {1.0, 1.333, 1.5}) {
-    StereoSamplerOptions options;
-    options.n = n;
-    options.per_frame = 500;
-    for (const StereoCorrespondence& c :
-         SampleStereoCorrespondences(rig, options).value()) {
+    for (const StereoCorrespondence& c : test::ExactMatches(rig, n, 500)) {
       const NormalizedCorrespondence m = rig.Normalize(c).value();
       const RectifiedLocus locus(n, m.left.x(), m.left.y());
       EXPECT_NEAR(locus.RightY(m.right.x()), m.right.y(), kTolerance);

@@ -1,13 +1,13 @@
 #include "rcm/geometry/observability.h"
 
-#include <cmath>
-#include <random>
-
 #include <ceres/jet.h>
 #include <gtest/gtest.h>
 
-#include "rcm/estimation/closed_form.h"
+#include <cmath>
+#include <random>
+
 #include "rcm/camera/refractive_camera.h"
+#include "rcm/estimation/closed_form.h"
 #include "rcm/estimation/paper_online_estimator.h"
 #include "rcm/sim/stereo_sampler.h"
 #include "support/test_rigs.h"
@@ -72,7 +72,8 @@ TEST(Observability, FirstOrderSigmaMatchesClosedFormGradient) {
   const double n = 1.333, sigma_px = 0.5;
   using Jet = ceres::Jet<double, 4>;
   for (const StereoCorrespondence& c : ObservableMatches(rig, n, 50)) {
-    const Jet left_pixel[2] = {Jet(c.left_pixel.x(), 0), Jet(c.left_pixel.y(), 1)};
+    const Jet left_pixel[2] = {Jet(c.left_pixel.x(), 0),
+                               Jet(c.left_pixel.y(), 1)};
     const Jet right_pixel[2] = {Jet(c.right_pixel.x(), 2),
                                 Jet(c.right_pixel.y(), 3)};
     Jet left[2], right[2];
@@ -122,7 +123,8 @@ TEST(Observability, FirstOrderSigmaIsHonest) {
 
 TEST(Observability, FirstOrderSigmaUndefinedOnHorizontalAxis) {
   // yl = yr = 0: e = yr m_l - yl m_r vanishes for every n.
-  const StereoRig rig = test::IdealRig(test::PinholeCamera(), test::PinholeCamera());
+  const StereoRig rig =
+      test::IdealRig(test::PinholeCamera(), test::PinholeCamera());
   StereoCorrespondence c;
   c.left_pixel = Eigen::Vector2d(500.0, rig.left().cy());
   c.right_pixel = Eigen::Vector2d(480.0, rig.right().cy());
@@ -131,9 +133,11 @@ TEST(Observability, FirstOrderSigmaUndefinedOnHorizontalAxis) {
 
 TEST(Observability, FirstOrderSigmaGrowsTowardTheAxes) {
   // The same depth and disparity, closer to the horizontal axis: worse.
-  const StereoRig rig = test::IdealRig(test::PinholeCamera(), test::PinholeCamera());
+  const StereoRig rig =
+      test::IdealRig(test::PinholeCamera(), test::PinholeCamera());
   const double n = 1.333;
-  const RefractiveCamera camera = RefractiveCamera::Create(rig.left(), n).value();
+  const RefractiveCamera camera =
+      RefractiveCamera::Create(rig.left(), n).value();
   const auto sigma_at = [&](const Eigen::Vector3d& point) {
     StereoCorrespondence c;
     c.left_pixel = camera.ImageFromPointInWater(point).value();

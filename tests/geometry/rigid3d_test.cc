@@ -1,18 +1,19 @@
 #include "rcm/geometry/rigid3d.h"
 
-#include <cmath>
-#include <limits>
+#include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-#include <gtest/gtest.h>
+#include <cmath>
+#include <limits>
 
 namespace rcm {
 namespace {
 
 Rigid3d SomeTransform() {
-  return Rigid3d{Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, -2, 0.5).normalized())
-                     .toRotationMatrix(),
-                 Eigen::Vector3d(0.1, -0.2, 0.3)};
+  return Rigid3d{
+      Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, -2, 0.5).normalized())
+          .toRotationMatrix(),
+      Eigen::Vector3d(0.1, -0.2, 0.3)};
 }
 
 TEST(Rigid3d, FromMatrixAcceptsRigidTransform) {

@@ -1,8 +1,8 @@
 #include "rcm/geometry/stereo_rig.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "rcm/camera/refractive_camera.h"
 #include "support/test_rigs.h"

@@ -1,28 +1,16 @@
 #include "support/test_rigs.h"
 
+#include <Eigen/Geometry>
 #include <cmath>
 
-#include <Eigen/Geometry>
+#include "rcm/sim/reference_rigs.h"
+#include "rcm/sim/stereo_sampler.h"
 
 namespace rcm::test {
 
-Camera AlphasenseCam0() {
-  return Camera::Create(LensModelId::kEquidistant, 720, 540,
-                        {346.68681661781403, 346.7780959214622,
-                         360.53325988648163, 271.0179819820658},
-                        {-0.037934508908317364, -0.0009855550912794707,
-                         -0.0009622185860956224, 2.365797666527927e-05})
-      .value();
-}
+Camera AlphasenseCam0() { return AlphasenseFrontCam0(); }
 
-Camera AlphasenseCam1() {
-  return Camera::Create(LensModelId::kEquidistant, 720, 540,
-                        {344.3933991977547, 344.2292927278568,
-                         358.725925185576, 262.02195974034373},
-                        {-0.03970881800919102, 0.0016107591002609727,
-                         -0.002331667784337188, 0.00035009066006595556})
-      .value();
-}
+Camera AlphasenseCam1() { return AlphasenseFrontCam1(); }
 
 Camera EurocRadtanCamera() {
   return Camera::Create(LensModelId::kRadTan, 752, 480,
@@ -59,9 +47,7 @@ StereoRig IdealRig(const Camera& left, const Camera& right, double baseline) {
   return StereoRig::Create(left, right, right_from_left).value();
 }
 
-StereoRig AlphasenseIdealRig() {
-  return IdealRig(AlphasenseCam0(), AlphasenseCam1());
-}
+StereoRig AlphasenseIdealRig() { return AlphasenseFrontRectifiedRig(); }
 
 StereoRig AlphasenseRealisticRig() {
   Rigid3d right_from_left;
@@ -72,6 +58,15 @@ StereoRig AlphasenseRealisticRig() {
   right_from_left.translation = Eigen::Vector3d(-0.11, 0.0015, -0.002);
   return StereoRig::Create(AlphasenseCam0(), AlphasenseCam1(), right_from_left)
       .value();
+}
+
+std::vector<StereoCorrespondence> ExactMatches(const StereoRig& rig, double n,
+                                               int count, uint64_t seed) {
+  StereoSamplerOptions options;
+  options.n = n;
+  options.per_frame = count;
+  options.seed = seed;
+  return SampleStereoCorrespondences(rig, options).value();
 }
 
 std::vector<Eigen::Vector2d> ImageGrid(const Camera& camera, double step) {

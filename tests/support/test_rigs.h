@@ -4,11 +4,11 @@
 #ifndef RCM_TESTS_SUPPORT_TEST_RIGS_H_
 #define RCM_TESTS_SUPPORT_TEST_RIGS_H_
 
+#include <Eigen/Core>
 #include <vector>
 
-#include <Eigen/Core>
-
 #include "rcm/camera/camera.h"
+#include "rcm/geometry/stereo_correspondence.h"
 #include "rcm/geometry/stereo_rig.h"
 
 namespace rcm::test {
@@ -34,6 +34,11 @@ StereoRig AlphasenseIdealRig();
 // The Alphasense intrinsics, 0.5 degrees of rotation about a skew axis and
 // a baseline slightly off the x axis: a real, unrectified rig.
 StereoRig AlphasenseRealisticRig();
+
+// `count` exact correspondences of `rig` in a medium of index n, one frame,
+// depths 0.6-6 m (rcm/sim/stereo_sampler.h).
+std::vector<StereoCorrespondence> ExactMatches(const StereoRig& rig, double n,
+                                               int count, uint64_t seed = 1);
 
 // Pixels on a grid covering the whole image with `step` spacing, plus the
 // four borders (-0.5 and size - 0.5) and the exact corners.

@@ -166,15 +166,14 @@ struct PinholeLens : public BaseLens<PinholeLens> {
   static constexpr const char* kParamsInfo = "fx, fy, cx, cy";
 
   template <typename T>
-  static void Distort(const T* /*dist*/, const T& x, const T& y, T* xd,
-                      T* yd) {
+  static void Distort(const T* /*dist*/, const T& x, const T& y, T* xd, T* yd) {
     *xd = x;
     *yd = y;
   }
   // jacobian = d(xd, yd) / d(x, y), row-major 2x2.
   template <typename T>
-  static void DistortWithJacobian(const T* dist, const T& x, const T& y,
-                                  T* xd, T* yd, T jacobian[4]) {
+  static void DistortWithJacobian(const T* dist, const T& x, const T& y, T* xd,
+                                  T* yd, T jacobian[4]) {
     Distort(dist, x, y, xd, yd);
     jacobian[0] = T(1.0);
     jacobian[1] = T(0.0);
@@ -221,8 +220,9 @@ struct RadTanLens : public BaseLens<RadTanLens> {
   //   dxd/dy = g x y + 2 p1 x + 2 p2 y = dyd/dx
   //   dyd/dy = radial + g y^2 + 6 p1 y + 2 p2 x
   template <typename T>
-  static void DistortWithJacobian(const T* dist, const T& x, const T& y,
-                                  T* xd, T* yd, T jacobian[4]) {
+  static void DistortWithJacobian(const T* dist, const T& x, const T& y, T* xd,
+                                  T* yd, T jacobian[4]) {
+    Distort(dist, x, y, xd, yd);
     const T& k1 = dist[0];
     const T& k2 = dist[1];
     const T& p1 = dist[2];
@@ -232,8 +232,6 @@ struct RadTanLens : public BaseLens<RadTanLens> {
     const T xy = x * y;
     const T r2 = x2 + y2;
     const T radial = T(1.0) + r2 * (k1 + k2 * r2);
-    *xd = x * radial + T(2.0) * p1 * xy + p2 * (r2 + T(2.0) * x2);
-    *yd = y * radial + p1 * (r2 + T(2.0) * y2) + T(2.0) * p2 * xy;
     const T g = T(2.0) * (k1 + T(2.0) * k2 * r2);
     const T cross = g * xy + T(2.0) * (p1 * x + p2 * y);
     jacobian[0] = radial + g * x2 + T(2.0) * p1 * y + T(6.0) * p2 * x;
@@ -265,28 +263,40 @@ struct EquidistantLens : public BaseLens<EquidistantLens> {
                           T* derivative = nullptr) {
     const T t2 = theta * theta;
     const T poly =
-        T(1.0) + t2 * (dist[0] + t2 * (dist[1] + t2 * (dist[2] + t2 * dist[3])));
+        T(1.0) +
+        t2 * (dist[0] + t2 * (dist[1] + t2 * (dist[2] + t2 * dist[3])));
     if (derivative != nullptr) {
       *derivative =
-          T(1.0) + t2 * (T(3.0) * dist[0] +
-                         t2 * (T(5.0) * dist[1] +
-                               t2 * (T(7.0) * dist[2] + t2 * T(9.0) * dist[3])));
+          T(1.0) +
+          t2 * (T(3.0) * dist[0] +
+                t2 * (T(5.0) * dist[1] +
+                      t2 * (T(7.0) * dist[2] + t2 * T(9.0) * dist[3])));
     }
     return theta * poly;
   }
 
+  // s(r) = theta_d / r from r^2 and, when `radial_term` is given,
+  // s'(r) / r (see DistortWithJacobian).
+  template <typename T>
+  static T Scale(const T* dist, const T& r2, T* radial_term = nullptr) {
+    if (ScalarPart(r2) < kSeriesRadiusSquared) {
+      const T k1_minus_third = dist[0] - T(1.0 / 3.0);
+      if (radial_term != nullptr) *radial_term = T(2.0) * k1_minus_third;
+      return T(1.0) + k1_minus_third * r2;
+    }
+    using std::atan;
+    using std::sqrt;
+    const T r = sqrt(r2);
+    if (radial_term == nullptr) return DistortedAngle(dist, atan(r)) / r;
+    T derivative;
+    const T theta_d = DistortedAngle(dist, atan(r), &derivative);
+    *radial_term = (derivative * r / (T(1.0) + r2) - theta_d) / (r2 * r);
+    return theta_d / r;
+  }
+
   template <typename T>
   static void Distort(const T* dist, const T& x, const T& y, T* xd, T* yd) {
-    const T r2 = x * x + y * y;
-    T scale;
-    if (ScalarPart(r2) < kSeriesRadiusSquared) {
-      scale = T(1.0) + (dist[0] - T(1.0 / 3.0)) * r2;
-    } else {
-      using std::atan;
-      using std::sqrt;
-      const T r = sqrt(r2);
-      scale = DistortedAngle(dist, atan(r)) / r;
-    }
+    const T scale = Scale(dist, x * x + y * y);
     *xd = scale * x;
     *yd = scale * y;
   }
@@ -296,22 +306,10 @@ struct EquidistantLens : public BaseLens<EquidistantLens> {
   //   s'(r) / r = (theta_d'(theta) r / (1 + r^2) - theta_d) / r^3
   //             -> 2 (k1 - 1/3) as r -> 0.
   template <typename T>
-  static void DistortWithJacobian(const T* dist, const T& x, const T& y,
-                                  T* xd, T* yd, T jacobian[4]) {
-    const T r2 = x * x + y * y;
-    T scale, radial_term;
-    if (ScalarPart(r2) < kSeriesRadiusSquared) {
-      scale = T(1.0) + (dist[0] - T(1.0 / 3.0)) * r2;
-      radial_term = T(2.0) * (dist[0] - T(1.0 / 3.0));
-    } else {
-      using std::atan;
-      using std::sqrt;
-      const T r = sqrt(r2);
-      T derivative;
-      const T theta_d = DistortedAngle(dist, atan(r), &derivative);
-      scale = theta_d / r;
-      radial_term = (derivative * r / (T(1.0) + r2) - theta_d) / (r2 * r);
-    }
+  static void DistortWithJacobian(const T* dist, const T& x, const T& y, T* xd,
+                                  T* yd, T jacobian[4]) {
+    T radial_term;
+    const T scale = Scale(dist, x * x + y * y, &radial_term);
     *xd = scale * x;
     *yd = scale * y;
     jacobian[0] = scale + radial_term * x * x;
@@ -383,8 +381,8 @@ struct EquidistantLens : public BaseLens<EquidistantLens> {
     double derivative;
     const double f = DistortedAngle(dist, t, &derivative) - target;
     *theta = t;
-    return std::abs(f) <= 1e3 * lens_internal::kUndistortTolerance *
-                              (1.0 + target) &&
+    return std::abs(f) <=
+               1e3 * lens_internal::kUndistortTolerance * (1.0 + target) &&
            t < kHalfPi;
   }
 };
