@@ -1,8 +1,8 @@
 #include "rcm/sim/stereo_sampler.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "rcm/camera/refractive_camera.h"
 #include "support/test_rigs.h"
@@ -34,12 +34,15 @@ TEST(StereoSampler, PointsAreConsistentWithTheModel) {
   options.n = 1.34;
   options.min_depth = 1.0;
   options.max_depth = 2.0;
-  const RefractiveCamera left = RefractiveCamera::Create(rig.left(), 1.34).value();
-  const RefractiveCamera right = RefractiveCamera::Create(rig.right(), 1.34).value();
+  const RefractiveCamera left =
+      RefractiveCamera::Create(rig.left(), 1.34).value();
+  const RefractiveCamera right =
+      RefractiveCamera::Create(rig.right(), 1.34).value();
   const Rigid3d left_from_right = rig.right_from_left().Inverse();
   for (const StereoCorrespondence& c :
        SampleStereoCorrespondences(rig, options).value()) {
-    const Eigen::Vector3d a = left.BearingInWaterFromImage(c.left_pixel).value();
+    const Eigen::Vector3d a =
+        left.BearingInWaterFromImage(c.left_pixel).value();
     const Eigen::Vector3d b =
         left_from_right.rotation *
         right.BearingInWaterFromImage(c.right_pixel).value();
@@ -91,7 +94,8 @@ TEST(StereoSampler, FailsWhenCamerasDoNotOverlap) {
   right_from_left.rotation = Eigen::Vector3d(-1.0, 1.0, -1.0).asDiagonal();
   right_from_left.translation = Eigen::Vector3d(-0.1, 0.0, 0.0);
   const StereoRig rig =
-      StereoRig::Create(test::PinholeCamera(), test::PinholeCamera(), right_from_left)
+      StereoRig::Create(test::PinholeCamera(), test::PinholeCamera(),
+                        right_from_left)
           .value();
   const StatusOr<std::vector<StereoCorrespondence>> sample =
       SampleStereoCorrespondences(rig, StereoSamplerOptions());

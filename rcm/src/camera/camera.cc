@@ -1,9 +1,8 @@
 #include "rcm/camera/camera.h"
 
+#include <Eigen/LU>
 #include <cmath>
 #include <sstream>
-
-#include <Eigen/LU>
 
 namespace rcm {
 
@@ -39,8 +38,7 @@ StatusOr<Camera> Camera::Create(LensModelId model, int width, int height,
                                 const std::vector<double>& distortion) {
   if (width <= 0 || height <= 0) {
     std::ostringstream message;
-    message << "image size must be positive, got " << width << " x "
-            << height;
+    message << "image size must be positive, got " << width << " x " << height;
     return Status::Error(message.str());
   }
   const char* kNames[4] = {"fx", "fy", "cx", "cy"};
@@ -106,10 +104,9 @@ Eigen::Matrix2d Camera::ImageFromNormalizedJacobian(
   double distorted[2];
   double jacobian[4] = {1.0, 0.0, 0.0, 1.0};
   RCM_LENS_MODEL_SWITCH(
-      model_,
-      LensModel::DistortWithJacobian(params_.data() + 4, normalized.x(),
-                                     normalized.y(), &distorted[0],
-                                     &distorted[1], jacobian);
+      model_, LensModel::DistortWithJacobian(params_.data() + 4, normalized.x(),
+                                             normalized.y(), &distorted[0],
+                                             &distorted[1], jacobian);
       break;)
   Eigen::Matrix2d result;
   result << fx() * jacobian[0], fx() * jacobian[1], fy() * jacobian[2],
@@ -122,8 +119,8 @@ bool Camera::LensInvertibleAt(const Eigen::Vector2d& normalized) const {
 }
 
 bool Camera::InImage(const Eigen::Vector2d& pixel) const {
-  return pixel.x() >= -0.5 && pixel.x() <= width_ - 0.5 &&
-         pixel.y() >= -0.5 && pixel.y() <= height_ - 0.5;
+  return pixel.x() >= -0.5 && pixel.x() <= width_ - 0.5 && pixel.y() >= -0.5 &&
+         pixel.y() <= height_ - 0.5;
 }
 
 bool Camera::operator==(const Camera& other) const {

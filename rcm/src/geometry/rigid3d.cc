@@ -1,10 +1,9 @@
 #include "rcm/geometry/rigid3d.h"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
-
-#include <Eigen/LU>
 
 namespace rcm {
 
@@ -33,8 +32,8 @@ StatusOr<Rigid3d> Rigid3d::FromMatrix(const Eigen::Matrix4d& matrix) {
   const double determinant = rotation.determinant();
   if (std::abs(determinant - 1.0) > kRotationTolerance) {
     std::ostringstream message;
-    message << "not a rigid transform: rotation has determinant "
-            << determinant << " (a reflection)";
+    message << "not a rigid transform: rotation has determinant " << determinant
+            << " (a reflection)";
     return Status::Error(message.str());
   }
   return Rigid3d{rotation, matrix.topRightCorner<3, 1>()};

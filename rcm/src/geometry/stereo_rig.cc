@@ -24,8 +24,7 @@ StereoRig::RectificationDeviation StereoRig::DeviationFromRectified() const {
   RectificationDeviation deviation;
   deviation.rotation = right_from_left_.RotationAngle();
   const Eigen::Vector3d& t = right_from_left_.translation;
-  deviation.baseline_off_axis =
-      std::atan2(t.tail<2>().norm(), std::abs(t.x()));
+  deviation.baseline_off_axis = std::atan2(t.tail<2>().norm(), std::abs(t.x()));
   return deviation;
 }
 

@@ -3,14 +3,14 @@
 #ifndef RCM_CAMERA_CAMERA_H_
 #define RCM_CAMERA_CAMERA_H_
 
+#include <glog/logging.h>
+
+#include <Eigen/Core>
 #include <array>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <Eigen/Core>
-#include <glog/logging.h>
 
 #include "rcm/camera/lens_models.h"
 #include "rcm/util/status.h"
@@ -108,19 +108,19 @@ template <typename T>
 void Camera::ImageFromNormalized(const T* normalized, T* pixel) const {
   T params[kMaxLensParams];
   for (int i = 0; i < kMaxLensParams; ++i) params[i] = T(params_[i]);
-  RCM_LENS_MODEL_SWITCH(model_, LensModel::ImgFromCam(
-                                    params, normalized[0], normalized[1],
+  RCM_LENS_MODEL_SWITCH(
+      model_, LensModel::ImgFromCam(params, normalized[0], normalized[1],
                                     &pixel[0], &pixel[1]);
-                        return;)
+      return;)
 }
 
 template <typename T>
 bool Camera::NormalizedFromImage(const T* pixel, T* normalized) const {
   T params[kMaxLensParams];
   for (int i = 0; i < kMaxLensParams; ++i) params[i] = T(params_[i]);
-  RCM_LENS_MODEL_SWITCH(model_, return LensModel::CamFromImg(
-                                    params, pixel[0], pixel[1],
-                                    &normalized[0], &normalized[1]);)
+  RCM_LENS_MODEL_SWITCH(
+      model_, return LensModel::CamFromImg(params, pixel[0], pixel[1],
+                                           &normalized[0], &normalized[1]);)
   return false;
 }
 

@@ -201,6 +201,18 @@ struct RadTanLens : public BaseLens<RadTanLens> {
 
   template <typename T>
   static void Distort(const T* dist, const T& x, const T& y, T* xd, T* yd) {
+    DistortWithJacobian(dist, x, y, xd, yd, static_cast<T*>(nullptr));
+  }
+
+  // Analytic jacobian = d(xd, yd) / d(x, y), row-major 2x2, skipped when
+  // `jacobian` is null:
+  //   with g = 2 (k1 + 2 k2 r^2) (so d radial / dx = g x),
+  //   dxd/dx = radial + g x^2 + 2 p1 y + 6 p2 x
+  //   dxd/dy = g x y + 2 p1 x + 2 p2 y = dyd/dx
+  //   dyd/dy = radial + g y^2 + 6 p1 y + 2 p2 x
+  template <typename T>
+  static void DistortWithJacobian(const T* dist, const T& x, const T& y, T* xd,
+                                  T* yd, T* jacobian) {
     const T& k1 = dist[0];
     const T& k2 = dist[1];
     const T& p1 = dist[2];
@@ -212,26 +224,7 @@ struct RadTanLens : public BaseLens<RadTanLens> {
     const T radial = T(1.0) + r2 * (k1 + k2 * r2);
     *xd = x * radial + T(2.0) * p1 * xy + p2 * (r2 + T(2.0) * x2);
     *yd = y * radial + p1 * (r2 + T(2.0) * y2) + T(2.0) * p2 * xy;
-  }
-
-  // Analytic jacobian = d(xd, yd) / d(x, y), row-major 2x2:
-  //   with g = 2 (k1 + 2 k2 r^2) (so d radial / dx = g x),
-  //   dxd/dx = radial + g x^2 + 2 p1 y + 6 p2 x
-  //   dxd/dy = g x y + 2 p1 x + 2 p2 y = dyd/dx
-  //   dyd/dy = radial + g y^2 + 6 p1 y + 2 p2 x
-  template <typename T>
-  static void DistortWithJacobian(const T* dist, const T& x, const T& y, T* xd,
-                                  T* yd, T jacobian[4]) {
-    Distort(dist, x, y, xd, yd);
-    const T& k1 = dist[0];
-    const T& k2 = dist[1];
-    const T& p1 = dist[2];
-    const T& p2 = dist[3];
-    const T x2 = x * x;
-    const T y2 = y * y;
-    const T xy = x * y;
-    const T r2 = x2 + y2;
-    const T radial = T(1.0) + r2 * (k1 + k2 * r2);
+    if (jacobian == nullptr) return;
     const T g = T(2.0) * (k1 + T(2.0) * k2 * r2);
     const T cross = g * xy + T(2.0) * (p1 * x + p2 * y);
     jacobian[0] = radial + g * x2 + T(2.0) * p1 * y + T(6.0) * p2 * x;

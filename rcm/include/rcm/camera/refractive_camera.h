@@ -5,9 +5,8 @@
 #ifndef RCM_CAMERA_REFRACTIVE_CAMERA_H_
 #define RCM_CAMERA_REFRACTIVE_CAMERA_H_
 
-#include <optional>
-
 #include <Eigen/Core>
+#include <optional>
 
 #include "rcm/camera/camera.h"
 #include "rcm/util/status.h"

@@ -15,8 +15,8 @@
 //   Unprojection:          bearing in the medium ~ (xb, yb, m(n, rb))
 //   Projection of P = (X, Y, Z) in the medium, R^2 = (X^2 + Y^2) / Z^2:
 //                          rb = n R / sqrt(1 + R^2 - n^2 R^2), so
-//                          (xb, yb) = n (X, Y) / sqrt(Z^2 - (n^2 - 1)(X^2 + Y^2))
-//                          valid for Z > 0 and below the critical angle,
+//                          (xb, yb) = n (X, Y) / sqrt(Z^2 - (n^2 - 1)(X^2 +
+//                          Y^2)) valid for Z > 0 and below the critical angle,
 //                          (n^2 - 1)(X^2 + Y^2) < Z^2 (otherwise no ray in
 //                          air reaches the camera: total internal reflection).
 //   Virtual pinhole (eqs. 9, 10): K_n = diag(n fx, n fy, 1) images the medium
@@ -50,8 +50,7 @@ struct FlatPortRefraction {
   // length: (xb, yb, m(n, rb)). Its direction makes the angle theta_w of
   // eq. 1 with the optical axis. Exists for every point of the image plane.
   template <typename T>
-  static void BearingInWater(const T& n, const T& xb, const T& yb,
-                             T* bearing) {
+  static void BearingInWater(const T& n, const T& xb, const T& yb, T* bearing) {
     bearing[0] = xb;
     bearing[1] = yb;
     bearing[2] = RadialFactor(n, xb * xb + yb * yb);
@@ -68,8 +67,7 @@ struct FlatPortRefraction {
     const T& y = point[1];
     const T& z = point[2];
     if (!(ScalarPart(z) > 0.0)) return false;
-    const T squared_denominator =
-        z * z - (n * n - T(1.0)) * (x * x + y * y);
+    const T squared_denominator = z * z - (n * n - T(1.0)) * (x * x + y * y);
     if (!(ScalarPart(squared_denominator) > 0.0)) return false;
     const T scale = n / sqrt(squared_denominator);
     *xb = scale * x;
@@ -81,8 +79,8 @@ struct FlatPortRefraction {
   // lens-undistorted normalized point: (n xb / m, n yb / m), which is
   // n (X/Z, Y/Z) of the point in the medium.
   template <typename T>
-  static void VirtualFromNormalized(const T& n, const T& xb, const T& yb,
-                                    T* xv, T* yv) {
+  static void VirtualFromNormalized(const T& n, const T& xb, const T& yb, T* xv,
+                                    T* yv) {
     const T scale = n / RadialFactor(n, xb * xb + yb * yb);
     *xv = scale * xb;
     *yv = scale * yb;
@@ -92,8 +90,8 @@ struct FlatPortRefraction {
   // pinhole is the ray (xv, yv, n) in the medium. False past the critical
   // angle (the virtual image extends beyond what the camera can see).
   template <typename T>
-  static bool NormalizedFromVirtual(const T& n, const T& xv, const T& yv,
-                                    T* xb, T* yb) {
+  static bool NormalizedFromVirtual(const T& n, const T& xv, const T& yv, T* xb,
+                                    T* yb) {
     const T ray[3] = {xv, yv, n};
     return NormalizedFromPointInWater(n, ray, xb, yb);
   }

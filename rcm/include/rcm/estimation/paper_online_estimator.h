@@ -31,10 +31,9 @@
 #ifndef RCM_ESTIMATION_PAPER_ONLINE_ESTIMATOR_H_
 #define RCM_ESTIMATION_PAPER_ONLINE_ESTIMATOR_H_
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <optional>
-
-#include <Eigen/Core>
 
 #include "rcm/geometry/stereo_correspondence.h"
 #include "rcm/geometry/stereo_rig.h"

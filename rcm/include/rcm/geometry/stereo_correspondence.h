@@ -3,10 +3,9 @@
 #ifndef RCM_GEOMETRY_STEREO_CORRESPONDENCE_H_
 #define RCM_GEOMETRY_STEREO_CORRESPONDENCE_H_
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <optional>
-
-#include <Eigen/Core>
 
 namespace rcm {
 

@@ -30,7 +30,7 @@ class StereoRig {
   // How far the rig is from the ideal rectified pair (R = I, t = [tx, 0, 0])
   // that the paper's closed form (eq. 14) assumes.
   struct RectificationDeviation {
-    double rotation = 0.0;          // radians, angle of right_from_left
+    double rotation = 0.0;           // radians, angle of right_from_left
     double baseline_off_axis = 0.0;  // radians, angle between t and +-x
   };
   RectificationDeviation DeviationFromRectified() const;

@@ -8,11 +8,11 @@
 #ifndef RCM_UTIL_STATUS_H_
 #define RCM_UTIL_STATUS_H_
 
+#include <glog/logging.h>
+
 #include <string>
 #include <utility>
 #include <variant>
-
-#include <glog/logging.h>
 
 namespace rcm {
 
@@ -84,9 +84,9 @@ class [[nodiscard]] StatusOr {
 }  // namespace rcm
 
 // Returns from the enclosing function when `expr` (a Status) is an error.
-#define RCM_RETURN_IF_ERROR(expr)        \
-  do {                                   \
-    ::rcm::Status rcm_status_ = (expr);  \
+#define RCM_RETURN_IF_ERROR(expr)              \
+  do {                                         \
+    ::rcm::Status rcm_status_ = (expr);        \
     if (!rcm_status_.ok()) return rcm_status_; \
   } while (false)
 

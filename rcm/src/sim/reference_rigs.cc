@@ -1,0 +1,31 @@
+#include "rcm/sim/reference_rigs.h"
+
+namespace rcm {
+
+Camera AlphasenseFrontCam0() {
+  return Camera::Create(LensModelId::kEquidistant, 720, 540,
+                        {346.68681661781403, 346.7780959214622,
+                         360.53325988648163, 271.0179819820658},
+                        {-0.037934508908317364, -0.0009855550912794707,
+                         -0.0009622185860956224, 2.365797666527927e-05})
+      .value();
+}
+
+Camera AlphasenseFrontCam1() {
+  return Camera::Create(LensModelId::kEquidistant, 720, 540,
+                        {344.3933991977547, 344.2292927278568, 358.725925185576,
+                         262.02195974034373},
+                        {-0.03970881800919102, 0.0016107591002609727,
+                         -0.002331667784337188, 0.00035009066006595556})
+      .value();
+}
+
+StereoRig AlphasenseFrontRectifiedRig() {
+  Rigid3d right_from_left;
+  right_from_left.translation = Eigen::Vector3d(-0.11, 0.0, 0.0);
+  return StereoRig::Create(AlphasenseFrontCam0(), AlphasenseFrontCam1(),
+                           right_from_left)
+      .value();
+}
+
+}  // namespace rcm
