@@ -3,99 +3,47 @@
 #include <glog/logging.h>
 #include <yaml-cpp/yaml.h>
 
-#include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <exception>
-#include <optional>
-#include <string_view>
-#include <system_error>
+#include <string>
 #include <utility>
 
 #include "rcm/io/atomic_file.h"
+#include "rcm/io/yaml_fields.h"
+#include "rcm/util/message_text.h"
 
 namespace rcm::calib {
 namespace {
 
-constexpr char kSupportedTypes[] = "supported: checkerboard, aprilgrid";
-constexpr size_t kMaxEchoLength = 40;
+constexpr char kSupportedTypes[] = "(supported: checkerboard, aprilgrid)";
 
-// A YAML scalar as quoted in an error message: on one line, shortened.
-std::string Echo(std::string_view text) {
-  std::string echo;
-  for (const char c : text.substr(0, kMaxEchoLength)) {
-    const auto byte = static_cast<unsigned char>(c);
-    echo.push_back(byte < 0x20 || byte == 0x7f ? '?' : c);
-  }
-  if (text.size() > kMaxEchoLength) echo += "...";
-  return echo;
-}
-
-std::string Location(const std::string& source_name, const YAML::Mark& mark) {
-  if (mark.is_null() || mark.line < 0) return source_name;
-  return source_name + ":" + std::to_string(mark.line + 1);
-}
-
-const char* KindOfNode(const YAML::Node& node) {
-  switch (node.Type()) {
-    case YAML::NodeType::Sequence:
-      return "a list";
-    case YAML::NodeType::Map:
-      return "a map";
-    case YAML::NodeType::Null:
-      return "nothing";
-    default:
-      return "a scalar";
-  }
-}
-
-// A key of the root map with its value.
-struct Entry {
-  YAML::Node key;
-  YAML::Node value;
-};
-
-// The first entry of `map` whose key is the scalar `key`.
-std::optional<Entry> FindEntry(const YAML::Node& map, const char* key) {
-  for (YAML::const_iterator it = map.begin(); it != map.end(); ++it) {
-    if (it->first.IsScalar() && it->first.Scalar() == key) {
-      return Entry{it->first, it->second};
-    }
-  }
-  return std::nullopt;
-}
-
-// Reads the keys of one target type from the root map, with error messages
-// naming the file, line and key.
+// Reads the keys of one target type from the entries of the root map, with
+// error messages naming the file, line and key.
 class TargetKeys {
  public:
   // `required_keys` is the list quoted when a key is missing.
-  TargetKeys(const YAML::Node& root, const std::string& source_name,
+  TargetKeys(const YamlReader& reader, const YamlEntries& entries,
              std::string type_name, std::string required_keys)
-      : root_(root),
-        source_name_(source_name),
+      : reader_(reader),
+        entries_(entries),
         type_name_(std::move(type_name)),
         required_keys_(std::move(required_keys)) {}
 
   // An integer in [min, kMaxTargetCount]; `unit` names what it counts.
   Status Count(const char* key, int min, const char* unit, int* value) const {
-    const StatusOr<Entry> entry = Lookup(key);
+    const StatusOr<const YamlEntry*> entry = Lookup(key);
     if (!entry.ok()) return entry.status();
-    const YAML::Node& node = entry->key;
-    const std::string& text = entry->value.Scalar();
+    const std::string& text = (*entry)->value.Scalar();
     int64_t parsed = 0;
-    const auto [end, error] =
-        std::from_chars(text.data(), text.data() + text.size(), parsed);
-    if (error != std::errc() || end != text.data() + text.size() ||
-        text.empty()) {
-      return ErrorAt(
-          node, std::string(key) + ": '" + Echo(text) + "' is not an integer");
+    if (ParseYamlInteger(text, &parsed) != NumberSyntax::kOk) {
+      return reader_.Error((*entry)->key, key,
+                           QuoteForMessage(text) + " is not an integer");
     }
     if (parsed < min || parsed > kMaxTargetCount) {
-      return ErrorAt(node, std::string(key) + ": must be between " +
-                               std::to_string(min) + " and " +
+      return reader_.Error((*entry)->key, key,
+                           "must be between " + std::to_string(min) + " and " +
                                std::to_string(kMaxTargetCount) + " " + unit +
-                               ", got " + Echo(text));
+                               ", got " + EscapeForMessage(text));
     }
     *value = static_cast<int>(parsed);
     return Status::Ok();
@@ -103,58 +51,52 @@ class TargetKeys {
 
   // A finite number > 0.
   Status PositiveLength(const char* key, double* value) const {
-    const StatusOr<Entry> entry = Lookup(key);
+    const StatusOr<const YamlEntry*> entry = Lookup(key);
     if (!entry.ok()) return entry.status();
-    const YAML::Node& node = entry->key;
-    const std::string& text = entry->value.Scalar();
+    const std::string& text = (*entry)->value.Scalar();
     double parsed = 0.0;
-    const auto [end, error] =
-        std::from_chars(text.data(), text.data() + text.size(), parsed);
-    if ((error != std::errc() && error != std::errc::result_out_of_range) ||
-        end != text.data() + text.size() || text.empty()) {
-      return ErrorAt(
-          node, std::string(key) + ": '" + Echo(text) + "' is not a number");
+    const NumberSyntax syntax = ParseYamlDouble(text, &parsed);
+    if (syntax == NumberSyntax::kMalformed) {
+      return reader_.Error((*entry)->key, key,
+                           QuoteForMessage(text) + " is not a number");
     }
-    if (error != std::errc() || !std::isfinite(parsed) || !(parsed > 0.0)) {
-      return ErrorAt(node, std::string(key) +
-                               ": must be positive and finite, got " +
-                               Echo(text));
+    if (syntax != NumberSyntax::kOk || !(parsed > 0.0)) {
+      return reader_.Error(
+          (*entry)->key, key,
+          "must be positive and finite, got " + EscapeForMessage(text));
     }
     *value = parsed;
     return Status::Ok();
   }
 
  private:
-  // The value of `key`, which must be a scalar. Errors point at the key's
-  // line: yaml-cpp marks a missing value at the next token.
-  StatusOr<Entry> Lookup(const char* key) const {
-    const std::optional<Entry> entry = FindEntry(root_, key);
-    if (!entry.has_value()) {
-      return Status::Error(source_name_ + ": missing key '" + key + "' (" +
-                           type_name_ + " needs " + required_keys_ + ")");
+  // The entry of `key`, whose value must be a scalar. Errors point at the
+  // key's line: yaml-cpp marks a missing value at the next token.
+  StatusOr<const YamlEntry*> Lookup(const char* key) const {
+    const YamlEntry* entry = FindYamlEntry(entries_, key);
+    if (entry == nullptr) {
+      return reader_.Error("", "missing key " + QuoteForMessage(key) + " (" +
+                                   type_name_ + " needs " + required_keys_ +
+                                   ")");
     }
     if (!entry->value.IsScalar()) {
-      return ErrorAt(entry->key, std::string(key) +
-                                     ": expected a number, got " +
-                                     KindOfNode(entry->value));
+      return reader_.Error(
+          entry->key, key,
+          "expected a number, got " + DescribeYamlNode(entry->value));
     }
-    return *entry;
+    return entry;
   }
 
-  Status ErrorAt(const YAML::Node& node, const std::string& what) const {
-    return Status::Error(Location(source_name_, node.Mark()) + ": " + what);
-  }
-
-  const YAML::Node& root_;
-  const std::string& source_name_;
+  const YamlReader& reader_;
+  const YamlEntries& entries_;
   std::string type_name_;
   std::string required_keys_;
 };
 
-StatusOr<CalibrationTarget> ParseCheckerboard(const YAML::Node& root,
-                                              const std::string& source_name) {
+StatusOr<CalibrationTarget> ParseCheckerboard(const YamlReader& reader,
+                                              const YamlEntries& entries) {
   const TargetKeys keys(
-      root, source_name, "a checkerboard",
+      reader, entries, "a checkerboard",
       "targetCols, targetRows, rowSpacingMeters, colSpacingMeters");
   CalibrationTarget target;
   target.type = TargetType::kCheckerboard;
@@ -169,9 +111,9 @@ StatusOr<CalibrationTarget> ParseCheckerboard(const YAML::Node& root,
   return target;
 }
 
-StatusOr<CalibrationTarget> ParseAprilGrid(const YAML::Node& root,
-                                           const std::string& source_name) {
-  const TargetKeys keys(root, source_name, "an aprilgrid",
+StatusOr<CalibrationTarget> ParseAprilGrid(const YamlReader& reader,
+                                           const YamlEntries& entries) {
+  const TargetKeys keys(reader, entries, "an aprilgrid",
                         "tagCols, tagRows, tagSize, tagSpacing");
   CalibrationTarget target;
   target.type = TargetType::kAprilGrid;
@@ -182,33 +124,35 @@ StatusOr<CalibrationTarget> ParseAprilGrid(const YAML::Node& root,
   return target;
 }
 
-StatusOr<CalibrationTarget> ParseRoot(const YAML::Node& root,
-                                      const std::string& source_name) {
+StatusOr<CalibrationTarget> ParseRoot(const YamlReader& reader,
+                                      const YAML::Node& root) {
   if (root.IsNull()) {
-    return Status::Error(source_name +
-                         ": empty file (expected a Kalibr target YAML map)");
+    return reader.Error("", "empty file (expected a Kalibr target YAML map)");
   }
   if (!root.IsMap()) {
-    return Status::Error(Location(source_name, root.Mark()) +
-                         ": expected a map of target settings, got " +
-                         KindOfNode(root));
+    return reader.Error(
+        root, "",
+        "expected a map of target settings, got " + DescribeYamlNode(root));
   }
-  const std::optional<Entry> type = FindEntry(root, "target_type");
-  if (!type.has_value()) {
-    return Status::Error(source_name + ": missing key 'target_type' (" +
-                         kSupportedTypes + ")");
+  const StatusOr<YamlEntries> entries = reader.Entries(root, "");
+  if (!entries.ok()) return entries.status();
+  const YamlEntry* type = FindYamlEntry(*entries, "target_type");
+  if (type == nullptr) {
+    return reader.Error(
+        "", std::string("missing key 'target_type' ") + kSupportedTypes);
   }
-  const std::string where = Location(source_name, type->key.Mark());
   if (!type->value.IsScalar()) {
-    return Status::Error(where + ": target_type: expected a name, got " +
-                         KindOfNode(type->value) + " (" + kSupportedTypes +
-                         ")");
+    return reader.Error(type->key, "target_type",
+                        "expected a name, got " +
+                            DescribeYamlNode(type->value) + " " +
+                            kSupportedTypes);
   }
   const std::string& name = type->value.Scalar();
-  if (name == "checkerboard") return ParseCheckerboard(root, source_name);
-  if (name == "aprilgrid") return ParseAprilGrid(root, source_name);
-  return Status::Error(where + ": unknown target_type '" + Echo(name) + "' (" +
-                       kSupportedTypes + ")");
+  if (name == "checkerboard") return ParseCheckerboard(reader, *entries);
+  if (name == "aprilgrid") return ParseAprilGrid(reader, *entries);
+  return reader.Error(
+      type->key, "",
+      "unknown target_type " + QuoteForMessage(name) + " " + kSupportedTypes);
 }
 
 void CheckValid(const CalibrationTarget& target) {
@@ -234,19 +178,10 @@ void CheckValid(const CalibrationTarget& target) {
 
 StatusOr<CalibrationTarget> ParseCalibrationTarget(
     const std::string& yaml_text, const std::string& source_name) {
-  try {
-    const YAML::Node root = YAML::Load(yaml_text);
-    return ParseRoot(root, source_name);
-  } catch (const YAML::ParserException& error) {
-    return Status::Error(Location(source_name, error.mark) +
-                         ": invalid YAML: " + Echo(error.msg));
-  } catch (const YAML::Exception& error) {
-    return Status::Error(Location(source_name, error.mark) +
-                         ": cannot read YAML: " + Echo(error.msg));
-  } catch (const std::exception& error) {
-    return Status::Error(source_name +
-                         ": cannot read YAML: " + Echo(error.what()));
-  }
+  const YamlReader reader(source_name, /*syntax_error=*/"invalid YAML");
+  return reader.ReadDocument(yaml_text, "YAML", [&](const YAML::Node& root) {
+    return ParseRoot(reader, root);
+  });
 }
 
 StatusOr<CalibrationTarget> ReadCalibrationTarget(const std::string& path) {

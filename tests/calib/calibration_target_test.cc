@@ -1,13 +1,12 @@
 #include "rcm/calib/calibration_target.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cstdio>
 #include <string>
 #include <vector>
 
-#include "rcm/io/atomic_file.h"
+#include "support/temp_file.h"
 
 namespace rcm::calib {
 namespace {
@@ -89,8 +88,7 @@ TEST(CalibrationTarget, ParsesUnquotedTypeAndIgnoresUnknownKeys) {
 
 TEST(CalibrationTarget, ReadsFile) {
   const std::string path =
-      ::testing::TempDir() + "/calibration_target_test_aprilgrid.yaml";
-  ASSERT_TRUE(WriteFileAtomically(path, kKalibrAprilGrid).ok());
+      test::WriteTempFile("aprilgrid.yaml", kKalibrAprilGrid);
   const StatusOr<CalibrationTarget> target = ReadCalibrationTarget(path);
   std::remove(path.c_str());
   ASSERT_TRUE(target.ok()) << target.status().message();
@@ -99,8 +97,7 @@ TEST(CalibrationTarget, ReadsFile) {
 }
 
 TEST(CalibrationTarget, ReadMissingFileReportsPath) {
-  const std::string path =
-      ::testing::TempDir() + "/calibration_target_test_missing.yaml";
+  const std::string path = test::TempFilePath("missing.yaml");
   const StatusOr<CalibrationTarget> target = ReadCalibrationTarget(path);
   ASSERT_FALSE(target.ok());
   EXPECT_EQ(target.status().message().rfind(path + ": cannot open: ", 0), 0u)
@@ -323,6 +320,20 @@ TEST(CalibrationTarget, ErrorEmptyFile) {
 TEST(CalibrationTarget, ErrorTargetTypeWithoutValue) {
   EXPECT_EQ(ErrorOf("target_type:\ntagCols: 6\n"),
             "t.yaml:1: target_type: expected a name, got nothing (supported: "
+            "checkerboard, aprilgrid)");
+}
+
+TEST(CalibrationTarget, ErrorDuplicateKey) {
+  // PyYAML (Kalibr) would silently take the last value; rcm refuses to
+  // guess.
+  EXPECT_EQ(ErrorOf("target_type: 'aprilgrid'\ntagCols: 6\ntagRows: 6\n"
+                    "tagSize: 0.088\ntagSpacing: 0.3\ntagCols: 7\n"),
+            "t.yaml:6: duplicate key 'tagCols'");
+}
+
+TEST(CalibrationTarget, ErrorStaysOnOneLine) {
+  EXPECT_EQ(ErrorOf("target_type: \"april\\ngrid\"\n"),
+            "t.yaml:1: unknown target_type 'april\\x0agrid' (supported: "
             "checkerboard, aprilgrid)");
 }
 

@@ -10,6 +10,8 @@
 #include <vector>
 
 #include "rcm/io/atomic_file.h"
+#include "support/reader_inputs.h"
+#include "support/temp_file.h"
 
 namespace rcm {
 namespace {
@@ -91,25 +93,11 @@ cam1:
 //  8 cam1:                     19   resolution (cam1)
 //  9   T_cn_cnm1:
 
-// `text` with its only occurrence of `from` replaced by `to`.
-std::string ReplaceOnce(const std::string& text, const std::string& from,
-                        const std::string& to) {
-  const size_t position = text.find(from);
-  if (position == std::string::npos ||
-      text.find(from, position + 1) != std::string::npos) {
-    ADD_FAILURE() << "'" << from << "' does not occur exactly once";
-    return text;
-  }
-  std::string result = text;
-  result.replace(position, from.size(), to);
-  return result;
-}
+using test::ReplaceOnce;
 
 // The error message of parsing `text` as "rig.yaml" (empty if it parsed).
 std::string ParseError(const std::string& text) {
-  const StatusOr<Camchain> camchain = ParseCamchain(text, "rig.yaml");
-  if (camchain.ok()) return "";
-  return camchain.status().message();
+  return test::ErrorMessage(ParseCamchain(text, "rig.yaml"));
 }
 
 bool BitwiseEqual(double a, double b) {
@@ -196,10 +184,6 @@ CamchainCamera MakeEntry(const Camera& camera,
                          std::optional<Rigid3d> cam_from_previous) {
   return CamchainCamera{
       camera, cam_from_previous, std::nullopt, std::nullopt, {}, ""};
-}
-
-std::string TempPath(const std::string& name) {
-  return ::testing::TempDir() + "/camchain_test_" + name;
 }
 
 // --- Reading a Kalibr file --------------------------------------------------
@@ -397,7 +381,7 @@ TEST(Camchain, NoneModelMayOmitCoefficients) {
 TEST(Camchain, WriteAndReadRoundTripThroughFile) {
   const StatusOr<Camchain> camchain = ParseCamchain(kAlphasense, "rig.yaml");
   ASSERT_TRUE(camchain.ok()) << camchain.status().message();
-  const std::string path = TempPath("write_read.yaml");
+  const std::string path = test::TempFilePath("write_read.yaml");
   ASSERT_TRUE(WriteCamchain(path, *camchain).ok());
   const StatusOr<std::string> bytes = ReadFileToString(path);
   ASSERT_TRUE(bytes.ok()) << bytes.status().message();
@@ -413,7 +397,7 @@ TEST(Camchain, WriteRejectsMissingTcnCnm1) {
       MakeEntry(MakeCamera(LensModelId::kPinhole, 400.0, {}), std::nullopt));
   camchain.cameras.push_back(
       MakeEntry(MakeCamera(LensModelId::kPinhole, 400.0, {}), std::nullopt));
-  const std::string path = TempPath("missing_t.yaml");
+  const std::string path = test::TempFilePath("missing_t.yaml");
   const Status status = WriteCamchain(path, camchain);
   ASSERT_FALSE(status.ok());
   EXPECT_EQ(status.message(), path + ": cannot write: cam1 has no T_cn_cnm1");
@@ -750,7 +734,7 @@ TEST(Camchain, ErrorStaysOnOneLine) {
 }
 
 TEST(Camchain, ReadRejectsMissingFile) {
-  const std::string path = TempPath("does_not_exist.yaml");
+  const std::string path = test::TempFilePath("does_not_exist.yaml");
   const StatusOr<Camchain> camchain = ReadCamchain(path);
   ASSERT_FALSE(camchain.ok());
   EXPECT_EQ(camchain.status().message(),
@@ -765,14 +749,12 @@ TEST(Camchain, ReadRejectsDirectory) {
 }
 
 TEST(Camchain, ReadPrefixesErrorsWithThePath) {
-  const std::string path = TempPath("bad_model.yaml");
-  ASSERT_TRUE(
-      WriteFileAtomically(path, ReplaceOnce(kMinimal,
-                                            "  distortion_model: equidistant\n"
-                                            "  intrinsics: [346.7",
-                                            "  distortion_model: fov\n"
-                                            "  intrinsics: [346.7"))
-          .ok());
+  const std::string path = test::WriteTempFile(
+      "bad_model.yaml", ReplaceOnce(kMinimal,
+                                    "  distortion_model: equidistant\n"
+                                    "  intrinsics: [346.7",
+                                    "  distortion_model: fov\n"
+                                    "  intrinsics: [346.7"));
   const StatusOr<Camchain> camchain = ReadCamchain(path);
   ASSERT_FALSE(camchain.ok());
   EXPECT_THAT(camchain.status().message(),

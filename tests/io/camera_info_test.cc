@@ -7,7 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "rcm/io/number_format.h"
+#include "support/camera_info_text.h"
+#include "support/reader_inputs.h"
+#include "support/temp_file.h"
 
 namespace rcm {
 namespace {
@@ -41,71 +43,10 @@ projection_matrix:
   data: [350.0, 0, 362.0, 0, 0, 350.0, 270.0, 0, 0, 0, 1, 0]
 )";
 
-std::string ReplaceOnce(const std::string& text, const std::string& from,
-                        const std::string& to) {
-  const size_t position = text.find(from);
-  if (position == std::string::npos ||
-      text.find(from, position + 1) != std::string::npos) {
-    ADD_FAILURE() << "'" << from << "' does not occur exactly once";
-    return text;
-  }
-  std::string result = text;
-  result.replace(position, from.size(), to);
-  return result;
-}
+using test::ReplaceOnce;
 
 std::string ParseError(const std::string& text) {
-  const StatusOr<CameraInfo> info = ParseCameraInfo(text, "left.yaml");
-  if (info.ok()) return "";
-  return info.status().message();
-}
-
-std::string FlowList(const double* values, int size) {
-  std::string text = "[";
-  for (int i = 0; i < size; ++i) {
-    text += (i == 0 ? "" : ", ") + FormatDouble(values[i]);
-  }
-  return text + "]";
-}
-
-// The camera_info text of one camera of a ROS-rectified pair.
-std::string FormatCameraInfo(const std::string& name,
-                             const Eigen::Matrix3d& camera_matrix,
-                             const std::vector<double>& distortion,
-                             const Eigen::Matrix3d& rectification,
-                             const Eigen::Matrix<double, 3, 4>& projection) {
-  const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> k = camera_matrix;
-  const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> r = rectification;
-  const Eigen::Matrix<double, 3, 4, Eigen::RowMajor> p = projection;
-  return "image_width: 720\n"
-         "image_height: 540\n"
-         "camera_name: " +
-         name +
-         "\n"
-         "camera_matrix:\n"
-         "  rows: 3\n"
-         "  cols: 3\n"
-         "  data: " +
-         FlowList(k.data(), 9) +
-         "\n"
-         "distortion_model: plumb_bob\n"
-         "distortion_coefficients:\n"
-         "  rows: 1\n"
-         "  cols: 5\n"
-         "  data: " +
-         FlowList(distortion.data(), static_cast<int>(distortion.size())) +
-         "\n"
-         "rectification_matrix:\n"
-         "  rows: 3\n"
-         "  cols: 3\n"
-         "  data: " +
-         FlowList(r.data(), 9) +
-         "\n"
-         "projection_matrix:\n"
-         "  rows: 3\n"
-         "  cols: 4\n"
-         "  data: " +
-         FlowList(p.data(), 12) + "\n";
+  return test::ErrorMessage(ParseCameraInfo(text, "left.yaml"));
 }
 
 // A stereo pair rectified the way OpenCV's stereoRectify / ROS do it, from
@@ -143,12 +84,12 @@ class CameraInfoStereo : public ::testing::Test {
     Eigen::Matrix<double, 3, 4> p_right = p_left;
     p_right(0, 3) = -fx_rect * baseline;
 
-    left_text_ = FormatCameraInfo("alphasense/left", k_left,
-                                  {-0.28, 0.07, 0.0002, -0.00003, 0.0},
-                                  rect_left, p_left);
-    right_text_ = FormatCameraInfo("alphasense/right", k_right,
-                                   {-0.27, 0.068, -0.0001, 0.00005, 0.0},
-                                   rect_right, p_right);
+    left_text_ = test::CameraInfoText("alphasense/left", k_left,
+                                      {-0.28, 0.07, 0.0002, -0.00003, 0.0},
+                                      rect_left, p_left);
+    right_text_ = test::CameraInfoText("alphasense/right", k_right,
+                                       {-0.27, 0.068, -0.0001, 0.00005, 0.0},
+                                       rect_right, p_right);
   }
 
   Rigid3d right_from_left_;
@@ -463,7 +404,7 @@ TEST(CameraInfo, RejectsTopLevelScalar) {
 }
 
 TEST(CameraInfo, ReadRejectsMissingFile) {
-  const std::string path = ::testing::TempDir() + "/camera_info_missing.yaml";
+  const std::string path = test::TempFilePath("missing.yaml");
   const StatusOr<CameraInfo> info = ReadCameraInfo(path);
   ASSERT_FALSE(info.ok());
   EXPECT_EQ(info.status().message(),

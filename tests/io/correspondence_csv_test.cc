@@ -400,7 +400,7 @@ TEST(CorrespondenceCsv, ErrorNoCorrespondencesAfterHeader) {
 
 TEST(CorrespondenceCsv, ErrorMessageHasNoControlCharacters) {
   EXPECT_EQ(ErrorOf("xl,yl,xr,yr\n1\r2,2,3,4\n"),
-            "m.csv:2: xl: '1?2' is not a number");
+            "m.csv:2: xl: '1\\x0d2' is not a number");
 }
 
 }  // namespace

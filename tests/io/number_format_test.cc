@@ -10,6 +10,8 @@
 #include <random>
 #include <string>
 
+#include "rcm/util/message_text.h"
+
 namespace rcm {
 namespace {
 
@@ -76,6 +78,31 @@ TEST(FormatDouble, RandomBitPatternsRoundTripExactly) {
     ASSERT_EQ(parsed_bits, bits) << text;
     ++checked;
   }
+}
+
+// QuoteForMessage (rcm/util/message_text.h) quotes the values that every
+// reader's error messages show; the readers' tests check it in context.
+
+TEST(QuoteForMessage, QuotesTextAsItIs) {
+  EXPECT_EQ(QuoteForMessage("6cm"), "'6cm'");
+  EXPECT_EQ(QuoteForMessage(""), "''");
+  EXPECT_EQ(QuoteForMessage("it's 3.5 \xC2\xB5m"), "'it's 3.5 \xC2\xB5m'");
+}
+
+TEST(QuoteForMessage, ShowsControlCharactersAsHexEscapes) {
+  EXPECT_EQ(QuoteForMessage("pin\nhole"), "'pin\\x0ahole'");
+  EXPECT_EQ(QuoteForMessage(std::string("a\tb\r\0c\x7f", 7)),
+            "'a\\x09b\\x0d\\x00c\\x7f'");
+  EXPECT_EQ(EscapeForMessage("1\x1f"), "1\\x1f");
+}
+
+TEST(QuoteForMessage, ShortensTextPast40Bytes) {
+  const std::string forty(40, 'x');
+  EXPECT_EQ(QuoteForMessage(forty), "'" + forty + "'");
+  EXPECT_EQ(QuoteForMessage(forty + "yz"), "'" + forty + "...'");
+  // The limit counts the bytes of the text, not of its escapes.
+  EXPECT_EQ(QuoteForMessage(std::string(39, 'x') + "\n\n"),
+            "'" + std::string(39, 'x') + "\\x0a...'");
 }
 
 }  // namespace

@@ -3,9 +3,13 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <optional>
 #include <string>
 
-#include "rcm/io/atomic_file.h"
+#include "rcm/io/camchain.h"
+#include "support/camera_info_text.h"
+#include "support/reader_inputs.h"
+#include "support/temp_file.h"
 
 namespace rcm {
 namespace {
@@ -13,84 +17,66 @@ namespace {
 using ::testing::HasSubstr;
 using ::testing::StartsWith;
 
-// Three cameras: cam1 is 0.11 m right of cam0, cam2 0.09 m right of cam1.
-constexpr char kCamchain[] = R"(cam0:
-  cam_overlaps: [1, 2]
-  camera_model: pinhole
-  distortion_coeffs: [-0.0379, -0.00098, -0.00096, 2.36e-05]
-  distortion_model: equidistant
-  intrinsics: [346.7, 346.8, 360.5, 271.0]
-  resolution: [720, 540]
-cam1:
-  T_cn_cnm1:
-  - [1.0, 0.0, 0.0, -0.11]
-  - [0.0, 1.0, 0.0, 0.0]
-  - [0.0, 0.0, 1.0, 0.0]
-  - [0.0, 0.0, 0.0, 1.0]
-  cam_overlaps: [0, 2]
-  camera_model: pinhole
-  distortion_coeffs: [-0.0397, 0.00161, -0.00233, 0.00035]
-  distortion_model: equidistant
-  intrinsics: [344.4, 344.2, 358.7, 262.0]
-  resolution: [720, 540]
-cam2:
-  T_cn_cnm1:
-  - [0.0, -1.0, 0.0, -0.09]
-  - [1.0, 0.0, 0.0, 0.0]
-  - [0.0, 0.0, 1.0, 0.0]
-  - [0.0, 0.0, 0.0, 1.0]
-  cam_overlaps: [0, 1]
-  camera_model: pinhole
-  distortion_coeffs: []
-  distortion_model: none
-  intrinsics: [500.0, 500.0, 320.0, 240.0]
-  resolution: [640, 480]
-)";
+using test::ErrorMessage;
+using test::WriteTempFile;
 
-// A ROS-rectified pair with identity rectification and a 0.12 m baseline:
-// Tx = -fx' * B = -350 * 0.12.
-std::string CameraInfoText(const std::string& name, double fx, double tx) {
-  return "image_width: 720\n"
-         "image_height: 540\n"
-         "camera_name: " +
-         name +
-         "\n"
-         "camera_matrix:\n"
-         "  rows: 3\n"
-         "  cols: 3\n"
-         "  data: [" +
-         std::to_string(fx) +
-         ", 0, 360, 0, 346, 270, 0, 0, 1]\n"
-         "distortion_model: plumb_bob\n"
-         "distortion_coefficients:\n"
-         "  rows: 1\n"
-         "  cols: 5\n"
-         "  data: [-0.28, 0.07, 0.0002, -0.00003, 0]\n"
-         "rectification_matrix:\n"
-         "  rows: 3\n"
-         "  cols: 3\n"
-         "  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n"
-         "projection_matrix:\n"
-         "  rows: 3\n"
-         "  cols: 4\n"
-         "  data: [350, 0, 362, " +
-         std::to_string(tx) + ", 0, 350, 270, 0, 0, 0, 1, 0]\n";
+// A Kalibr camchain of three cameras: cam1 is 0.11 m right of cam0, cam2
+// 0.09 m right of cam1 and turned by 90 degrees about the optical axis.
+std::string ThreeCameraCamchain() {
+  Rigid3d cam1_from_cam0;
+  cam1_from_cam0.translation = Eigen::Vector3d(-0.11, 0.0, 0.0);
+  Rigid3d cam2_from_cam1;
+  cam2_from_cam1.rotation << 0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0;
+  cam2_from_cam1.translation = Eigen::Vector3d(-0.09, 0.0, 0.0);
+  Camchain camchain;
+  camchain.cameras = {
+      {Camera::Create(LensModelId::kEquidistant, 720, 540,
+                      {346.7, 346.8, 360.5, 271.0},
+                      {-0.0379, -0.00098, -0.00096, 2.36e-05})
+           .value(),
+       std::nullopt,
+       std::nullopt,
+       std::nullopt,
+       {1, 2},
+       ""},
+      {Camera::Create(LensModelId::kEquidistant, 720, 540,
+                      {344.4, 344.2, 358.7, 262.0},
+                      {-0.0397, 0.00161, -0.00233, 0.00035})
+           .value(),
+       cam1_from_cam0,
+       std::nullopt,
+       std::nullopt,
+       {0, 2},
+       ""},
+      {Camera::Create(LensModelId::kPinhole, 640, 480,
+                      {500.0, 500.0, 320.0, 240.0}, {})
+           .value(),
+       cam2_from_cam1,
+       std::nullopt,
+       std::nullopt,
+       {0, 1},
+       ""},
+  };
+  return FormatCamchain(camchain);
 }
 
-// Writes `contents` to a file in the test temp directory; returns its path.
-std::string WriteTemp(const std::string& name, const std::string& contents) {
-  const std::string path = ::testing::TempDir() + "/stereo_rig_file_" + name;
-  const Status status = WriteFileAtomically(path, contents);
-  EXPECT_TRUE(status.ok()) << status.message();
-  return path;
-}
-
-std::string ErrorOf(const StatusOr<StereoRig>& rig) {
-  return rig.ok() ? "" : rig.status().message();
+// One camera of a ROS-rectified pair with identity rectification; the
+// pair has a 0.12 m baseline when the right one has
+// tx = -fx' * B = -350 * 0.12.
+std::string RectifiedCameraInfoText(const std::string& name, double fx,
+                                    double tx) {
+  Eigen::Matrix3d camera_matrix;
+  camera_matrix << fx, 0.0, 360.0, 0.0, 346.0, 270.0, 0.0, 0.0, 1.0;
+  Eigen::Matrix<double, 3, 4> projection;
+  projection << 350.0, 0.0, 362.0, tx, 0.0, 350.0, 270.0, 0.0, 0.0, 0.0, 1.0,
+      0.0;
+  return test::CameraInfoText(name, camera_matrix,
+                              {-0.28, 0.07, 0.0002, -0.00003, 0.0},
+                              Eigen::Matrix3d::Identity(), projection);
 }
 
 TEST(StereoRigFile, ReadsCamchainDefaultPair) {
-  const std::string path = WriteTemp("default.yaml", kCamchain);
+  const std::string path = WriteTempFile("default.yaml", ThreeCameraCamchain());
   const StatusOr<StereoRig> rig = ReadStereoRig(path);
   ASSERT_TRUE(rig.ok()) << rig.status().message();
   EXPECT_EQ(rig->left().fx(), 346.7);
@@ -101,7 +87,7 @@ TEST(StereoRigFile, ReadsCamchainDefaultPair) {
 }
 
 TEST(StereoRigFile, SelectsNamedCameras) {
-  const std::string path = WriteTemp("named.yaml", kCamchain);
+  const std::string path = WriteTempFile("named.yaml", ThreeCameraCamchain());
   const StatusOr<StereoRig> rig = ReadStereoRig(path, "cam0", "cam2");
   ASSERT_TRUE(rig.ok()) << rig.status().message();
   EXPECT_EQ(rig->right().fx(), 500.0);
@@ -112,7 +98,8 @@ TEST(StereoRigFile, SelectsNamedCameras) {
 }
 
 TEST(StereoRigFile, ReversedNamesInvertTheTransform) {
-  const std::string path = WriteTemp("reversed.yaml", kCamchain);
+  const std::string path =
+      WriteTempFile("reversed.yaml", ThreeCameraCamchain());
   const StatusOr<StereoRig> rig = ReadStereoRig(path, "cam1", "cam0");
   ASSERT_TRUE(rig.ok()) << rig.status().message();
   EXPECT_EQ(rig->left().fx(), 344.4);
@@ -121,76 +108,76 @@ TEST(StereoRigFile, ReversedNamesInvertTheTransform) {
 }
 
 TEST(StereoRigFile, RejectsUnknownCamera) {
-  const std::string path = WriteTemp("unknown.yaml", kCamchain);
-  EXPECT_EQ(ErrorOf(ReadStereoRig(path, "cam0", "cam7")),
+  const std::string path = WriteTempFile("unknown.yaml", ThreeCameraCamchain());
+  EXPECT_EQ(ErrorMessage(ReadStereoRig(path, "cam0", "cam7")),
             path +
                 ": unknown camera 'cam7' (the camchain has cam0, cam1, "
                 "cam2)");
 }
 
 TEST(StereoRigFile, RejectsCameraNameThatIsNotCamN) {
-  const std::string path = WriteTemp("bad_name.yaml", kCamchain);
-  EXPECT_EQ(ErrorOf(ReadStereoRig(path, "left", "cam1")),
+  const std::string path =
+      WriteTempFile("bad_name.yaml", ThreeCameraCamchain());
+  EXPECT_EQ(ErrorMessage(ReadStereoRig(path, "left", "cam1")),
             path +
                 ": unknown camera 'left' (the camchain has cam0, cam1, "
                 "cam2)");
 }
 
 TEST(StereoRigFile, RejectsSameCameraTwice) {
-  const std::string path = WriteTemp("same.yaml", kCamchain);
-  EXPECT_EQ(ErrorOf(ReadStereoRig(path, "cam1", "cam1")),
+  const std::string path = WriteTempFile("same.yaml", ThreeCameraCamchain());
+  EXPECT_EQ(ErrorMessage(ReadStereoRig(path, "cam1", "cam1")),
             path + ": left and right are the same camera (cam1)");
 }
 
 TEST(StereoRigFile, ReportsCamchainErrorsWithPath) {
-  const std::string path =
-      WriteTemp("bad_camchain.yaml",
-                std::string(kCamchain).replace(
-                    std::string(kCamchain).find("pinhole"), 7, "omni"));
-  EXPECT_EQ(ErrorOf(ReadStereoRig(path)),
+  std::string camchain = ThreeCameraCamchain();
+  camchain.replace(camchain.find("pinhole"), 7, "omni");
+  const std::string path = WriteTempFile("bad_camchain.yaml", camchain);
+  EXPECT_EQ(ErrorMessage(ReadStereoRig(path)),
             path +
                 ":3: cam0.camera_model: unknown model 'omni' (supported: "
                 "pinhole)");
 }
 
 TEST(StereoRigFile, ReportsYamlSyntaxError) {
-  const std::string path = WriteTemp("syntax.yaml", "cam0: [1, 2\n");
-  EXPECT_THAT(ErrorOf(ReadStereoRig(path)),
+  const std::string path = WriteTempFile("syntax.yaml", "cam0: [1, 2\n");
+  EXPECT_THAT(ErrorMessage(ReadStereoRig(path)),
               StartsWith(path + ":2: YAML syntax error: "));
 }
 
 TEST(StereoRigFile, ReportsEmptyFile) {
-  const std::string path = WriteTemp("empty.yaml", "");
-  EXPECT_EQ(ErrorOf(ReadStereoRig(path)), path + ": empty file");
+  const std::string path = WriteTempFile("empty.yaml", "");
+  EXPECT_EQ(ErrorMessage(ReadStereoRig(path)), path + ": empty file");
 }
 
 TEST(StereoRigFile, RejectsUnrecognisedFile) {
-  const std::string path = WriteTemp("other.yaml", "image_width: 720\n");
-  EXPECT_EQ(ErrorOf(ReadStereoRig(path)),
+  const std::string path = WriteTempFile("other.yaml", "image_width: 720\n");
+  EXPECT_EQ(ErrorMessage(ReadStereoRig(path)),
             path +
                 ": neither a Kalibr camchain (no 'cam0') nor a ROS "
                 "camera_info (no 'camera_matrix')");
 }
 
 TEST(StereoRigFile, RejectsTopLevelList) {
-  const std::string path = WriteTemp("list.yaml", "- cam0\n- cam1\n");
-  EXPECT_EQ(ErrorOf(ReadStereoRig(path)),
+  const std::string path = WriteTempFile("list.yaml", "- cam0\n- cam1\n");
+  EXPECT_EQ(ErrorMessage(ReadStereoRig(path)),
             path +
                 ": neither a Kalibr camchain (no 'cam0') nor a ROS "
                 "camera_info (no 'camera_matrix')");
 }
 
 TEST(StereoRigFile, RejectsMissingFile) {
-  const std::string path = ::testing::TempDir() + "/stereo_rig_file_none.yaml";
-  EXPECT_EQ(ErrorOf(ReadStereoRig(path)),
+  const std::string path = test::TempFilePath("none.yaml");
+  EXPECT_EQ(ErrorMessage(ReadStereoRig(path)),
             path + ": cannot open: No such file or directory");
 }
 
 TEST(StereoRigFile, ReadsCameraInfoPair) {
   const std::string left =
-      WriteTemp("left.yaml", CameraInfoText("left", 346.5, 0.0));
-  const std::string right =
-      WriteTemp("right.yaml", CameraInfoText("right", 344.5, -42.0));
+      WriteTempFile("left.yaml", RectifiedCameraInfoText("left", 346.5, 0.0));
+  const std::string right = WriteTempFile(
+      "right.yaml", RectifiedCameraInfoText("right", 344.5, -42.0));
   const StatusOr<StereoRig> rig = ReadStereoRig(left + "," + right);
   ASSERT_TRUE(rig.ok()) << rig.status().message();
   EXPECT_EQ(rig->left().fx(), 346.5);
@@ -203,64 +190,65 @@ TEST(StereoRigFile, ReadsCameraInfoPair) {
 }
 
 TEST(StereoRigFile, RejectsSwappedCameraInfoPair) {
-  const std::string left =
-      WriteTemp("swap_left.yaml", CameraInfoText("left", 346.5, 0.0));
-  const std::string right =
-      WriteTemp("swap_right.yaml", CameraInfoText("right", 344.5, -42.0));
-  EXPECT_THAT(ErrorOf(ReadStereoRig(right + "," + left)),
+  const std::string left = WriteTempFile(
+      "swap_left.yaml", RectifiedCameraInfoText("left", 346.5, 0.0));
+  const std::string right = WriteTempFile(
+      "swap_right.yaml", RectifiedCameraInfoText("right", 344.5, -42.0));
+  EXPECT_THAT(ErrorMessage(ReadStereoRig(right + "," + left)),
               StartsWith(right + "," + left +
                          ": left projection_matrix has a nonzero 4th column"));
 }
 
 TEST(StereoRigFile, RejectsCameraNamesWithCameraInfoPair) {
-  const std::string left =
-      WriteTemp("names_left.yaml", CameraInfoText("left", 346.5, 0.0));
-  const std::string right =
-      WriteTemp("names_right.yaml", CameraInfoText("right", 344.5, -42.0));
-  EXPECT_THAT(ErrorOf(ReadStereoRig(left + "," + right, "cam1", "cam0")),
+  const std::string left = WriteTempFile(
+      "names_left.yaml", RectifiedCameraInfoText("left", 346.5, 0.0));
+  const std::string right = WriteTempFile(
+      "names_right.yaml", RectifiedCameraInfoText("right", 344.5, -42.0));
+  EXPECT_THAT(ErrorMessage(ReadStereoRig(left + "," + right, "cam1", "cam0")),
               StartsWith("camera names ('cam1', 'cam0') select cameras of a "
                          "Kalibr camchain; with two ROS camera_info files"));
 }
 
 TEST(StereoRigFile, RejectsSingleCameraInfo) {
   const std::string path =
-      WriteTemp("single.yaml", CameraInfoText("left", 346.5, 0.0));
-  EXPECT_EQ(ErrorOf(ReadStereoRig(path)),
+      WriteTempFile("single.yaml", RectifiedCameraInfoText("left", 346.5, 0.0));
+  EXPECT_EQ(ErrorMessage(ReadStereoRig(path)),
             path +
                 ": is a ROS camera_info, which describes one camera; give "
                 "the left and right files as 'left.yaml,right.yaml'");
 }
 
 TEST(StereoRigFile, RejectsCamchainInPair) {
-  const std::string camchain = WriteTemp("pair_camchain.yaml", kCamchain);
-  const std::string right =
-      WriteTemp("pair_right.yaml", CameraInfoText("right", 344.5, -42.0));
-  EXPECT_THAT(ErrorOf(ReadStereoRig(camchain + "," + right)),
+  const std::string camchain =
+      WriteTempFile("pair_camchain.yaml", ThreeCameraCamchain());
+  const std::string right = WriteTempFile(
+      "pair_right.yaml", RectifiedCameraInfoText("right", 344.5, -42.0));
+  EXPECT_THAT(ErrorMessage(ReadStereoRig(camchain + "," + right)),
               StartsWith(camchain + ": is a Kalibr camchain, expected a ROS "
                                     "camera_info"));
 }
 
 TEST(StereoRigFile, RejectsPairWithEmptyPath) {
-  const std::string left =
-      WriteTemp("lonely_left.yaml", CameraInfoText("left", 346.5, 0.0));
-  EXPECT_EQ(ErrorOf(ReadStereoRig(left + ",")),
+  const std::string left = WriteTempFile(
+      "lonely_left.yaml", RectifiedCameraInfoText("left", 346.5, 0.0));
+  EXPECT_EQ(ErrorMessage(ReadStereoRig(left + ",")),
             "'" + left +
                 ",': expected one camchain path or two camera_info paths "
                 "'left.yaml,right.yaml'");
 }
 
 TEST(StereoRigFile, RejectsThreePaths) {
-  EXPECT_THAT(ErrorOf(ReadStereoRig("a.yaml,b.yaml,c.yaml")),
+  EXPECT_THAT(ErrorMessage(ReadStereoRig("a.yaml,b.yaml,c.yaml")),
               HasSubstr("expected one camchain path or two camera_info paths"));
 }
 
 TEST(StereoRigFile, ReportsCameraInfoErrorsWithPath) {
-  const std::string left =
-      WriteTemp("k3_left.yaml", CameraInfoText("left", 346.5, 0.0));
-  std::string bad = CameraInfoText("right", 344.5, -42.0);
-  bad.replace(bad.find("-0.00003, 0]"), 12, "-0.00003, 0.1]");
-  const std::string right = WriteTemp("k3_right.yaml", bad);
-  EXPECT_THAT(ErrorOf(ReadStereoRig(left + "," + right)),
+  const std::string left = WriteTempFile(
+      "k3_left.yaml", RectifiedCameraInfoText("left", 346.5, 0.0));
+  std::string bad = RectifiedCameraInfoText("right", 344.5, -42.0);
+  bad.replace(bad.find("-3e-05, 0.0]"), 12, "-3e-05, 0.1]");
+  const std::string right = WriteTempFile("k3_right.yaml", bad);
+  EXPECT_THAT(ErrorMessage(ReadStereoRig(left + "," + right)),
               StartsWith(right + ":12: distortion_coefficients.data: k3 = 0.1 "
                                  "is not supported"));
 }

@@ -7,13 +7,15 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
-#include <exception>
 #include <map>
+#include <string_view>
 #include <system_error>
 #include <utility>
 
 #include "rcm/io/atomic_file.h"
 #include "rcm/io/number_format.h"
+#include "rcm/io/yaml_fields.h"
+#include "rcm/util/message_text.h"
 
 namespace rcm {
 namespace {
@@ -21,248 +23,34 @@ namespace {
 // ---------------------------------------------------------------------------
 // Reading.
 
-// A scalar as it appears in an error message: quoted, control characters
-// escaped (so that the message stays on one line), long values shortened.
-std::string Quote(const std::string& scalar) {
-  constexpr size_t kMaxShown = 40;
-  std::string shown;
-  for (size_t i = 0; i < scalar.size() && i < kMaxShown; ++i) {
-    const unsigned char c = static_cast<unsigned char>(scalar[i]);
-    if (c < 0x20 || c == 0x7f) {
-      static const char kHex[] = "0123456789abcdef";
-      shown += "\\x";
-      shown += kHex[c >> 4];
-      shown += kHex[c & 0xf];
-    } else {
-      shown += static_cast<char>(c);
-    }
+// A homogeneous 4x4 transform written as 4 rows of 4 numbers, validated by
+// Rigid3d::FromMatrix.
+StatusOr<Rigid3d> ReadTransform(const YamlReader& reader,
+                                const YAML::Node& node,
+                                const std::string& field) {
+  const StatusOr<Eigen::Matrix4d> matrix = reader.Matrix<4, 4>(node, field);
+  if (!matrix.ok()) return matrix.status();
+  const StatusOr<Rigid3d> transform = Rigid3d::FromMatrix(*matrix);
+  if (!transform.ok()) {
+    return reader.Error(node, field, transform.status().message());
   }
-  if (scalar.size() > kMaxShown) shown += "...";
-  return "'" + shown + "'";
+  return *transform;
 }
 
-// What a node is, for "expected X, got <Describe>" messages.
-std::string Describe(const YAML::Node& node) {
-  switch (node.Type()) {
-    case YAML::NodeType::Scalar:
-      return Quote(node.Scalar());
-    case YAML::NodeType::Sequence:
-      return "a list";
-    case YAML::NodeType::Map:
-      return "a map";
-    case YAML::NodeType::Null:
-    case YAML::NodeType::Undefined:
-      break;
-  }
-  return "nothing";
+const YAML::Node* Find(const YamlEntries& entries, std::string_view key) {
+  const YamlEntry* entry = FindYamlEntry(entries, key);
+  return entry == nullptr ? nullptr : &entry->value;
 }
 
-// YAML 1.1's spellings of infinity and NaN (which from_chars does not
-// read).
-bool IsYamlNonFinite(const std::string& text) {
-  static const char* const kSpellings[] = {".nan",  ".NaN",  ".NAN",  ".inf",
-                                           ".Inf",  ".INF",  "+.inf", "+.Inf",
-                                           "+.INF", "-.inf", "-.Inf", "-.INF"};
-  for (const char* spelling : kSpellings) {
-    if (text == spelling) return true;
-  }
-  return false;
-}
-
-// The keys of a YAML map, each with its key node (for its line) and value.
-struct MapEntry {
-  YAML::Node key;
-  YAML::Node value;
-};
-using MapEntries = std::map<std::string, MapEntry>;
-
-// Reads fields of one camchain file and words the errors.
-class FieldReader {
- public:
-  explicit FieldReader(const std::string& source) : source_(source) {}
-
-  // "SOURCE:LINE: FIELD: MESSAGE" (no line when the node has none).
-  Status Error(const YAML::Node& at, const std::string& field,
-               const std::string& message) const {
-    std::string text = source_;
-    const YAML::Mark mark = at.Mark();
-    if (!mark.is_null()) text += ":" + std::to_string(mark.line + 1);
-    if (!field.empty()) text += ": " + field;
-    return Status::Error(text + ": " + message);
-  }
-  Status MissingKey(const std::string& field, const std::string& key) const {
-    return Status::Error(source_ + ": " + field + ": missing key '" + key +
-                         "'");
-  }
-
-  // The scalar-keyed entries of a map; fails on a duplicated key. Keys that
-  // are not scalars are skipped (no camchain key is one).
-  StatusOr<MapEntries> Entries(const YAML::Node& map,
-                               const std::string& field) const {
-    MapEntries entries;
-    for (auto it = map.begin(); it != map.end(); ++it) {
-      if (!it->first.IsScalar()) continue;
-      const std::string& key = it->first.Scalar();
-      if (entries.count(key) > 0) {
-        return Error(it->first, field, "duplicate key " + Quote(key));
-      }
-      entries.emplace(key, MapEntry{it->first, it->second});
-    }
-    return entries;
-  }
-
-  StatusOr<double> Number(const YAML::Node& node,
-                          const std::string& field) const {
-    if (!node.IsScalar()) {
-      return Error(node, field, "expected a number, got " + Describe(node));
-    }
-    const std::string& text = node.Scalar();
-    // from_chars does not take the '+' that YAML allows.
-    const size_t start = (text.size() > 1 && text[0] == '+') ? 1 : 0;
-    double value = 0.0;
-    const char* end = text.data() + text.size();
-    const std::from_chars_result result =
-        std::from_chars(text.data() + start, end, value);
-    if (result.ec == std::errc::result_out_of_range) {
-      return Error(node, field, Quote(text) + " is out of range");
-    }
-    if (IsYamlNonFinite(text)) {
-      return Error(node, field, Quote(text) + " is not a finite number");
-    }
-    if (text.empty() || result.ec != std::errc() || result.ptr != end) {
-      return Error(node, field, Quote(text) + " is not a number");
-    }
-    if (!std::isfinite(value)) {
-      return Error(node, field, Quote(text) + " is not a finite number");
-    }
-    return value;
-  }
-
-  StatusOr<int> Integer(const YAML::Node& node,
-                        const std::string& field) const {
-    if (!node.IsScalar()) {
-      return Error(node, field, "expected an integer, got " + Describe(node));
-    }
-    const std::string& text = node.Scalar();
-    const size_t start = (text.size() > 1 && text[0] == '+') ? 1 : 0;
-    int value = 0;
-    const char* end = text.data() + text.size();
-    const std::from_chars_result result =
-        std::from_chars(text.data() + start, end, value);
-    if (result.ec == std::errc::result_out_of_range) {
-      return Error(node, field, Quote(text) + " is out of range");
-    }
-    if (text.empty() || result.ec != std::errc() || result.ptr != end) {
-      return Error(node, field, Quote(text) + " is not an integer");
-    }
-    return value;
-  }
-
-  StatusOr<std::string> String(const YAML::Node& node,
-                               const std::string& field) const {
-    if (!node.IsScalar()) {
-      return Error(node, field, "expected a string, got " + Describe(node));
-    }
-    return node.Scalar();
-  }
-
-  // A list of numbers; `expected_size` < 0 accepts any length.
-  StatusOr<std::vector<double>> NumberList(const YAML::Node& node,
-                                           const std::string& field,
-                                           int expected_size) const {
-    if (!node.IsSequence()) {
-      return Error(node, field,
-                   ListExpectation(expected_size, "numbers") + ", got " +
-                       Describe(node));
-    }
-    if (expected_size >= 0 && static_cast<int>(node.size()) != expected_size) {
-      return Error(node, field,
-                   ListExpectation(expected_size, "numbers") + ", got " +
-                       std::to_string(node.size()));
-    }
-    std::vector<double> values;
-    for (const YAML::Node& element : node) {
-      const StatusOr<double> value = Number(element, field);
-      if (!value.ok()) return value.status();
-      values.push_back(*value);
-    }
-    return values;
-  }
-
-  StatusOr<std::vector<int>> IntegerList(const YAML::Node& node,
-                                         const std::string& field,
-                                         int expected_size) const {
-    if (!node.IsSequence()) {
-      return Error(node, field,
-                   ListExpectation(expected_size, "integers") + ", got " +
-                       Describe(node));
-    }
-    if (expected_size >= 0 && static_cast<int>(node.size()) != expected_size) {
-      return Error(node, field,
-                   ListExpectation(expected_size, "integers") + ", got " +
-                       std::to_string(node.size()));
-    }
-    std::vector<int> values;
-    for (const YAML::Node& element : node) {
-      const StatusOr<int> value = Integer(element, field);
-      if (!value.ok()) return value.status();
-      values.push_back(*value);
-    }
-    return values;
-  }
-
-  // A homogeneous 4x4 transform written as 4 rows of 4 numbers, validated
-  // by Rigid3d::FromMatrix.
-  StatusOr<Rigid3d> Transform(const YAML::Node& node,
-                              const std::string& field) const {
-    constexpr char kExpected[] = "expected a 4x4 matrix (4 rows of 4 numbers)";
-    if (!node.IsSequence()) {
-      return Error(node, field,
-                   std::string(kExpected) + ", got " + Describe(node));
-    }
-    if (node.size() != 4) {
-      return Error(node, field,
-                   std::string(kExpected) + ", got " +
-                       std::to_string(node.size()) + " rows");
-    }
-    Eigen::Matrix4d matrix;
-    for (int row = 0; row < 4; ++row) {
-      const YAML::Node row_node = node[row];
-      const StatusOr<std::vector<double>> values =
-          NumberList(row_node, field + " row " + std::to_string(row + 1), 4);
-      if (!values.ok()) return values.status();
-      for (int col = 0; col < 4; ++col) matrix(row, col) = (*values)[col];
-    }
-    const StatusOr<Rigid3d> transform = Rigid3d::FromMatrix(matrix);
-    if (!transform.ok()) {
-      return Error(node, field, transform.status().message());
-    }
-    return *transform;
-  }
-
- private:
-  static std::string ListExpectation(int expected_size, const char* what) {
-    if (expected_size < 0) return std::string("expected a list of ") + what;
-    return "expected " + std::to_string(expected_size) + " " + what;
-  }
-
-  std::string source_;
-};
-
-const YAML::Node* Find(const MapEntries& entries, const std::string& key) {
-  const auto it = entries.find(key);
-  return it == entries.end() ? nullptr : &it->second.value;
-}
-
-StatusOr<CamchainCamera> ParseCamera(const FieldReader& reader, int index,
+StatusOr<CamchainCamera> ParseCamera(const YamlReader& reader, int index,
                                      const YAML::Node& node) {
   const std::string name = "cam" + std::to_string(index);
   if (!node.IsMap()) {
     return reader.Error(
         node, name,
-        "expected a map of camera parameters, got " + Describe(node));
+        "expected a map of camera parameters, got " + DescribeYamlNode(node));
   }
-  const StatusOr<MapEntries> entries = reader.Entries(node, name);
+  const StatusOr<YamlEntries> entries = reader.Entries(node, name);
   if (!entries.ok()) return entries.status();
   const auto required =
       [&](const std::string& key) -> StatusOr<const YAML::Node*> {
@@ -279,9 +67,9 @@ StatusOr<CamchainCamera> ParseCamera(const FieldReader& reader, int index,
       reader.String(**camera_model_node, field("camera_model"));
   if (!camera_model.ok()) return camera_model.status();
   if (*camera_model != "pinhole") {
-    return reader.Error(
-        **camera_model_node, field("camera_model"),
-        "unknown model " + Quote(*camera_model) + " (supported: pinhole)");
+    return reader.Error(**camera_model_node, field("camera_model"),
+                        "unknown model " + QuoteForMessage(*camera_model) +
+                            " (supported: pinhole)");
   }
 
   // The distortion model is read before its coefficients, whose number it
@@ -294,7 +82,7 @@ StatusOr<CamchainCamera> ParseCamera(const FieldReader& reader, int index,
   const std::optional<LensModelId> model = LensModelFromName(*model_name);
   if (!model.has_value()) {
     return reader.Error(**model_node, field("distortion_model"),
-                        "unknown model " + Quote(*model_name) +
+                        "unknown model " + QuoteForMessage(*model_name) +
                             " (supported: none, radtan, equidistant)");
   }
 
@@ -306,7 +94,7 @@ StatusOr<CamchainCamera> ParseCamera(const FieldReader& reader, int index,
     }
   } else {
     const StatusOr<std::vector<double>> coeffs =
-        reader.NumberList(*coeffs_node, field("distortion_coeffs"), -1);
+        reader.NumberList(*coeffs_node, field("distortion_coeffs"));
     if (!coeffs.ok()) return coeffs.status();
     const int expected = NumDistortionParams(*model);
     if (static_cast<int>(coeffs->size()) != expected) {
@@ -359,7 +147,7 @@ StatusOr<CamchainCamera> ParseCamera(const FieldReader& reader, int index,
 
   if (const YAML::Node* value = Find(*entries, "T_cam_imu")) {
     const StatusOr<Rigid3d> transform =
-        reader.Transform(*value, field("T_cam_imu"));
+        ReadTransform(reader, *value, field("T_cam_imu"));
     if (!transform.ok()) return transform.status();
     result.cam_from_imu = *transform;
   }
@@ -373,7 +161,7 @@ StatusOr<CamchainCamera> ParseCamera(const FieldReader& reader, int index,
   if (index > 0) {
     if (previous == nullptr) return reader.MissingKey(name, "T_cn_cnm1");
     const StatusOr<Rigid3d> transform =
-        reader.Transform(*previous, field("T_cn_cnm1"));
+        ReadTransform(reader, *previous, field("T_cn_cnm1"));
     if (!transform.ok()) return transform.status();
     result.cam_from_previous = *transform;
   }
@@ -402,7 +190,7 @@ StatusOr<CamchainCamera> ParseCamera(const FieldReader& reader, int index,
 // The camera index of a top-level key "camN"; nullopt for any other key.
 // A malformed index ("cam01", an overflowing number) is an error rather
 // than an ignored key, since it was clearly meant as a camera.
-StatusOr<std::optional<int>> CameraIndex(const FieldReader& reader,
+StatusOr<std::optional<int>> CameraIndex(const YamlReader& reader,
                                          const std::string& key,
                                          const YAML::Node& key_node) {
   if (key.size() <= 3 || key.compare(0, 3, "cam") != 0) {
@@ -417,27 +205,20 @@ StatusOr<std::optional<int>> CameraIndex(const FieldReader& reader,
   const std::from_chars_result result =
       std::from_chars(digits.data(), digits.data() + digits.size(), index);
   if (result.ec != std::errc() || (digits.size() > 1 && digits[0] == '0')) {
-    return reader.Error(
-        key_node, "",
-        "malformed camera key " + Quote(key) + " (expected cam0, cam1, ...)");
+    return reader.Error(key_node, "",
+                        "malformed camera key " + QuoteForMessage(key) +
+                            " (expected cam0, cam1, ...)");
   }
   return std::optional<int>(index);
 }
 
-StatusOr<Camchain> ParseCamchainNode(const FieldReader& reader,
-                                     const std::string& source_name,
+StatusOr<Camchain> ParseCamchainNode(const YamlReader& reader,
                                      const YAML::Node& root) {
-  if (root.IsNull()) return Status::Error(source_name + ": empty file");
-  if (!root.IsMap()) {
-    return reader.Error(root, "",
-                        "top level is not a map (expected cam0, cam1, ...), "
-                        "got " +
-                            Describe(root));
-  }
-  const StatusOr<MapEntries> entries = reader.Entries(root, "");
+  const StatusOr<YamlEntries> entries =
+      reader.RootEntries(root, "expected cam0, cam1, ...");
   if (!entries.ok()) return entries.status();
 
-  std::map<int, std::pair<std::string, const MapEntry*>> cameras;
+  std::map<int, std::pair<std::string, const YamlEntry*>> cameras;
   for (const auto& [key, entry] : *entries) {
     const StatusOr<std::optional<int>> index =
         CameraIndex(reader, key, entry.key);
@@ -445,8 +226,7 @@ StatusOr<Camchain> ParseCamchainNode(const FieldReader& reader,
     if (index->has_value()) cameras[**index] = {key, &entry};
   }
   if (cameras.count(0) == 0) {
-    return Status::Error(source_name +
-                         ": no 'cam0' key: not a Kalibr camchain");
+    return reader.Error("", "no 'cam0' key: not a Kalibr camchain");
   }
   int expected = 0;
   for (const auto& [index, named_entry] : cameras) {
@@ -638,23 +418,10 @@ void AppendCamera(const std::string& name, const CamchainCamera& entry,
 
 StatusOr<Camchain> ParseCamchain(const std::string& text,
                                  const std::string& source_name) {
-  const FieldReader reader(source_name);
-  try {
-    YAML::Node root;
-    try {
-      root = YAML::Load(text);
-    } catch (const YAML::ParserException& e) {
-      std::string location = source_name;
-      if (!e.mark.is_null()) location += ":" + std::to_string(e.mark.line + 1);
-      return Status::Error(location + ": YAML syntax error: " + e.msg);
-    }
-    return ParseCamchainNode(reader, source_name, root);
-  } catch (const std::exception& e) {
-    // yaml-cpp reports misuse by exception; every access above is checked,
-    // so this is a last line of defence that keeps the no-throw promise.
-    return Status::Error(source_name +
-                         ": cannot read the camchain: " + e.what());
-  }
+  const YamlReader reader(source_name);
+  return reader.ReadDocument(text, "the camchain", [&](const YAML::Node& root) {
+    return ParseCamchainNode(reader, root);
+  });
 }
 
 StatusOr<Camchain> ReadCamchain(const std::string& path) {

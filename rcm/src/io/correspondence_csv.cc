@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "rcm/io/atomic_file.h"
+#include "rcm/util/message_text.h"
 
 namespace rcm {
 namespace {
@@ -24,9 +25,6 @@ enum Column : int { kFrame = 0, kXl, kYl, kXr, kYr, kTime, kNumColumns };
 constexpr std::array<std::string_view, kNumColumns> kColumnNames = {
     "frame", "xl", "yl", "xr", "yr", "t"};
 constexpr std::array<Column, 4> kRequiredColumns = {kXl, kYl, kXr, kYr};
-
-// Longest echo of a field inside an error message.
-constexpr size_t kMaxEchoLength = 40;
 
 std::string_view TrimBlanks(std::string_view text) {
   while (!text.empty() && (text.front() == ' ' || text.front() == '\t')) {
@@ -49,20 +47,6 @@ void SplitFields(std::string_view line, std::vector<std::string_view>* fields) {
   }
 }
 
-// A field as quoted in an error message: control characters replaced so the
-// message stays on one line, long fields shortened.
-std::string Echo(std::string_view field) {
-  std::string echo;
-  for (const char c : field.substr(0, kMaxEchoLength)) {
-    const auto byte = static_cast<unsigned char>(c);
-    echo.push_back(byte < 0x20 || byte == 0x7f ? '?' : c);
-  }
-  if (field.size() > kMaxEchoLength) echo += "...";
-  return echo;
-}
-
-std::string Quoted(std::string_view field) { return "'" + Echo(field) + "'"; }
-
 // Parses a whole field as a finite double. The error names the column.
 Status ParseFiniteDouble(std::string_view field, Column column, double* value) {
   const std::string name(kColumnNames[column]);
@@ -71,15 +55,17 @@ Status ParseFiniteDouble(std::string_view field, Column column, double* value) {
       std::from_chars(field.data(), field.data() + field.size(), parsed);
   if (error == std::errc::result_out_of_range &&
       end == field.data() + field.size()) {
-    return Status::Error(name + ": " + Quoted(field) +
+    return Status::Error(name + ": " + QuoteForMessage(field) +
                          " is out of the range of a double");
   }
   if (error != std::errc() || end != field.data() + field.size() ||
       field.empty()) {
-    return Status::Error(name + ": " + Quoted(field) + " is not a number");
+    return Status::Error(name + ": " + QuoteForMessage(field) +
+                         " is not a number");
   }
   if (!std::isfinite(parsed)) {
-    return Status::Error(name + ": " + Echo(field) + " is not finite");
+    return Status::Error(name + ": " + EscapeForMessage(field) +
+                         " is not finite");
   }
   *value = parsed;
   return Status::Ok();
@@ -91,7 +77,7 @@ Status ParseFrame(std::string_view field, int64_t* frame) {
       std::from_chars(field.data(), field.data() + field.size(), parsed);
   if (error != std::errc() || end != field.data() + field.size() ||
       field.empty() || parsed < 0) {
-    return Status::Error("frame: " + Quoted(field) +
+    return Status::Error("frame: " + QuoteForMessage(field) +
                          " is not a non-negative integer");
   }
   *frame = parsed;

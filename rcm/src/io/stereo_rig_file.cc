@@ -3,7 +3,6 @@
 #include <yaml-cpp/yaml.h>
 
 #include <charconv>
-#include <exception>
 #include <optional>
 #include <system_error>
 #include <utility>
@@ -11,6 +10,7 @@
 #include "rcm/io/atomic_file.h"
 #include "rcm/io/camchain.h"
 #include "rcm/io/camera_info.h"
+#include "rcm/io/yaml_fields.h"
 
 namespace rcm {
 namespace {
@@ -22,27 +22,23 @@ enum class RigFileFormat { kCamchain, kCameraInfo };
 // message describes the problem.
 StatusOr<RigFileFormat> DetectFormat(const std::string& path,
                                      const std::string& text) {
-  try {
-    const YAML::Node root = YAML::Load(text);
-    if (root.IsNull()) return RigFileFormat::kCamchain;
-    bool has_cam0 = false;
-    bool has_camera_matrix = false;
-    if (root.IsMap()) {
-      for (auto it = root.begin(); it != root.end(); ++it) {
-        if (!it->first.IsScalar()) continue;
-        has_cam0 = has_cam0 || it->first.Scalar() == "cam0";
-        has_camera_matrix =
-            has_camera_matrix || it->first.Scalar() == "camera_matrix";
-      }
+  const StatusOr<YAML::Node> root = YamlReader(path).Load(text);
+  if (!root.ok() || root->IsNull()) return RigFileFormat::kCamchain;
+  bool has_cam0 = false;
+  bool has_camera_matrix = false;
+  if (root->IsMap()) {
+    for (auto it = root->begin(); it != root->end(); ++it) {
+      if (!it->first.IsScalar()) continue;
+      has_cam0 = has_cam0 || it->first.Scalar() == "cam0";
+      has_camera_matrix =
+          has_camera_matrix || it->first.Scalar() == "camera_matrix";
     }
-    if (has_cam0) return RigFileFormat::kCamchain;
-    if (has_camera_matrix) return RigFileFormat::kCameraInfo;
-    return Status::Error(path +
-                         ": neither a Kalibr camchain (no 'cam0') nor a ROS "
-                         "camera_info (no 'camera_matrix')");
-  } catch (const std::exception&) {
-    return RigFileFormat::kCamchain;
   }
+  if (has_cam0) return RigFileFormat::kCamchain;
+  if (has_camera_matrix) return RigFileFormat::kCameraInfo;
+  return Status::Error(path +
+                       ": neither a Kalibr camchain (no 'cam0') nor a ROS "
+                       "camera_info (no 'camera_matrix')");
 }
 
 // Reads a file and recognises its format.
