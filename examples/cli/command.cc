@@ -1,0 +1,100 @@
+#include "command.h"
+
+#include <gflags/gflags.h>
+
+#include <algorithm>
+#include <cstring>
+#include <iostream>
+#include <string_view>
+#include <vector>
+
+// Flags every subcommand shares.
+DEFINE_bool(json, false, "print one JSON object on stdout instead of text");
+
+namespace rcm::cli {
+namespace {
+
+bool IsHelpFlag(std::string_view arg) {
+  return arg == "-h" || arg == "--help" || arg == "-help" ||
+         arg == "--helpfull";
+}
+
+// Flags of this file and of the subcommand's own file.
+bool OwnsFlag(const Subcommand& subcommand,
+              const gflags::CommandLineFlagInfo& flag) {
+  return flag.filename == subcommand.source || flag.filename == __FILE__;
+}
+
+void PrintHelp(const Subcommand& subcommand) {
+  std::cout << subcommand.usage << "\n\nFlags:\n";
+  std::vector<gflags::CommandLineFlagInfo> flags;
+  gflags::GetAllFlags(&flags);
+  std::sort(flags.begin(), flags.end(),
+            [](const auto& a, const auto& b) { return a.name < b.name; });
+  for (const gflags::CommandLineFlagInfo& flag : flags) {
+    if (!OwnsFlag(subcommand, flag)) continue;
+    std::cout << "  --" << flag.name;
+    if (flag.type != "bool") std::cout << "=" << flag.type;
+    std::cout << "\n      " << flag.description;
+    if (!flag.default_value.empty() && flag.default_value != "false") {
+      std::cout << " (default: " << flag.default_value << ")";
+    }
+    std::cout << "\n";
+  }
+  std::cout << "  --help\n      show this help\n";
+}
+
+}  // namespace
+
+int ParseSubcommandFlags(const Subcommand& subcommand, int* argc,
+                         char*** argv) {
+  for (int i = 1; i < *argc; ++i) {
+    if (std::strcmp((*argv)[i], "--") == 0) break;
+    if (IsHelpFlag((*argv)[i])) {
+      PrintHelp(subcommand);
+      return kExitOk;
+    }
+  }
+  // Flags of other subcommands, and those of libraries (glog), are not part
+  // of this subcommand's interface: reject them by the names typed.
+  for (int i = 1; i < *argc; ++i) {
+    std::string_view arg = (*argv)[i];
+    if (arg == "--") break;
+    if (arg.size() < 2 || arg[0] != '-') continue;
+    arg.remove_prefix(arg[1] == '-' ? 2 : 1);
+    std::string name(arg.substr(0, arg.find('=')));
+    gflags::CommandLineFlagInfo flag;
+    bool found = gflags::GetCommandLineFlagInfo(name.c_str(), &flag);
+    if (!found && name.rfind("no", 0) == 0) {
+      name = name.substr(2);  // --noflag sets a bool flag to false
+      found = gflags::GetCommandLineFlagInfo(name.c_str(), &flag);
+    }
+    if (!found) continue;  // unknown: gflags reports it below
+    if (!OwnsFlag(subcommand, flag)) {
+      PrintError(subcommand, "--" + name + " is not a flag of rcm " +
+                                 subcommand.name + " (see rcm " +
+                                 subcommand.name + " --help)");
+      return kExitUsage;
+    }
+  }
+  // gflags prints "ERROR: unknown command line flag 'x'" and exits 1 on an
+  // unknown flag.
+  gflags::ParseCommandLineFlags(argc, argv, /*remove_flags=*/true);
+  if (*argc > 1) {
+    PrintError(subcommand, std::string("unexpected argument '") + (*argv)[1] +
+                               "' (see rcm " + subcommand.name + " --help)");
+    return kExitUsage;
+  }
+  return -1;
+}
+
+void PrintError(const Subcommand& subcommand, const std::string& message) {
+  std::cerr << "rcm " << subcommand.name << ": error: " << message << std::endl;
+}
+
+void PrintWarning(const Subcommand& subcommand, const std::string& message) {
+  std::cerr << "rcm " << subcommand.name << ": warning: " << message
+            << std::endl;
+}
+
+}  // namespace rcm::cli

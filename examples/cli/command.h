@@ -1,0 +1,35 @@
+// The subcommand machinery of the `rcm` executable: each subcommand lives
+// in its own file, defines its gflags there, and is listed in main.cc.
+#ifndef RCM_EXAMPLES_CLI_COMMAND_H_
+#define RCM_EXAMPLES_CLI_COMMAND_H_
+
+#include <string>
+
+namespace rcm::cli {
+
+// Exit codes of every subcommand.
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitFailure = 1;  // bad input, nothing to estimate
+inline constexpr int kExitUsage = 2;    // wrong flags
+
+struct Subcommand {
+  const char* name;     // e.g. "estimate"
+  const char* summary;  // one line for `rcm --help`
+  const char* usage;    // the text of `rcm NAME --help` above the flags
+  const char* source;   // __FILE__ of the file that defines its flags
+  int (*run)();         // runs after the flags are parsed
+};
+
+// Parses the flags of `subcommand` from argv (argv[0] = "rcm NAME"),
+// handles --help, and rejects flags that belong to other subcommands.
+// Returns the exit code to stop with, or -1 to go on and run it.
+int ParseSubcommandFlags(const Subcommand& subcommand, int* argc, char*** argv);
+
+// Writes "rcm NAME: error: MESSAGE" as one line on stderr.
+void PrintError(const Subcommand& subcommand, const std::string& message);
+// Writes "rcm NAME: warning: MESSAGE" as one line on stderr.
+void PrintWarning(const Subcommand& subcommand, const std::string& message);
+
+}  // namespace rcm::cli
+
+#endif  // RCM_EXAMPLES_CLI_COMMAND_H_

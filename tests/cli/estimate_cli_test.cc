@@ -1,0 +1,285 @@
+// End-to-end tests of `rcm estimate`: what a user types, what they see.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "cli/cli_runner.h"
+#include "rcm/io/correspondence_csv.h"
+#include "rcm/sim/reference_rigs.h"
+#include "rcm/sim/stereo_sampler.h"
+#include "support/temp_file.h"
+
+namespace rcm {
+namespace {
+
+using test::IsOneLine;
+using test::RunResult;
+
+const std::string kRig = std::string(RCM_SOURCE_DIR) +
+                         "/examples/data/alphasense_front_rectified.yaml";
+const std::string kDemoMatches =
+    std::string(RCM_SOURCE_DIR) + "/examples/data/demo_matches.csv";
+
+RunResult Rcm(const std::vector<std::string>& args) {
+  return test::RunProgram(RCM_BINARY, args);
+}
+
+// Exact correspondences of the reference rig, written as a CSV.
+std::string ExactMatches(double n) {
+  StereoSamplerOptions options;
+  options.n = n;
+  options.num_frames = 4;
+  options.per_frame = 250;
+  return test::WriteTempFile(
+      "exact.csv",
+      FormatCorrespondenceCsv(
+          SampleStereoCorrespondences(AlphasenseFrontRectifiedRig(), options)
+              .value()));
+}
+
+// The rig file with one line replaced.
+std::string RigWith(const std::string& from, const std::string& to) {
+  std::string text = test::ReadWholeFile(kRig);
+  const size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  text.replace(at, from.size(), to);
+  return test::WriteTempFile("rig.yaml", text);
+}
+
+void ExpectFailsWithOneLine(const RunResult& result, int exit_code,
+                            const std::string& needle) {
+  EXPECT_EQ(result.exit_code, exit_code) << result.err;
+  EXPECT_TRUE(IsOneLine(result.err)) << "stderr:\n" << result.err;
+  EXPECT_NE(result.err.find(needle), std::string::npos) << result.err;
+  EXPECT_EQ(result.err.rfind("rcm", 0), 0u) << result.err;
+  EXPECT_TRUE(result.out.empty()) << result.out;
+}
+
+TEST(EstimateCli, ExactDataGiveTrueIndexAsJson) {
+  const RunResult result = Rcm({"estimate", "--calib", kRig, "--matches",
+                                ExactMatches(1.333), "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_TRUE(result.err.empty()) << result.err;
+  const nlohmann::json json = nlohmann::json::parse(result.out);
+  EXPECT_NEAR(json["n"].get<double>(), 1.333, 1e-9);
+  EXPECT_EQ(json["correspondences"].get<int>(), 1000);
+  EXPECT_EQ(json["frames"].get<int>(), 4);
+  EXPECT_EQ(json["used"].get<int>() + json["masked"].get<int>() +
+                json["invalid"].get<int>(),
+            1000);
+  EXPECT_GT(json["used"].get<int>(), 500);
+  EXPECT_EQ(json["estimator"], "closed-form");
+}
+
+TEST(EstimateCli, DemoDataTextReport) {
+  const RunResult result =
+      Rcm({"estimate", "--calib", kRig, "--matches", kDemoMatches});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("2000 correspondences in 10 frames"),
+            std::string::npos)
+      << result.out;
+  EXPECT_NE(result.out.find("  n          1.3"), std::string::npos)
+      << result.out;
+}
+
+TEST(EstimateCli, PerFrameCsvHasOneRowPerFrame) {
+  const std::string per_frame = test::TempFilePath("per_frame.csv");
+  std::filesystem::remove(per_frame);
+  const RunResult result =
+      Rcm({"estimate", "--calib", kRig, "--matches", kDemoMatches,
+           "--per_frame_csv", per_frame, "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const std::string text = test::ReadWholeFile(per_frame);
+  EXPECT_EQ(text.rfind("frame,t,used,n,standard_error\n", 0), 0u);
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 11);
+}
+
+TEST(EstimateCli, HelpListsOwnFlagsOnly) {
+  const RunResult result = Rcm({"estimate", "--help"});
+  EXPECT_EQ(result.exit_code, 0);
+  EXPECT_NE(result.out.find("--calib"), std::string::npos);
+  EXPECT_NE(result.out.find("--matches"), std::string::npos);
+  EXPECT_NE(result.out.find("--json"), std::string::npos);
+  EXPECT_EQ(result.out.find("--logtostderr"), std::string::npos);  // glog's
+}
+
+TEST(EstimateCli, TopLevelHelpAndVersion) {
+  EXPECT_EQ(Rcm({"--help"}).exit_code, 0);
+  EXPECT_NE(Rcm({"--help"}).out.find("estimate"), std::string::npos);
+  EXPECT_EQ(Rcm({"--version"}).out, "rcm 0.1.0\n");
+}
+
+TEST(EstimateCli, NoSubcommand) {
+  ExpectFailsWithOneLine(Rcm({}), 2, "no subcommand");
+}
+
+TEST(EstimateCli, UnknownSubcommand) {
+  ExpectFailsWithOneLine(Rcm({"estimat"}), 2, "unknown subcommand 'estimat'");
+}
+
+TEST(EstimateCli, MissingCalibFlag) {
+  ExpectFailsWithOneLine(Rcm({"estimate", "--matches", kDemoMatches}), 2,
+                         "--calib is required");
+}
+
+TEST(EstimateCli, MissingMatchesFlag) {
+  ExpectFailsWithOneLine(Rcm({"estimate", "--calib", kRig}), 2,
+                         "--matches is required");
+}
+
+TEST(EstimateCli, UnknownFlag) {
+  const RunResult result = Rcm({"estimate", "--calib", kRig, "--matchez", "x"});
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_TRUE(IsOneLine(result.err)) << result.err;
+  EXPECT_NE(result.err.find("matchez"), std::string::npos);
+}
+
+TEST(EstimateCli, LibraryFlagIsNotAnEstimateFlag) {
+  ExpectFailsWithOneLine(
+      Rcm({"estimate", "--calib", kRig, "--matches", kDemoMatches, "--v=3"}), 2,
+      "--v is not a flag of rcm estimate");
+}
+
+TEST(EstimateCli, StrayArgument) {
+  ExpectFailsWithOneLine(
+      Rcm({"estimate", "--calib", kRig, "--matches", kDemoMatches, "extra"}), 2,
+      "unexpected argument 'extra'");
+}
+
+TEST(EstimateCli, UnknownEstimator) {
+  ExpectFailsWithOneLine(Rcm({"estimate", "--calib", kRig, "--matches",
+                              kDemoMatches, "--estimator", "magic"}),
+                         2, "unknown estimator 'magic'");
+}
+
+TEST(EstimateCli, NegativeMaskThreshold) {
+  ExpectFailsWithOneLine(Rcm({"estimate", "--calib", kRig, "--matches",
+                              kDemoMatches, "--mask_eta=-1"}),
+                         2, "--mask_eta");
+}
+
+TEST(EstimateCli, MissingCalibFile) {
+  ExpectFailsWithOneLine(
+      Rcm({"estimate", "--calib", "/nonexistent/rig.yaml", "--matches",
+           kDemoMatches}),
+      1, "/nonexistent/rig.yaml: cannot open: No such file or directory");
+}
+
+TEST(EstimateCli, MissingMatchesFile) {
+  ExpectFailsWithOneLine(
+      Rcm({"estimate", "--calib", kRig, "--matches", "/nonexistent/m.csv"}), 1,
+      "/nonexistent/m.csv: cannot open");
+}
+
+TEST(EstimateCli, DirectoryInsteadOfMatches) {
+  ExpectFailsWithOneLine(
+      Rcm({"estimate", "--calib", kRig, "--matches", ::testing::TempDir()}), 1,
+      "is a directory");
+}
+
+TEST(EstimateCli, MalformedYaml) {
+  ExpectFailsWithOneLine(
+      Rcm({"estimate", "--calib",
+           test::WriteTempFile("bad.yaml", "cam0: [unclosed\n"), "--matches",
+           kDemoMatches}),
+      1, "bad.yaml");
+}
+
+TEST(EstimateCli, RigWithNonRigidTransform) {
+  ExpectFailsWithOneLine(
+      Rcm({"estimate", "--calib",
+           RigWith("- [1.0, 0.0, 0.0, -0.11]", "- [1.1, 0.0, 0.0, -0.11]"),
+           "--matches", kDemoMatches}),
+      1, "not a rigid transform");
+}
+
+TEST(EstimateCli, RigWithZeroBaseline) {
+  ExpectFailsWithOneLine(
+      Rcm({"estimate", "--calib",
+           RigWith("- [1.0, 0.0, 0.0, -0.11]", "- [1.0, 0.0, 0.0, 0.0]"),
+           "--matches", kDemoMatches}),
+      1, "zero baseline");
+}
+
+TEST(EstimateCli, RigWithNegativeFocal) {
+  ExpectFailsWithOneLine(
+      Rcm({"estimate", "--calib",
+           RigWith("intrinsics: [346.68681661781403", "intrinsics: [-346.7"),
+           "--matches", kDemoMatches}),
+      1, "focal length must be positive");
+}
+
+TEST(EstimateCli, RigWithUnknownDistortionModel) {
+  ExpectFailsWithOneLine(
+      Rcm({"estimate", "--calib",
+           RigWith("distortion_model: equidistant", "distortion_model: fov"),
+           "--matches", kDemoMatches}),
+      1, "unknown model 'fov'");
+}
+
+TEST(EstimateCli, CsvWithoutHeader) {
+  ExpectFailsWithOneLine(
+      Rcm({"estimate", "--calib", kRig, "--matches",
+           test::WriteTempFile("no_header.csv", "1,2,3,4\n")}),
+      1, "header lacks column");
+}
+
+TEST(EstimateCli, CsvWithNan) {
+  ExpectFailsWithOneLine(
+      Rcm({"estimate", "--calib", kRig, "--matches",
+           test::WriteTempFile("nan.csv", "xl,yl,xr,yr\n100,100,90,nan\n")}),
+      1, "nan.csv:2: yr");
+}
+
+TEST(EstimateCli, EmptyCsv) {
+  ExpectFailsWithOneLine(Rcm({"estimate", "--calib", kRig, "--matches",
+                              test::WriteTempFile("empty.csv", "")}),
+                         1, "empty file");
+}
+
+TEST(EstimateCli, AllMatchesOnImageAxes) {
+  // Degenerate geometry: every match on the horizontal axis (v = cy).
+  ExpectFailsWithOneLine(
+      Rcm({"estimate", "--calib", kRig, "--matches",
+           test::WriteTempFile(
+               "axis.csv",
+               "xl,yl,xr,yr\n100,271.0179819820658,90,262.02195974034373\n"
+               "600,271.0179819820658,590,262.02195974034373\n")}),
+      1, "no usable correspondence");
+}
+
+TEST(EstimateCli, FailedRunWritesNoPerFrameCsv) {
+  const std::string per_frame = test::TempFilePath("per_frame.csv");
+  std::filesystem::remove(per_frame);
+  const RunResult result = Rcm({"estimate", "--calib", kRig, "--matches",
+                                test::WriteTempFile("empty2.csv", ""),
+                                "--per_frame_csv", per_frame});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_FALSE(std::filesystem::exists(per_frame));
+}
+
+TEST(EstimateCli, WarnsOnUnrectifiedRig) {
+  const RunResult result =
+      Rcm({"estimate", "--calib",
+           RigWith("  - [1.0, 0.0, 0.0, -0.11]\n  - [0.0, 1.0, 0.0, 0.0]\n"
+                   "  - [0.0, 0.0, 1.0, 0.0]",
+                   "  - [0.9998476951563913, 0.0, 0.01745240643728351, -0.11]\n"
+                   "  - [0.0, 1.0, 0.0, 0.0]\n"
+                   "  - [-0.01745240643728351, 0.0, 0.9998476951563913, 0.0]"),
+           "--matches", kDemoMatches});
+  EXPECT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_TRUE(IsOneLine(result.err)) << result.err;
+  EXPECT_NE(
+      result.err.find("warning: the rig is 1.00 deg from a rectified pair"),
+      std::string::npos)
+      << result.err;
+}
+
+}  // namespace
+}  // namespace rcm
