@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# Installs the Debian packages rcm needs (when missing), then configures and
+# builds everything in Release into build/ with two jobs. Extra arguments go
+# to the CMake configure step, e.g. -DRCM_BUILD_BENCHMARKS=OFF.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+./scripts/setup.sh
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "$@"
+cmake --build build -j2
