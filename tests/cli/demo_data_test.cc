@@ -5,6 +5,7 @@
 #include <string>
 
 #include "cli/cli_runner.h"
+#include "rcm/io/camchain.h"
 #include "support/temp_file.h"
 
 namespace rcm {
@@ -22,6 +23,15 @@ TEST(DemoData, RegeneratesByteForByte) {
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_EQ(test::ReadWholeFile(output),
             test::ReadWholeFile(source + "/examples/data/demo_matches.csv"));
+}
+
+TEST(DemoData, RigFileIsWhatKalibrWouldWrite) {
+  // The bundled camchain reads back and formats to the same bytes.
+  const std::string path = std::string(RCM_SOURCE_DIR) +
+                           "/examples/data/alphasense_front_rectified.yaml";
+  const StatusOr<Camchain> camchain = ReadCamchain(path);
+  ASSERT_TRUE(camchain.ok()) << camchain.status().message();
+  EXPECT_EQ(FormatCamchain(*camchain), test::ReadWholeFile(path));
 }
 
 }  // namespace
