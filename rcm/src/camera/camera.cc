@@ -33,14 +33,14 @@ int NumDistortionParams(LensModelId model) {
   return 0;
 }
 
-StatusOr<Camera> Camera::Create(LensModelId model, int width, int height,
-                                const std::array<double, 4>& intrinsics,
-                                const std::vector<double>& distortion) {
-  if (width <= 0 || height <= 0) {
-    std::ostringstream message;
-    message << "image size must be positive, got " << width << " x " << height;
-    return Status::Error(message.str());
-  }
+Status Camera::CheckImageSize(int width, int height) {
+  if (width > 0 && height > 0) return Status::Ok();
+  std::ostringstream message;
+  message << "image size must be positive, got " << width << " x " << height;
+  return Status::Error(message.str());
+}
+
+Status Camera::CheckIntrinsics(const std::array<double, 4>& intrinsics) {
   const char* kNames[4] = {"fx", "fy", "cx", "cy"};
   for (int i = 0; i < 4; ++i) {
     if (!std::isfinite(intrinsics[i])) {
@@ -55,6 +55,11 @@ StatusOr<Camera> Camera::Create(LensModelId model, int width, int height,
       return Status::Error(message.str());
     }
   }
+  return Status::Ok();
+}
+
+Status Camera::CheckDistortion(LensModelId model,
+                               const std::vector<double>& distortion) {
   const int expected = NumDistortionParams(model);
   if (static_cast<int>(distortion.size()) != expected) {
     std::ostringstream message;
@@ -69,6 +74,16 @@ StatusOr<Camera> Camera::Create(LensModelId model, int width, int height,
       return Status::Error(message.str());
     }
   }
+  return Status::Ok();
+}
+
+StatusOr<Camera> Camera::Create(LensModelId model, int width, int height,
+                                const std::array<double, 4>& intrinsics,
+                                const std::vector<double>& distortion) {
+  RCM_RETURN_IF_ERROR(CheckImageSize(width, height));
+  RCM_RETURN_IF_ERROR(CheckIntrinsics(intrinsics));
+  RCM_RETURN_IF_ERROR(CheckDistortion(model, distortion));
+  const int expected = NumDistortionParams(model);
   Camera camera;
   camera.model_ = model;
   camera.width_ = width;

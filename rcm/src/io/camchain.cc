@@ -118,31 +118,31 @@ StatusOr<CamchainCamera> ParseCamera(const YamlReader& reader, int index,
       reader.IntegerList(**resolution_node, field("resolution"), 2);
   if (!resolution.ok()) return resolution.status();
 
-  // Camera::Create validates everything at once; build it in stages so
-  // that its message can be attributed to the key it is about.
+  // Each of Camera::Create's checks, attributed to the key it is about.
   const int width = (*resolution)[0];
   const int height = (*resolution)[1];
   const std::array<double, 4> fx_fy_cx_cy = {
       (*intrinsics)[0], (*intrinsics)[1], (*intrinsics)[2], (*intrinsics)[3]};
-  StatusOr<Camera> camera = Camera::Create(LensModelId::kPinhole, width, height,
-                                           {1.0, 1.0, 0.0, 0.0}, {});
-  if (!camera.ok()) {
+  if (const Status status = Camera::CheckImageSize(width, height);
+      !status.ok()) {
     return reader.Error(**resolution_node, field("resolution"),
-                        camera.status().message());
+                        status.message());
   }
-  camera =
-      Camera::Create(LensModelId::kPinhole, width, height, fx_fy_cx_cy, {});
-  if (!camera.ok()) {
+  if (const Status status = Camera::CheckIntrinsics(fx_fy_cx_cy);
+      !status.ok()) {
     return reader.Error(**intrinsics_node, field("intrinsics"),
-                        camera.status().message());
+                        status.message());
   }
-  camera = Camera::Create(*model, width, height, fx_fy_cx_cy, distortion);
-  if (!camera.ok()) {
+  if (const Status status = Camera::CheckDistortion(*model, distortion);
+      !status.ok()) {
     return reader.Error(coeffs_node != nullptr ? *coeffs_node : node,
-                        field("distortion_coeffs"), camera.status().message());
+                        field("distortion_coeffs"), status.message());
   }
+  // Cannot fail: Create runs exactly the three checks above.
+  const Camera camera =
+      Camera::Create(*model, width, height, fx_fy_cx_cy, distortion).value();
 
-  CamchainCamera result{*camera,      std::nullopt, std::nullopt,
+  CamchainCamera result{camera,       std::nullopt, std::nullopt,
                         std::nullopt, {},           ""};
 
   if (const YAML::Node* value = Find(*entries, "T_cam_imu")) {

@@ -215,27 +215,26 @@ StatusOr<CameraInfo> ParseCameraInfoNode(const YamlReader& reader,
     distortion = *converted;
   }
 
-  // Camera::Create validates everything at once; build it in stages so that
-  // its message can be attributed to the key it is about.
+  // Each of Camera::Create's checks, attributed to the key it is about.
   const std::array<double, 4> intrinsics = {k[0], k[4], k[2], k[5]};
-  StatusOr<Camera> camera = Camera::Create(LensModelId::kPinhole, *width,
-                                           *height, {1.0, 1.0, 0.0, 0.0}, {});
-  if (!camera.ok()) {
+  if (const Status status = Camera::CheckImageSize(*width, *height);
+      !status.ok()) {
     const bool width_bad = *width <= 0;
     return reader.Error(width_bad ? width_entry->value : height_entry->value,
                         width_bad ? "image_width" : "image_height",
-                        camera.status().message());
+                        status.message());
   }
-  camera =
-      Camera::Create(LensModelId::kPinhole, *width, *height, intrinsics, {});
-  if (!camera.ok()) {
-    return reader.Error(k_data, k_field, camera.status().message());
+  if (const Status status = Camera::CheckIntrinsics(intrinsics); !status.ok()) {
+    return reader.Error(k_data, k_field, status.message());
   }
-  camera = Camera::Create(*model, *width, *height, intrinsics, distortion);
-  if (!camera.ok()) {
+  if (const Status status = Camera::CheckDistortion(*model, distortion);
+      !status.ok()) {
     return reader.Error(d_entry != nullptr ? d_entry->value : root,
-                        "distortion_coefficients", camera.status().message());
+                        "distortion_coefficients", status.message());
   }
+  // Cannot fail: Create runs exactly the three checks above.
+  const Camera camera =
+      Camera::Create(*model, *width, *height, intrinsics, distortion).value();
 
   Eigen::Matrix3d rectification = Eigen::Matrix3d::Identity();
   if (const YamlEntry* entry =
@@ -262,7 +261,7 @@ StatusOr<CameraInfo> ParseCameraInfoNode(const YamlReader& reader,
     for (int i = 0; i < 12; ++i) projection(i / 4, i % 4) = p->data[i];
   }
 
-  return CameraInfo{camera_name, *camera, rectification, projection};
+  return CameraInfo{camera_name, camera, rectification, projection};
 }
 
 // Checks that a ROS projection matrix has the form

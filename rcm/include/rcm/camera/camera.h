@@ -44,12 +44,21 @@ int NumDistortionParams(LensModelId model);
 class Camera {
  public:
   // Validates and builds a camera. `intrinsics` = [fx, fy, cx, cy];
-  // `distortion` has NumDistortionParams(model) entries. Errors name the
-  // problem: non-positive or non-finite focal length, wrong coefficient
-  // count, non-finite value, non-positive image size.
+  // `distortion` has NumDistortionParams(model) entries. Create fails
+  // exactly when one of the three checks below does, with its message.
   static StatusOr<Camera> Create(LensModelId model, int width, int height,
                                  const std::array<double, 4>& intrinsics,
                                  const std::vector<double>& distortion);
+
+  // The checks of Create, one per input, so that a file reader can
+  // attribute a problem to the key it came from.
+  // Width and height positive.
+  static Status CheckImageSize(int width, int height);
+  // All four finite, focal lengths positive.
+  static Status CheckIntrinsics(const std::array<double, 4>& intrinsics);
+  // NumDistortionParams(model) coefficients, all finite.
+  static Status CheckDistortion(LensModelId model,
+                                const std::vector<double>& distortion);
 
   LensModelId model() const { return model_; }
   int width() const { return width_; }
