@@ -763,3 +763,20 @@ TEST(Camchain, ReadPrefixesErrorsWithThePath) {
 
 }  // namespace
 }  // namespace rcm
+
+namespace rcm {
+namespace {
+
+TEST(CamchainCameraIndex, ReadsCanonicalNamesOnly) {
+  EXPECT_EQ(CamchainCameraIndex("cam0"), 0);
+  EXPECT_EQ(CamchainCameraIndex("cam12"), 12);
+  EXPECT_FALSE(CamchainCameraIndex("cam").has_value());
+  EXPECT_FALSE(CamchainCameraIndex("cam01").has_value());
+  EXPECT_FALSE(CamchainCameraIndex("cam-1").has_value());
+  EXPECT_FALSE(CamchainCameraIndex("cam1x").has_value());
+  EXPECT_FALSE(CamchainCameraIndex("camera").has_value());
+  EXPECT_FALSE(CamchainCameraIndex("cam99999999999").has_value());
+}
+
+}  // namespace
+}  // namespace rcm

@@ -188,28 +188,26 @@ StatusOr<CamchainCamera> ParseCamera(const YamlReader& reader, int index,
 }
 
 // The camera index of a top-level key "camN"; nullopt for any other key.
-// A malformed index ("cam01", an overflowing number) is an error rather
-// than an ignored key, since it was clearly meant as a camera.
+// A key of "cam" and digits that is not a canonical index ("cam01", an
+// overflowing number) is an error rather than an ignored key, since it was
+// clearly meant as a camera.
 StatusOr<std::optional<int>> CameraIndex(const YamlReader& reader,
                                          const std::string& key,
                                          const YAML::Node& key_node) {
-  if (key.size() <= 3 || key.compare(0, 3, "cam") != 0) {
-    return std::optional<int>();
-  }
-  const std::string digits = key.substr(3);
-  if (!std::all_of(digits.begin(), digits.end(),
+  const std::string_view digits =
+      std::string_view(key).substr(std::min<size_t>(key.size(), 3));
+  if (key.compare(0, 3, "cam") != 0 || digits.empty() ||
+      !std::all_of(digits.begin(), digits.end(),
                    [](char c) { return c >= '0' && c <= '9'; })) {
     return std::optional<int>();
   }
-  int index = 0;
-  const std::from_chars_result result =
-      std::from_chars(digits.data(), digits.data() + digits.size(), index);
-  if (result.ec != std::errc() || (digits.size() > 1 && digits[0] == '0')) {
+  const std::optional<int> index = CamchainCameraIndex(key);
+  if (!index.has_value()) {
     return reader.Error(key_node, "",
                         "malformed camera key " + QuoteForMessage(key) +
                             " (expected cam0, cam1, ...)");
   }
-  return std::optional<int>(index);
+  return index;
 }
 
 StatusOr<Camchain> ParseCamchainNode(const YamlReader& reader,
@@ -415,6 +413,20 @@ void AppendCamera(const std::string& name, const CamchainCamera& entry,
 }
 
 }  // namespace
+
+std::optional<int> CamchainCameraIndex(std::string_view name) {
+  if (name.size() <= 3 || name.substr(0, 3) != "cam") return std::nullopt;
+  const std::string_view digits = name.substr(3);
+  if (digits.size() > 1 && digits[0] == '0') return std::nullopt;
+  int index = 0;
+  const std::from_chars_result result =
+      std::from_chars(digits.data(), digits.data() + digits.size(), index);
+  if (result.ec != std::errc() || result.ptr != digits.data() + digits.size() ||
+      index < 0) {
+    return std::nullopt;
+  }
+  return index;
+}
 
 StatusOr<Camchain> ParseCamchain(const std::string& text,
                                  const std::string& source_name) {

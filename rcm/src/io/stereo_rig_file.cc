@@ -2,9 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include <charconv>
 #include <optional>
-#include <system_error>
 #include <utility>
 
 #include "rcm/io/atomic_file.h"
@@ -54,20 +52,6 @@ StatusOr<RigFile> ReadRigFile(const std::string& path) {
   return RigFile{std::move(text).value(), *format};
 }
 
-// The index N of a camera name "camN"; nullopt for anything else.
-std::optional<int> CameraIndexFromName(const std::string& name) {
-  if (name.size() <= 3 || name.compare(0, 3, "cam") != 0) return std::nullopt;
-  if (name.size() > 4 && name[3] == '0') return std::nullopt;
-  int index = 0;
-  const char* begin = name.data() + 3;
-  const char* end = name.data() + name.size();
-  const std::from_chars_result result = std::from_chars(begin, end, index);
-  if (result.ec != std::errc() || result.ptr != end || index < 0) {
-    return std::nullopt;
-  }
-  return index;
-}
-
 StatusOr<StereoRig> ReadCamchainRig(const std::string& path,
                                     const std::string& text,
                                     const std::string& left,
@@ -78,7 +62,7 @@ StatusOr<StereoRig> ReadCamchainRig(const std::string& path,
   int indices[2];
   const std::string* names[2] = {&left, &right};
   for (int i = 0; i < 2; ++i) {
-    const std::optional<int> index = CameraIndexFromName(*names[i]);
+    const std::optional<int> index = CamchainCameraIndex(*names[i]);
     if (!index.has_value() || *index >= num_cameras) {
       std::string known;
       for (int k = 0; k < num_cameras; ++k) {

@@ -42,6 +42,7 @@
 
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "rcm/camera/camera.h"
@@ -69,6 +70,10 @@ struct Camchain {
   // cameras[k] is camk.
   std::vector<CamchainCamera> cameras;
 };
+
+// The index N of a camchain camera name "camN" (N a decimal without sign or
+// leading zero that fits an int); nullopt for any other name.
+std::optional<int> CamchainCameraIndex(std::string_view name);
 
 // Parses camchain text. `source_name` (usually the path) prefixes every
 // error message.
