@@ -11,13 +11,6 @@
 namespace rcm {
 namespace {
 
-Camera RadTanCamera() {
-  return Camera::Create(LensModelId::kRadTan, 752, 480,
-                        {458.654, 457.296, 367.215, 248.375},
-                        {-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05})
-      .value();
-}
-
 Camera CameraFor(LensModelId model) {
   switch (model) {
     case LensModelId::kPinhole:
@@ -25,7 +18,7 @@ Camera CameraFor(LensModelId model) {
                             {400.0, 400.0, 319.5, 239.5}, {})
           .value();
     case LensModelId::kRadTan:
-      return RadTanCamera();
+      return EurocCam0();
     case LensModelId::kEquidistant:
       return AlphasenseFrontCam0();
   }

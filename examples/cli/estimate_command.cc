@@ -154,7 +154,6 @@ int RunEstimate() {
   std::vector<double> per_match;
   std::vector<FrameRow> frame_rows;
   per_match.reserve(matches->size());
-  int64_t num_frames = 0;
   for (size_t i = 0; i < matches->size(); ++i) {
     const StereoCorrespondence& match = (*matches)[i];
     const PaperOnlineEstimator::Contribution contribution =
@@ -165,7 +164,6 @@ int RunEstimate() {
     const bool frame_ends =
         i + 1 == matches->size() || (*matches)[i + 1].frame != match.frame;
     if (frame_ends) {
-      ++num_frames;
       const std::optional<PaperOnlineEstimator::Estimate> current =
           estimator.Current();
       frame_rows.push_back({match.frame, match.timestamp, estimator.num_used(),
@@ -174,6 +172,7 @@ int RunEstimate() {
     }
   }
 
+  const size_t num_frames = frame_rows.size();
   const std::optional<PaperOnlineEstimator::Estimate> estimate =
       estimator.Current();
   if (!estimate) {

@@ -12,12 +12,7 @@ Camera AlphasenseCam0() { return AlphasenseFrontCam0(); }
 
 Camera AlphasenseCam1() { return AlphasenseFrontCam1(); }
 
-Camera EurocRadtanCamera() {
-  return Camera::Create(LensModelId::kRadTan, 752, 480,
-                        {458.654, 457.296, 367.215, 248.375},
-                        {-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05})
-      .value();
-}
+Camera EurocRadtanCamera() { return EurocCam0(); }
 
 Camera PinholeCamera() {
   return Camera::Create(LensModelId::kPinhole, 640, 480,

@@ -29,6 +29,14 @@ std::optional<Eigen::Vector3d> RefractiveCamera::BearingInWaterFromImage(
   return bearing.normalized();
 }
 
+std::optional<Eigen::Vector2d> RefractiveCamera::ImageFromNormalized(
+    const Eigen::Vector2d& normalized) const {
+  if (!camera_.LensInvertibleAt(normalized)) return std::nullopt;
+  const Eigen::Vector2d pixel = camera_.ImageFromNormalized(normalized);
+  if (!pixel.allFinite()) return std::nullopt;
+  return pixel;
+}
+
 std::optional<Eigen::Vector2d> RefractiveCamera::ImageFromPointInWater(
     const Eigen::Vector3d& point_in_camera) const {
   Eigen::Vector2d normalized;
@@ -36,10 +44,7 @@ std::optional<Eigen::Vector2d> RefractiveCamera::ImageFromPointInWater(
           n_, point_in_camera.data(), &normalized.x(), &normalized.y())) {
     return std::nullopt;
   }
-  if (!camera_.LensInvertibleAt(normalized)) return std::nullopt;
-  const Eigen::Vector2d pixel = camera_.ImageFromNormalized(normalized);
-  if (!pixel.allFinite()) return std::nullopt;
-  return pixel;
+  return ImageFromNormalized(normalized);
 }
 
 Eigen::Matrix3d RefractiveCamera::VirtualPinholeMatrix() const {
@@ -72,10 +77,7 @@ std::optional<Eigen::Vector2d> RefractiveCamera::ImageFromVirtualPinhole(
                                                  &normalized.y())) {
     return std::nullopt;
   }
-  if (!camera_.LensInvertibleAt(normalized)) return std::nullopt;
-  const Eigen::Vector2d pixel = camera_.ImageFromNormalized(normalized);
-  if (!pixel.allFinite()) return std::nullopt;
-  return pixel;
+  return ImageFromNormalized(normalized);
 }
 
 }  // namespace rcm

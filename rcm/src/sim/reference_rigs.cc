@@ -20,6 +20,13 @@ Camera AlphasenseFrontCam1() {
       .value();
 }
 
+Camera EurocCam0() {
+  return Camera::Create(LensModelId::kRadTan, 752, 480,
+                        {458.654, 457.296, 367.215, 248.375},
+                        {-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05})
+      .value();
+}
+
 StereoRig AlphasenseFrontRectifiedRig() {
   Rigid3d right_from_left;
   right_from_left.translation = Eigen::Vector3d(-0.11, 0.0, 0.0);

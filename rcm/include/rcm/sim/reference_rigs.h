@@ -14,6 +14,9 @@ namespace rcm {
 Camera AlphasenseFrontCam0();
 Camera AlphasenseFrontCam1();
 
+// EuRoC MAV cam0 (752x480, radtan): a strongly distorted radtan lens.
+Camera EurocCam0();
+
 // Those intrinsics on the ideal rectified extrinsics of the paper's
 // derivation: right_from_left = (I, (-0.11 m, 0, 0)).
 StereoRig AlphasenseFrontRectifiedRig();
