@@ -1,6 +1,8 @@
 #include "rcm/sim/stereo_sampler.h"
 
+#include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <random>
 #include <sstream>
 
@@ -98,6 +100,27 @@ void AddPixelNoise(double sigma_px, uint64_t seed,
     c.right_pixel.x() += noise(rng);
     c.right_pixel.y() += noise(rng);
   }
+}
+
+std::vector<int64_t> AddOutliers(
+    const StereoRig& rig, double fraction, uint64_t seed,
+    std::vector<StereoCorrespondence>* correspondences) {
+  CHECK(correspondences != nullptr);
+  CHECK(fraction >= 0.0 && fraction <= 1.0) << fraction;
+  std::mt19937_64 rng(seed);
+  std::vector<int64_t> order(correspondences->size());
+  std::iota(order.begin(), order.end(), int64_t{0});
+  std::shuffle(order.begin(), order.end(), rng);
+  order.resize(static_cast<size_t>(
+      std::llround(fraction * static_cast<double>(order.size()))));
+  std::sort(order.begin(), order.end());
+  const Camera& right = rig.right();
+  std::uniform_real_distribution<double> u(-0.5, right.width() - 0.5);
+  std::uniform_real_distribution<double> v(-0.5, right.height() - 0.5);
+  for (const int64_t i : order) {
+    (*correspondences)[i].right_pixel = Eigen::Vector2d(u(rng), v(rng));
+  }
+  return order;
 }
 
 }  // namespace rcm

@@ -43,6 +43,13 @@ StatusOr<std::vector<StereoCorrespondence>> SampleStereoCorrespondences(
 void AddPixelNoise(double sigma_px, uint64_t seed,
                    std::vector<StereoCorrespondence>* correspondences);
 
+// Makes a random `fraction` (in [0, 1]) of the correspondences gross
+// outliers: their right pixel is replaced by one drawn uniformly over the
+// right image. Returns the indices of the replaced ones, increasing.
+std::vector<int64_t> AddOutliers(
+    const StereoRig& rig, double fraction, uint64_t seed,
+    std::vector<StereoCorrespondence>* correspondences);
+
 }  // namespace rcm
 
 #endif  // RCM_SIM_STEREO_SAMPLER_H_

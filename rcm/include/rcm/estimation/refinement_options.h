@@ -1,0 +1,74 @@
+// Options shared by the refractive-index estimators of record: the batch
+// refinement (batch_refinement.h), the online estimator and its sliding
+// window. All fit n to the Sampson coplanarity residual
+// (sampson_coplanarity_error.h) in two stages:
+//
+//   1. robust: minimize sum rho(r_i(n)^2) over n in [1, 2], seeded by a
+//      coarse scan of the whole interval (so the solver cannot start in
+//      the basin of a wrong minimum);
+//   2. least squares on the inliers |r_i| <= inlier_threshold_px at the
+//      robust estimate, whose covariance gives sigma_n.
+//
+// Stage 2 makes the estimate efficient (plain least squares is the
+// first-order maximum-likelihood estimate under Gaussian pixel noise) and
+// its sigma honest; stage 1 keeps outliers out of it.
+#ifndef RCM_ESTIMATION_REFINEMENT_OPTIONS_H_
+#define RCM_ESTIMATION_REFINEMENT_OPTIONS_H_
+
+#include <optional>
+#include <string_view>
+
+#include "rcm/util/status.h"
+
+namespace rcm {
+
+// Ceres' conventions, s = r^2 and c = the scale:
+//   kNone:   rho(s) = s
+//   kHuber:  rho(s) = s for s <= c^2, 2 c sqrt(s) - c^2 beyond
+//   kCauchy: rho(s) = c^2 log(1 + s / c^2)
+enum class RobustLoss { kNone, kHuber, kCauchy };
+
+// "none", "huber", "cauchy".
+std::string_view RobustLossName(RobustLoss loss);
+std::optional<RobustLoss> RobustLossFromName(std::string_view name);
+
+// rho(s) above.
+double RobustLossRho(RobustLoss loss, double scale, double squared_residual);
+
+struct RefinementOptions {
+  // Loss of stage 1.
+  RobustLoss loss = RobustLoss::kCauchy;
+  // Its scale, in pixels of Sampson distance; > 0. About twice the pixel
+  // noise of good features, where Cauchy keeps ~95 % of the efficiency of
+  // least squares.
+  double loss_scale_px = 1.0;
+  // Inlier threshold of stage 2, in pixels; > 0, +inf keeps every match.
+  // Four times a 0.5 px noise: it drops about 1 in 16000 true matches.
+  double inlier_threshold_px = 2.0;
+  // Points of the coarse scan of [1, 2] that seeds stage 1; >= 3. The
+  // default spacing 0.02 is finer than the width of the robust cost's
+  // basin (loss scale / slope of r in n, about 0.1 for 1 px at 10 px per
+  // unit of n).
+  int num_scan_points = 51;
+  // Fewest inliers accepted; >= 2 (one more than the parameters, so that
+  // the pixel noise can be estimated), at least 5 with the rotation.
+  int min_inliers = 10;
+  // The data must observe n: refuse when the Cramer-Rao bound at 1 px of
+  // pixel noise exceeds this. At 0.1 the data could not tell water (1.33)
+  // from air (1.0) at 3 sigma; matches on the image axes, or few and far
+  // away, are refused with a message instead of giving a number. > 0.
+  double max_crlb_per_px = 0.1;
+  // Also estimate a small rotation correction of cam1_from_cam0 (batch
+  // only; see batch_refinement.h for when it is identifiable).
+  bool refine_rotation = false;
+  // Solver iterations per stage; >= 1.
+  int max_num_iterations = 100;
+  // Threads for evaluating residuals; >= 1.
+  int num_threads = 2;
+
+  Status Check() const;
+};
+
+}  // namespace rcm
+
+#endif  // RCM_ESTIMATION_REFINEMENT_OPTIONS_H_

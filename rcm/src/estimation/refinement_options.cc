@@ -1,0 +1,72 @@
+#include "rcm/estimation/refinement_options.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace rcm {
+
+std::string_view RobustLossName(RobustLoss loss) {
+  switch (loss) {
+    case RobustLoss::kNone:
+      return "none";
+    case RobustLoss::kHuber:
+      return "huber";
+    case RobustLoss::kCauchy:
+      return "cauchy";
+  }
+  return "none";
+}
+
+std::optional<RobustLoss> RobustLossFromName(std::string_view name) {
+  for (const RobustLoss loss :
+       {RobustLoss::kNone, RobustLoss::kHuber, RobustLoss::kCauchy}) {
+    if (RobustLossName(loss) == name) return loss;
+  }
+  return std::nullopt;
+}
+
+double RobustLossRho(RobustLoss loss, double scale, double squared_residual) {
+  const double c2 = scale * scale;
+  switch (loss) {
+    case RobustLoss::kNone:
+      return squared_residual;
+    case RobustLoss::kHuber:
+      return squared_residual <= c2
+                 ? squared_residual
+                 : 2.0 * scale * std::sqrt(squared_residual) - c2;
+    case RobustLoss::kCauchy:
+      return c2 * std::log1p(squared_residual / c2);
+  }
+  return squared_residual;
+}
+
+Status RefinementOptions::Check() const {
+  std::ostringstream error;
+  if (!(loss_scale_px > 0.0) || !std::isfinite(loss_scale_px)) {
+    error << "loss scale must be a positive number of pixels, got "
+          << loss_scale_px;
+  } else if (!(inlier_threshold_px > 0.0)) {
+    error << "inlier threshold must be positive (inf keeps every match), got "
+          << inlier_threshold_px;
+  } else if (num_scan_points < 3) {
+    error << "the scan of [1, 2] needs at least 3 points, got "
+          << num_scan_points;
+  } else if (min_inliers < (refine_rotation ? 5 : 2)) {
+    error << "at least " << (refine_rotation ? 5 : 2)
+          << " inliers are needed to estimate "
+          << (refine_rotation ? "n, the rotation" : "n")
+          << " and the pixel noise, got min_inliers = " << min_inliers;
+  } else if (!(max_crlb_per_px > 0.0)) {
+    error << "max_crlb_per_px must be positive, got " << max_crlb_per_px;
+  } else if (max_num_iterations < 1) {
+    error << "max_num_iterations must be at least 1, got "
+          << max_num_iterations;
+  } else if (num_threads < 1) {
+    error << "num_threads must be at least 1, got " << num_threads;
+  } else {
+    return Status::Ok();
+  }
+  return Status::Error(error.str());
+}
+
+}  // namespace rcm

@@ -1,0 +1,206 @@
+#include "rcm/estimation/sampson_coplanarity_error.h"
+
+#include <ceres/jet.h>
+#include <ceres/rotation.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <random>
+
+#include "rcm/geometry/epipolar.h"
+#include "rcm/sim/stereo_sampler.h"
+#include "support/test_rigs.h"
+
+namespace rcm {
+namespace {
+
+// Exact correspondences come from the model's forward map with round trips
+// below 1.3e-12 px (refractive_camera_test.cc); the residual is a pixel
+// distance, so it is as small.
+constexpr double kExactResidualPx = 1e-9;
+
+std::vector<StereoRig> TestRigs() {
+  return {test::AlphasenseIdealRig(), test::AlphasenseRealisticRig(),
+          test::IdealRig(test::EurocRadtanCamera(), test::EurocRadtanCamera()),
+          test::IdealRig(test::PinholeCamera(), test::PinholeCamera()),
+          test::IdealRig(test::WideEquidistantCamera(),
+                         test::WideEquidistantCamera())};
+}
+
+double Residual(const StereoRig& rig, const StereoCorrespondence& match,
+                double n, const double* rotation = nullptr) {
+  const PreparedCorrespondence prepared =
+      PrepareCorrespondence(rig, match).value();
+  double residual = NAN;
+  EXPECT_TRUE(
+      SampsonCoplanarityResidual<double>(EssentialMatrix(rig.right_from_left()),
+                                         prepared, n, rotation, &residual));
+  return residual;
+}
+
+TEST(SampsonCoplanarityError, ZeroOnExactMatchesOfEveryRig) {
+  for (const StereoRig& rig : TestRigs()) {
+    for (const double n : {1.0, 1.333, 1.6}) {
+      for (const StereoCorrespondence& match :
+           test::ExactMatches(rig, n, 300)) {
+        ASSERT_LT(std::abs(Residual(rig, match, n)), kExactResidualPx);
+      }
+    }
+  }
+}
+
+TEST(SampsonCoplanarityError, IsCoplanarityOverItsPixelGradient) {
+  // The same quantity from the unnormalized residual of epipolar.h, with
+  // the pixel gradient taken by Jets through the lens undistortion (the
+  // route of FirstOrderSigmaN) instead of the analytic chain rule.
+  constexpr double kRelativeTolerance = 1e-9;  // two routes, same algebra
+  using Jet = ceres::Jet<double, 4>;
+  const double rotation[3] = {0.002, -0.004, 0.003};
+  for (const StereoRig& rig : TestRigs()) {
+    std::vector<StereoCorrespondence> data = test::ExactMatches(rig, 1.333, 50);
+    AddPixelNoise(1.0, 3, &data);
+    Eigen::Matrix3d delta;
+    ceres::AngleAxisToRotationMatrix(
+        rotation, ceres::ColumnMajorAdapter3x3(delta.data()));
+    const Eigen::Matrix3d essential = EssentialMatrix(rig.right_from_left());
+    for (const bool rotated : {false, true}) {
+      const Eigen::Matrix3d used =
+          rotated ? Eigen::Matrix3d(delta * essential) : essential;
+      for (const StereoCorrespondence& match : data) {
+        const Jet left_pixel[2] = {Jet(match.left_pixel.x(), 0),
+                                   Jet(match.left_pixel.y(), 1)};
+        const Jet right_pixel[2] = {Jet(match.right_pixel.x(), 2),
+                                    Jet(match.right_pixel.y(), 3)};
+        Jet left[2], right[2];
+        ASSERT_TRUE(rig.left().NormalizedFromImage(left_pixel, left));
+        ASSERT_TRUE(rig.right().NormalizedFromImage(right_pixel, right));
+        const Jet e = CoplanarityResidual(used, Jet(1.333), left, right);
+        const double expected = e.a / e.v.norm();
+        const double actual =
+            Residual(rig, match, 1.333, rotated ? rotation : nullptr);
+        EXPECT_NEAR(actual, expected,
+                    kRelativeTolerance * std::max(1.0, std::abs(expected)));
+      }
+    }
+  }
+}
+
+TEST(SampsonCoplanarityError, IsSignedPixelDistanceToFirstOrder) {
+  // Moving the four pixels by s px along the unit pixel gradient of e
+  // moves the residual by s, up to O(s^2) curvature of the locus.
+  constexpr double kStepPx = 0.01;
+  constexpr double kTolerancePx = 1e-5;  // curvature term, ~ step^2 / 10
+  using Jet = ceres::Jet<double, 4>;
+  const StereoRig rig = test::AlphasenseRealisticRig();
+  const Eigen::Matrix3d essential = EssentialMatrix(rig.right_from_left());
+  for (StereoCorrespondence match : test::ExactMatches(rig, 1.333, 100)) {
+    const Jet left_pixel[2] = {Jet(match.left_pixel.x(), 0),
+                               Jet(match.left_pixel.y(), 1)};
+    const Jet right_pixel[2] = {Jet(match.right_pixel.x(), 2),
+                                Jet(match.right_pixel.y(), 3)};
+    Jet left[2], right[2];
+    ASSERT_TRUE(rig.left().NormalizedFromImage(left_pixel, left));
+    ASSERT_TRUE(rig.right().NormalizedFromImage(right_pixel, right));
+    const Eigen::Vector4d direction =
+        CoplanarityResidual(essential, Jet(1.333), left, right).v.normalized();
+    match.left_pixel += kStepPx * direction.head<2>();
+    match.right_pixel += kStepPx * direction.tail<2>();
+    EXPECT_NEAR(Residual(rig, match, 1.333), kStepPx, kTolerancePx);
+  }
+}
+
+TEST(SampsonCoplanarityError, HasThePixelNoiseAsStandardDeviation) {
+  // Under Gaussian noise sigma on the four pixels, r ~ N(0, sigma^2) to
+  // first order. The sample standard deviation of 20000 residuals has a
+  // relative sampling error of 1/sqrt(2 * 20000) = 0.5 %; 2 % allows 4 of
+  // those.
+  constexpr double kSigmaPx = 0.5;
+  constexpr int kCount = 20000;
+  constexpr double kRelativeTolerance = 0.02;
+  const StereoRig rig = test::AlphasenseRealisticRig();
+  std::vector<StereoCorrespondence> data =
+      test::ExactMatches(rig, 1.333, kCount, 11);
+  AddPixelNoise(kSigmaPx, 12, &data);
+  double sum = 0.0, sum_squares = 0.0;
+  for (const StereoCorrespondence& match : data) {
+    const double r = Residual(rig, match, 1.333);
+    sum += r;
+    sum_squares += r * r;
+  }
+  const double mean = sum / kCount;
+  const double deviation = std::sqrt(sum_squares / kCount - mean * mean);
+  EXPECT_NEAR(deviation, kSigmaPx, kRelativeTolerance * kSigmaPx);
+  EXPECT_LT(std::abs(mean), 4.0 * kSigmaPx / std::sqrt(kCount));
+}
+
+TEST(SampsonCoplanarityError, DoesNotDependOnTheBaselineLength) {
+  constexpr double kRelativeTolerance = 1e-12;  // the unit t of E
+  const StereoRig rig = test::AlphasenseRealisticRig();
+  Rigid3d longer = rig.right_from_left();
+  longer.translation *= 7.0;
+  const StereoRig scaled =
+      StereoRig::Create(rig.left(), rig.right(), longer).value();
+  std::vector<StereoCorrespondence> data = test::ExactMatches(rig, 1.333, 50);
+  AddPixelNoise(0.5, 4, &data);
+  for (const StereoCorrespondence& match : data) {
+    const double r = Residual(rig, match, 1.4);
+    EXPECT_NEAR(Residual(scaled, match, 1.4), r,
+                kRelativeTolerance * std::max(1.0, std::abs(r)));
+  }
+}
+
+TEST(SampsonCoplanarityError, ZeroRotationEqualsNoRotation) {
+  const StereoRig rig = test::AlphasenseRealisticRig();
+  std::vector<StereoCorrespondence> data = test::ExactMatches(rig, 1.333, 50);
+  AddPixelNoise(0.5, 5, &data);
+  const double zero[3] = {0.0, 0.0, 0.0};
+  for (const StereoCorrespondence& match : data) {
+    EXPECT_EQ(Residual(rig, match, 1.3, zero), Residual(rig, match, 1.3));
+  }
+}
+
+TEST(SampsonCoplanarityError, CeresJacobianMatchesCentralDifferences) {
+  // Central differences with step h have error ~ h^2 r''' / 6 ~ 1e-10 for
+  // h = 1e-5 and derivatives of order 10 px per unit; roundoff adds
+  // ~1e-16 / h ~ 1e-11.
+  constexpr double kStep = 1e-5;
+  constexpr double kTolerance = 1e-7;
+  const StereoRig rig = test::AlphasenseRealisticRig();
+  const Eigen::Matrix3d essential = EssentialMatrix(rig.right_from_left());
+  std::vector<StereoCorrespondence> data = test::ExactMatches(rig, 1.333, 40);
+  AddPixelNoise(0.5, 6, &data);
+  for (const StereoCorrespondence& match : data) {
+    const PreparedCorrespondence prepared =
+        PrepareCorrespondence(rig, match).value();
+    std::unique_ptr<ceres::CostFunction> cost(
+        SampsonCoplanarityError::CreateWithRotation(essential, prepared));
+    double parameters[4] = {1.35, 0.001, -0.002, 0.0015};
+    const double* blocks[2] = {&parameters[0], &parameters[1]};
+    double residual;
+    double jacobian_n[1], jacobian_rotation[3];
+    double* jacobians[2] = {jacobian_n, jacobian_rotation};
+    ASSERT_TRUE(cost->Evaluate(blocks, &residual, jacobians));
+    const double analytic[4] = {jacobian_n[0], jacobian_rotation[0],
+                                jacobian_rotation[1], jacobian_rotation[2]};
+    for (int k = 0; k < 4; ++k) {
+      double plus[4], minus[4];
+      std::copy(parameters, parameters + 4, plus);
+      std::copy(parameters, parameters + 4, minus);
+      plus[k] += kStep;
+      minus[k] -= kStep;
+      double r_plus, r_minus;
+      const double* blocks_plus[2] = {&plus[0], &plus[1]};
+      const double* blocks_minus[2] = {&minus[0], &minus[1]};
+      ASSERT_TRUE(cost->Evaluate(blocks_plus, &r_plus, nullptr));
+      ASSERT_TRUE(cost->Evaluate(blocks_minus, &r_minus, nullptr));
+      const double numeric = (r_plus - r_minus) / (2.0 * kStep);
+      EXPECT_NEAR(analytic[k], numeric,
+                  kTolerance * std::max(1.0, std::abs(numeric)))
+          << "parameter " << k;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace rcm
