@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstring>
 #include <iostream>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -17,6 +18,13 @@ namespace {
 bool IsHelpFlag(std::string_view arg) {
   return arg == "-h" || arg == "--help" || arg == "-help" ||
          arg == "--helpfull";
+}
+
+// Flags are defined with underscores (gflags' convention) and shown with
+// dashes; gflags accepts both spellings on the command line.
+std::string DashedName(std::string name) {
+  std::replace(name.begin(), name.end(), '_', '-');
+  return name;
 }
 
 // Flags of this file and of the subcommand's own file.
@@ -33,7 +41,7 @@ void PrintHelp(const Subcommand& subcommand) {
             [](const auto& a, const auto& b) { return a.name < b.name; });
   for (const gflags::CommandLineFlagInfo& flag : flags) {
     if (!OwnsFlag(subcommand, flag)) continue;
-    std::cout << "  --" << flag.name;
+    std::cout << "  --" << DashedName(flag.name);
     if (flag.type != "bool") std::cout << "=" << flag.type;
     std::cout << "\n      " << flag.description;
     if (!flag.default_value.empty() && flag.default_value != "false") {
@@ -63,6 +71,7 @@ int ParseSubcommandFlags(const Subcommand& subcommand, int* argc,
     if (arg.size() < 2 || arg[0] != '-') continue;
     arg.remove_prefix(arg[1] == '-' ? 2 : 1);
     std::string name(arg.substr(0, arg.find('=')));
+    std::replace(name.begin(), name.end(), '-', '_');
     gflags::CommandLineFlagInfo flag;
     bool found = gflags::GetCommandLineFlagInfo(name.c_str(), &flag);
     if (!found && name.rfind("no", 0) == 0) {
@@ -71,9 +80,9 @@ int ParseSubcommandFlags(const Subcommand& subcommand, int* argc,
     }
     if (!found) continue;  // unknown: gflags reports it below
     if (!OwnsFlag(subcommand, flag)) {
-      PrintError(subcommand, "--" + name + " is not a flag of rcm " +
-                                 subcommand.name + " (see rcm " +
-                                 subcommand.name + " --help)");
+      PrintError(subcommand, "--" + DashedName(name) +
+                                 " is not a flag of rcm " + subcommand.name +
+                                 " (see rcm " + subcommand.name + " --help)");
       return kExitUsage;
     }
   }

@@ -1,17 +1,22 @@
 // rcm estimate: the refractive index n from stereo correspondences.
 #include <gflags/gflags.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "command.h"
+#include "rcm/estimation/batch_refinement.h"
 #include "rcm/estimation/paper_online_estimator.h"
+#include "rcm/estimation/refinement_options.h"
 #include "rcm/io/atomic_file.h"
 #include "rcm/io/correspondence_csv.h"
 #include "rcm/io/stereo_rig_file.h"
@@ -24,17 +29,32 @@ DEFINE_string(calib, "",
 DEFINE_string(matches, "",
               "correspondence CSV with header frame,xl,yl,xr,yr[,t] in raw "
               "pixels (required)");
-DEFINE_string(estimator, "closed-form",
-              "closed-form: the paper's estimator (eq. 14 per match, "
-              "observability mask, radially weighted mean, Sec. III-E)");
+DEFINE_string(estimator, "refine",
+              "refine: robust least squares over all frames (the estimator "
+              "of record); closed-form: the paper's baseline (eq. 14, mask, "
+              "radially weighted mean)");
 DEFINE_string(left, "cam0", "camchain camera that is the left one");
 DEFINE_string(right, "cam1", "camchain camera that is the right one");
+DEFINE_string(per_frame, "",
+              "also write one row per frame to this CSV: frame,t,n,sigma_n,"
+              "switch (refine: each frame's own estimate; closed-form: the "
+              "running estimate)");
+DEFINE_string(loss, "cauchy",
+              "robust loss of the refinement's first stage: cauchy, huber or "
+              "none");
+DEFINE_double(loss_scale, 1.0,
+              "scale of the robust loss, in pixels of distance from the "
+              "refractive epipolar locus");
+DEFINE_double(inlier_threshold, 2.0,
+              "matches within this many pixels of their locus (and in front "
+              "of both cameras) are the inliers of the final least squares; "
+              "inf keeps all");
+DEFINE_bool(refine_rotation, false,
+            "refine: also estimate a small rotation correction of cam1 "
+            "(reported with its correlation with n)");
 DEFINE_double(mask_eta, 0.3,
-              "observability mask: use a match when sqrt|u| sqrt|v| > eta, "
-              "(u, v) its normalized left coordinates");
-DEFINE_string(per_frame_csv, "",
-              "also write the running estimate after each frame to this CSV "
-              "(frame,t,used,n,standard_error)");
+              "closed-form: use a match when sqrt|u| sqrt|v| > eta, (u, v) "
+              "its normalized left coordinates");
 
 namespace rcm::cli {
 namespace {
@@ -42,10 +62,17 @@ namespace {
 constexpr char kUsage[] =
     "rcm estimate: the refractive index n of the medium from stereo\n"
     "correspondences of a rig calibrated in air.\n\n"
-    "usage: rcm estimate --calib RIG.yaml --matches MATCHES.csv "
-    "[--estimator closed-form] [--json]\n\n"
-    "The closed-form estimator is the paper's baseline; it assumes a "
-    "rectified rig\nand is biased under pixel noise (DESIGN.md Sec. 2).";
+    "usage: rcm estimate --calib RIG.yaml --matches MATCHES.csv\n"
+    "                    [--estimator refine|closed-form] [--per-frame "
+    "OUT.csv] [--json]\n\n"
+    "refine fits n to the distance of every match from its refractive "
+    "epipolar\nlocus (Sampson distance, pixels) over all frames: a robust "
+    "stage that finds n\namong outliers, then least squares on the inliers, "
+    "whose covariance gives\nsigma_n. It works on any calibrated rig. "
+    "closed-form is the paper's baseline;\nit assumes a rectified rig and is "
+    "biased under pixel noise (DESIGN.md Sec. 2).\n\n"
+    "Exit status: 0 on success, 1 when the input cannot give an estimate, "
+    "2 on\nwrong flags.";
 
 // Above this deviation from a rectified pair the closed form is biased.
 constexpr double kRectifiedToleranceDeg = 0.05;
@@ -61,37 +88,241 @@ std::string FormatFixed(double value, int digits) {
   return out.str();
 }
 
-// The q-quantile of sorted values (linear interpolation).
-double Quantile(const std::vector<double>& sorted, double q) {
-  const double position = q * (sorted.size() - 1);
-  const size_t below = static_cast<size_t>(std::floor(position));
-  const size_t above = std::min(below + 1, sorted.size() - 1);
-  return sorted[below] + (position - below) * (sorted[above] - sorted[below]);
+// JSON number, or null when not finite.
+nlohmann::json JsonNumber(double value) {
+  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json();
+}
+nlohmann::json JsonNumber(const std::optional<double>& value) {
+  return value ? JsonNumber(*value) : nlohmann::json();
 }
 
-// The running estimate after one frame, for --per_frame_csv.
-struct FrameRow {
-  int64_t frame;
+// One frame of the input: consecutive correspondences with equal `frame`.
+struct Frame {
+  int64_t frame = 0;
   std::optional<double> timestamp;
-  int64_t used;
-  double n;
-  double standard_error;
+  std::vector<StereoCorrespondence> matches;
+};
+
+std::vector<Frame> SplitFrames(
+    const std::vector<StereoCorrespondence>& matches) {
+  std::vector<Frame> frames;
+  for (const StereoCorrespondence& match : matches) {
+    if (frames.empty() || frames.back().frame != match.frame) {
+      frames.push_back({match.frame, match.timestamp, {}});
+    }
+    frames.back().matches.push_back(match);
+  }
+  return frames;
+}
+
+// A row of --per-frame.
+struct FrameRow {
+  int64_t frame = 0;
+  std::optional<double> timestamp;
+  double n = NAN;
+  double sigma_n = NAN;
+  bool medium_switch = false;
 };
 
 std::string FormatFrameRows(const std::vector<FrameRow>& rows) {
   std::ostringstream out;
   out.precision(17);
-  out << "frame,t,used,n,standard_error\n";
+  out << "frame,t,n,sigma_n,switch\n";
   for (const FrameRow& row : rows) {
     out << row.frame << ",";
     if (row.timestamp) out << *row.timestamp;
-    out << "," << row.used << ",";
+    out << ",";
     if (std::isfinite(row.n)) out << row.n;
     out << ",";
-    if (std::isfinite(row.standard_error)) out << row.standard_error;
-    out << "\n";
+    if (std::isfinite(row.sigma_n)) out << row.sigma_n;
+    out << "," << (row.medium_switch ? 1 : 0) << "\n";
   }
   return out.str();
+}
+
+// Shows "frame k of N" on a terminal (stderr) for runs long enough to
+// wait for; silent when stderr is redirected.
+class Progress {
+ public:
+  Progress(const char* what, size_t total)
+      : what_(what), total_(total), enabled_(isatty(STDERR_FILENO) != 0) {}
+  ~Progress() {
+    if (shown_) std::cerr << "\r\033[K" << std::flush;
+  }
+  void Update(size_t done) {
+    if (!enabled_ || total_ < 2) return;
+    std::cerr << "\r" << what_ << " " << done << " of " << total_ << " ("
+              << (100 * done / total_) << " %)" << std::flush;
+    shown_ = true;
+  }
+
+ private:
+  const char* what_;
+  size_t total_;
+  bool enabled_;
+  bool shown_ = false;
+};
+
+// What every estimator reports; fields an estimator does not have stay
+// NaN / empty and print as null.
+struct Report {
+  std::string method;  // one line for the text report
+  double n = NAN;
+  double sigma_n = NAN;
+  double crlb = NAN;
+  double sigma_px = NAN;
+  std::optional<double> n_closed_form;
+  int64_t inliers = 0;
+  int64_t invalid = 0;
+  std::vector<FrameRow> rows;
+  nlohmann::json extra = nlohmann::json::object();
+  std::vector<std::string> text_lines;  // estimator-specific lines
+};
+
+RefinementOptions RefinementOptionsFromFlags() {
+  RefinementOptions options;
+  options.loss = RobustLossFromName(FLAGS_loss).value_or(RobustLoss::kCauchy);
+  options.loss_scale_px = FLAGS_loss_scale;
+  options.inlier_threshold_px = FLAGS_inlier_threshold;
+  options.refine_rotation = FLAGS_refine_rotation;
+  return options;
+}
+
+std::string LossDescription(const RefinementOptions& options) {
+  std::string loss(RobustLossName(options.loss));
+  if (options.loss != RobustLoss::kNone) {
+    loss += " " + FormatFixed(options.loss_scale_px, 2) + " px";
+  }
+  return loss;
+}
+
+StatusOr<Report> RunRefine(const StereoRig& rig,
+                           const std::vector<StereoCorrespondence>& matches,
+                           const std::vector<Frame>& frames,
+                           const RefinementOptions& options) {
+  StatusOr<RefinementSummary> summary =
+      RefineRefractiveIndex(rig, matches, options);
+  if (!summary.ok()) return summary.status();
+  Report report;
+  report.method =
+      "robust least squares on the refractive epipolar loci (loss " +
+      LossDescription(options) + ", inliers within " +
+      FormatFixed(options.inlier_threshold_px, 2) + " px)";
+  report.n = summary->n;
+  report.sigma_n = summary->sigma_n;
+  report.crlb = summary->crlb;
+  report.sigma_px = summary->sigma_px;
+  report.n_closed_form = summary->n_closed_form;
+  report.inliers = static_cast<int64_t>(summary->inliers.size());
+  report.invalid = summary->num_invalid;
+  report.extra["n_seed"] = summary->n_seed;
+  report.extra["n_robust"] = summary->n_robust;
+  report.extra["cost"] = summary->cost;
+  report.extra["iterations"] = summary->num_iterations;
+  report.text_lines.push_back(
+      "  seeds      closed form " +
+      (summary->n_closed_form ? FormatFixed(*summary->n_closed_form, 4)
+                              : std::string("n/a")) +
+      ", scan " + FormatFixed(summary->n_seed, 4) + ", robust stage " +
+      FormatFixed(summary->n_robust, 5));
+  if (summary->rotation) {
+    const RotationCorrection& rotation = *summary->rotation;
+    const Eigen::Vector3d degrees = rotation.angle_axis * 180.0 / M_PI;
+    const Eigen::Vector3d sigma_degrees = rotation.sigma * 180.0 / M_PI;
+    report.extra["rotation"] = {
+        {"angle_axis_deg", {degrees.x(), degrees.y(), degrees.z()}},
+        {"sigma_deg",
+         {sigma_degrees.x(), sigma_degrees.y(), sigma_degrees.z()}},
+        {"correlation_with_n",
+         {rotation.correlation_with_n.x(), rotation.correlation_with_n.y(),
+          rotation.correlation_with_n.z()}},
+        {"multiple_correlation_with_n", rotation.multiple_correlation_with_n}};
+    std::ostringstream line;
+    line << "  rotation   cam1 corrected by (" << FormatFixed(degrees.x(), 4)
+         << ", " << FormatFixed(degrees.y(), 4) << ", "
+         << FormatFixed(degrees.z(), 4) << ") deg +- ("
+         << FormatFixed(sigma_degrees.x(), 4) << ", "
+         << FormatFixed(sigma_degrees.y(), 4) << ", "
+         << FormatFixed(sigma_degrees.z(), 4) << "); correlation with n R = "
+         << FormatFixed(rotation.multiple_correlation_with_n, 2);
+    report.text_lines.push_back(line.str());
+  }
+  if (!FLAGS_per_frame.empty()) {
+    // Each frame's own estimate, for a look at how n varies over time.
+    RefinementOptions frame_options = options;
+    frame_options.num_threads = 1;
+    Progress progress("rcm estimate: per-frame estimates, frame",
+                      frames.size());
+    for (size_t i = 0; i < frames.size(); ++i) {
+      progress.Update(i + 1);
+      FrameRow row{frames[i].frame, frames[i].timestamp};
+      const StatusOr<RefinementSummary> own =
+          RefineRefractiveIndex(rig, frames[i].matches, frame_options);
+      if (own.ok()) {
+        row.n = own->n;
+        row.sigma_n = own->sigma_n;
+      }
+      report.rows.push_back(row);
+    }
+  }
+  return report;
+}
+
+StatusOr<Report> RunClosedForm(const StereoRig& rig,
+                               const std::vector<Frame>& frames,
+                               const Subcommand& command) {
+  PaperOnlineEstimatorOptions options;
+  options.eta = FLAGS_mask_eta;
+  const StereoRig::RectificationDeviation deviation =
+      rig.DeviationFromRectified();
+  const double deviation_deg =
+      Degrees(std::max(deviation.rotation, deviation.baseline_off_axis));
+  if (deviation_deg > kRectifiedToleranceDeg) {
+    PrintWarning(command,
+                 "the rig is " + FormatFixed(deviation_deg, 2) +
+                     " deg from a rectified pair; the closed form assumes "
+                     "one and is biased on this rig");
+  }
+  PaperOnlineEstimator estimator(rig, options);
+  Report report;
+  for (const Frame& frame : frames) {
+    for (const StereoCorrespondence& match : frame.matches) {
+      estimator.Add(match);
+    }
+    const std::optional<PaperOnlineEstimator::Estimate> current =
+        estimator.Current();
+    FrameRow row{frame.frame, frame.timestamp};
+    if (current) {
+      row.n = current->n;
+      row.sigma_n = current->standard_error;
+    }
+    report.rows.push_back(row);
+  }
+  const std::optional<PaperOnlineEstimator::Estimate> estimate =
+      estimator.Current();
+  if (!estimate) {
+    return Status::Error(
+        "no usable correspondence: " + std::to_string(estimator.num_masked()) +
+        " removed by the observability mask, " +
+        std::to_string(estimator.num_invalid()) +
+        " invalid; matches near the image axes do not observe n (lower "
+        "--mask-eta to keep more)");
+  }
+  report.method = "closed form (eq. 14), mask sqrt|u|sqrt|v| > " +
+                  FormatFixed(options.eta, 2) +
+                  ", radially weighted mean (eq. 17)";
+  report.n = estimate->n;
+  report.sigma_n = estimate->standard_error;
+  report.inliers = estimator.num_used();
+  report.invalid = estimator.num_invalid();
+  report.n_closed_form = estimate->n;
+  report.extra["masked"] = estimator.num_masked();
+  report.extra["mask_eta"] = options.eta;
+  report.text_lines.push_back(
+      "  used       " + std::to_string(estimator.num_used()) + " (masked " +
+      std::to_string(estimator.num_masked()) + ", invalid " +
+      std::to_string(estimator.num_invalid()) + ")");
+  return report;
 }
 
 int RunEstimate();
@@ -114,15 +345,27 @@ int RunEstimate() {
     PrintError(command, "--matches is required (see rcm estimate --help)");
     return kExitUsage;
   }
-  if (FLAGS_estimator != "closed-form") {
+  const std::vector<std::string> estimators = {"refine", "closed-form"};
+  if (std::find(estimators.begin(), estimators.end(), FLAGS_estimator) ==
+      estimators.end()) {
     PrintError(command, "unknown estimator '" + FLAGS_estimator +
-                            "' (available: closed-form)");
+                            "' (available: refine, closed-form)");
     return kExitUsage;
   }
-  PaperOnlineEstimatorOptions options;
-  options.eta = FLAGS_mask_eta;
-  if (const Status status = options.Check(); !status.ok()) {
-    PrintError(command, "--mask_eta: " + status.message());
+  if (!RobustLossFromName(FLAGS_loss)) {
+    PrintError(command, "unknown loss '" + FLAGS_loss +
+                            "' (available: cauchy, huber, none)");
+    return kExitUsage;
+  }
+  const RefinementOptions refinement = RefinementOptionsFromFlags();
+  if (const Status status = refinement.Check(); !status.ok()) {
+    PrintError(command, status.message());
+    return kExitUsage;
+  }
+  PaperOnlineEstimatorOptions paper_options;
+  paper_options.eta = FLAGS_mask_eta;
+  if (const Status status = paper_options.Check(); !status.ok()) {
+    PrintError(command, "--mask-eta: " + status.message());
     return kExitUsage;
   }
 
@@ -132,85 +375,52 @@ int RunEstimate() {
     PrintError(command, rig.status().message());
     return kExitFailure;
   }
-  const StatusOr<std::vector<StereoCorrespondence>> matches =
+  StatusOr<std::vector<StereoCorrespondence>> matches =
       ReadCorrespondenceCsv(FLAGS_matches);
   if (!matches.ok()) {
     PrintError(command, matches.status().message());
     return kExitFailure;
   }
+  // Frames in time order; matches of a frame stay in file order.
+  std::stable_sort(
+      matches->begin(), matches->end(),
+      [](const StereoCorrespondence& a, const StereoCorrespondence& b) {
+        return a.frame < b.frame;
+      });
+  const std::vector<Frame> frames = SplitFrames(*matches);
 
-  const StereoRig::RectificationDeviation deviation =
-      rig->DeviationFromRectified();
-  const double deviation_deg =
-      Degrees(std::max(deviation.rotation, deviation.baseline_off_axis));
-  if (deviation_deg > kRectifiedToleranceDeg) {
-    PrintWarning(command,
-                 "the rig is " + FormatFixed(deviation_deg, 2) +
-                     " deg from a rectified pair; the closed form assumes "
-                     "one and is biased on this rig");
-  }
-
-  PaperOnlineEstimator estimator(*rig, options);
-  std::vector<double> per_match;
-  std::vector<FrameRow> frame_rows;
-  per_match.reserve(matches->size());
-  for (size_t i = 0; i < matches->size(); ++i) {
-    const StereoCorrespondence& match = (*matches)[i];
-    const PaperOnlineEstimator::Contribution contribution =
-        estimator.Add(match);
-    if (contribution.outcome == PaperOnlineEstimator::Outcome::kUsed) {
-      per_match.push_back(contribution.n);
-    }
-    const bool frame_ends =
-        i + 1 == matches->size() || (*matches)[i + 1].frame != match.frame;
-    if (frame_ends) {
-      const std::optional<PaperOnlineEstimator::Estimate> current =
-          estimator.Current();
-      frame_rows.push_back({match.frame, match.timestamp, estimator.num_used(),
-                            current ? current->n : std::nan(""),
-                            current ? current->standard_error : std::nan("")});
-    }
-  }
-
-  const size_t num_frames = frame_rows.size();
-  const std::optional<PaperOnlineEstimator::Estimate> estimate =
-      estimator.Current();
-  if (!estimate) {
-    PrintError(
-        command,
-        "no usable correspondence: " + std::to_string(estimator.num_masked()) +
-            " removed by the observability mask, " +
-            std::to_string(estimator.num_invalid()) +
-            " invalid; matches near the image axes do not observe n "
-            "(lower --mask_eta to keep more)");
+  const StatusOr<Report> report =
+      FLAGS_estimator == "closed-form"
+          ? RunClosedForm(*rig, frames, command)
+          : RunRefine(*rig, *matches, frames, refinement);
+  if (!report.ok()) {
+    PrintError(command, report.status().message());
     return kExitFailure;
   }
-  if (!FLAGS_per_frame_csv.empty()) {
+  if (!FLAGS_per_frame.empty()) {
     const Status written =
-        WriteFileAtomically(FLAGS_per_frame_csv, FormatFrameRows(frame_rows));
+        WriteFileAtomically(FLAGS_per_frame, FormatFrameRows(report->rows));
     if (!written.ok()) {
       PrintError(command, written.message());
       return kExitFailure;
     }
   }
 
-  std::sort(per_match.begin(), per_match.end());
-  const double median = Quantile(per_match, 0.5);
-  const double low = Quantile(per_match, 0.16);
-  const double high = Quantile(per_match, 0.84);
-
+  const StereoRig::RectificationDeviation deviation =
+      rig->DeviationFromRectified();
   if (FLAGS_json) {
     nlohmann::json out;
     out["estimator"] = FLAGS_estimator;
-    out["n"] = estimate->n;
-    out["standard_error"] = estimate->standard_error;  // NaN -> null
+    out["n"] = JsonNumber(report->n);
+    out["sigma_n"] = JsonNumber(report->sigma_n);
+    out["n_closed_form"] = JsonNumber(report->n_closed_form);
+    out["crlb"] = JsonNumber(report->crlb);
+    out["sigma_px"] = JsonNumber(report->sigma_px);
+    out["inliers"] = report->inliers;
+    out["invalid"] = report->invalid;
     out["correspondences"] = matches->size();
-    out["frames"] = num_frames;
-    out["used"] = estimator.num_used();
-    out["masked"] = estimator.num_masked();
-    out["invalid"] = estimator.num_invalid();
-    out["mask_eta"] = options.eta;
-    out["per_match"] = {{"median", median}, {"p16", low}, {"p84", high}};
+    out["frames"] = frames.size();
+    out.update(report->extra);
     out["rig"] = {
         {"calib", FLAGS_calib},
         {"left", FLAGS_left},
@@ -223,23 +433,35 @@ int RunEstimate() {
     return kExitOk;
   }
 
-  std::cout << "rcm estimate: closed form (eq. 14), mask sqrt|u|sqrt|v| > "
-            << options.eta << ", radially weighted mean (eq. 17)\n"
-            << "  rig        " << FLAGS_calib << " (" << FLAGS_left << " left, "
-            << FLAGS_right << " right), baseline "
-            << FormatFixed(rig->Baseline(), 4) << " m, "
-            << FormatFixed(deviation_deg, 3) << " deg from rectified\n"
-            << "  matches    " << FLAGS_matches << ": " << matches->size()
-            << " correspondences in " << num_frames << " frame"
-            << (num_frames == 1 ? "" : "s") << "\n"
-            << "  used       " << estimator.num_used() << " (masked "
-            << estimator.num_masked() << ", invalid " << estimator.num_invalid()
-            << ")\n"
-            << "  n          " << FormatFixed(estimate->n, 5) << " +- "
-            << FormatFixed(estimate->standard_error, 5) << " (standard error)\n"
-            << "  per match  median " << FormatFixed(median, 5) << ", 16-84 % ["
-            << FormatFixed(low, 5) << ", " << FormatFixed(high, 5) << "]"
-            << std::endl;
+  const double deviation_deg =
+      Degrees(std::max(deviation.rotation, deviation.baseline_off_axis));
+  std::ostringstream text;
+  text << "rcm estimate: " << report->method << "\n"
+       << "  rig        " << FLAGS_calib << " (" << FLAGS_left << " left, "
+       << FLAGS_right << " right), baseline " << FormatFixed(rig->Baseline(), 4)
+       << " m, " << FormatFixed(deviation_deg, 3) << " deg from rectified\n"
+       << "  matches    " << FLAGS_matches << ": " << matches->size()
+       << " correspondences in " << frames.size() << " frame"
+       << (frames.size() == 1 ? "" : "s") << "\n";
+  if (FLAGS_estimator != "closed-form") {
+    text << "  inliers    " << report->inliers << " (" << report->invalid
+         << " could not be undistorted)\n";
+  }
+  for (const std::string& line : report->text_lines) text << line << "\n";
+  if (FLAGS_estimator == "closed-form") {
+    text << "  n          " << FormatFixed(report->n, 5) << " +- "
+         << FormatFixed(report->sigma_n, 5) << " (standard error)\n";
+  } else {
+    text << "  n          " << FormatFixed(report->n, 5) << " +- "
+         << FormatFixed(report->sigma_n, 5) << " (1 sigma; Cramer-Rao bound "
+         << FormatFixed(report->crlb, 5) << ")\n"
+         << "  pixel noise " << FormatFixed(report->sigma_px, 3)
+         << " px (estimated from the inliers)\n";
+  }
+  if (!FLAGS_per_frame.empty()) {
+    text << "  per frame  " << FLAGS_per_frame << "\n";
+  }
+  std::cout << text.str() << std::flush;
   return kExitOk;
 }
 

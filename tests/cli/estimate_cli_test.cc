@@ -62,19 +62,50 @@ void ExpectFailsWithOneLine(const RunResult& result, int exit_code,
 }
 
 TEST(EstimateCli, ExactDataGiveTrueIndexAsJson) {
+  // The refinement is exact to 1e-9 on exact data (batch_refinement_test).
   const RunResult result = Rcm({"estimate", "--calib", kRig, "--matches",
                                 ExactMatches(1.333), "--json"});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_TRUE(result.err.empty()) << result.err;
   const nlohmann::json json = nlohmann::json::parse(result.out);
+  EXPECT_EQ(json["estimator"], "refine");
   EXPECT_NEAR(json["n"].get<double>(), 1.333, 1e-9);
+  EXPECT_LT(json["sigma_n"].get<double>(), 1e-9);
+  EXPECT_LT(json["crlb"].get<double>(), 1e-9);
+  EXPECT_NEAR(json["n_closed_form"].get<double>(), 1.333, 1e-9);
+  EXPECT_EQ(json["inliers"].get<int>(), 1000);
   EXPECT_EQ(json["correspondences"].get<int>(), 1000);
   EXPECT_EQ(json["frames"].get<int>(), 4);
-  EXPECT_EQ(json["used"].get<int>() + json["masked"].get<int>() +
+}
+
+TEST(EstimateCli, ClosedFormOnExactData) {
+  const RunResult result =
+      Rcm({"estimate", "--calib", kRig, "--matches", ExactMatches(1.333),
+           "--estimator", "closed-form", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json json = nlohmann::json::parse(result.out);
+  EXPECT_EQ(json["estimator"], "closed-form");
+  EXPECT_NEAR(json["n"].get<double>(), 1.333, 1e-9);
+  EXPECT_EQ(json["inliers"].get<int>() + json["masked"].get<int>() +
                 json["invalid"].get<int>(),
             1000);
-  EXPECT_GT(json["used"].get<int>(), 500);
-  EXPECT_EQ(json["estimator"], "closed-form");
+  EXPECT_GT(json["inliers"].get<int>(), 500);
+  EXPECT_TRUE(json["crlb"].is_null());
+}
+
+TEST(EstimateCli, RefineRotationIsReported) {
+  const RunResult result = Rcm({"estimate", "--calib", kRig, "--matches",
+                                kDemoMatches, "--refine-rotation", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json json = nlohmann::json::parse(result.out);
+  ASSERT_TRUE(json.contains("rotation")) << result.out;
+  EXPECT_EQ(json["rotation"]["angle_axis_deg"].size(), 3u);
+  const double correlation =
+      json["rotation"]["multiple_correlation_with_n"].get<double>();
+  EXPECT_GE(correlation, 0.0);
+  EXPECT_LT(correlation, 1.0);
+  // Estimating the rotation too can only widen sigma_n.
+  EXPECT_GE(json["sigma_n"].get<double>(), json["crlb"].get<double>());
 }
 
 TEST(EstimateCli, DemoDataTextReport) {
@@ -86,6 +117,8 @@ TEST(EstimateCli, DemoDataTextReport) {
       << result.out;
   EXPECT_NE(result.out.find("  n          1.3"), std::string::npos)
       << result.out;
+  EXPECT_NE(result.out.find("Cramer-Rao bound"), std::string::npos)
+      << result.out;
 }
 
 TEST(EstimateCli, PerFrameCsvHasOneRowPerFrame) {
@@ -93,11 +126,13 @@ TEST(EstimateCli, PerFrameCsvHasOneRowPerFrame) {
   std::filesystem::remove(per_frame);
   const RunResult result =
       Rcm({"estimate", "--calib", kRig, "--matches", kDemoMatches,
-           "--per_frame_csv", per_frame, "--json"});
+           "--per-frame", per_frame, "--json"});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const std::string text = test::ReadWholeFile(per_frame);
-  EXPECT_EQ(text.rfind("frame,t,used,n,standard_error\n", 0), 0u);
+  EXPECT_EQ(text.rfind("frame,t,n,sigma_n,switch\n", 0), 0u);
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 11);
+  // The rows are the correspondence CSV's frames with their timestamps.
+  EXPECT_NE(text.find("\n9,0.45"), std::string::npos) << text;
 }
 
 TEST(EstimateCli, HelpListsOwnFlagsOnly) {
@@ -106,6 +141,8 @@ TEST(EstimateCli, HelpListsOwnFlagsOnly) {
   EXPECT_NE(result.out.find("--calib"), std::string::npos);
   EXPECT_NE(result.out.find("--matches"), std::string::npos);
   EXPECT_NE(result.out.find("--json"), std::string::npos);
+  EXPECT_NE(result.out.find("--per-frame"), std::string::npos);  // dashes
+  EXPECT_EQ(result.out.find("--per_frame"), std::string::npos);
   EXPECT_EQ(result.out.find("--logtostderr"), std::string::npos);  // glog's
 }
 
@@ -160,8 +197,20 @@ TEST(EstimateCli, UnknownEstimator) {
 
 TEST(EstimateCli, NegativeMaskThreshold) {
   ExpectFailsWithOneLine(Rcm({"estimate", "--calib", kRig, "--matches",
-                              kDemoMatches, "--mask_eta=-1"}),
-                         2, "--mask_eta");
+                              kDemoMatches, "--mask-eta=-1"}),
+                         2, "--mask-eta");
+}
+
+TEST(EstimateCli, UnknownLoss) {
+  ExpectFailsWithOneLine(Rcm({"estimate", "--calib", kRig, "--matches",
+                              kDemoMatches, "--loss", "tukey"}),
+                         2, "unknown loss 'tukey'");
+}
+
+TEST(EstimateCli, NonPositiveLossScale) {
+  ExpectFailsWithOneLine(Rcm({"estimate", "--calib", kRig, "--matches",
+                              kDemoMatches, "--loss-scale=0"}),
+                         2, "loss scale");
 }
 
 TEST(EstimateCli, MissingCalibFile) {
@@ -243,23 +292,43 @@ TEST(EstimateCli, EmptyCsv) {
                          1, "empty file");
 }
 
+// Matches whose left pixels lie on the row through the principal point
+// (normalized y = 0): on this rectified rig their loci are that row for
+// every n.
+std::string MatchesOnImageRow() {
+  std::string csv = "xl,yl,xr,yr\n";
+  for (int i = 0; i < 60; ++i) {
+    const double xl = 40.0 + 10.0 * i;
+    csv += std::to_string(xl) + ",271.0179819820658," +
+           std::to_string(xl - 5.0 - 0.5 * (i % 7)) + ",262.02195974034373\n";
+  }
+  return test::WriteTempFile("axis.csv", csv);
+}
+
 TEST(EstimateCli, AllMatchesOnImageAxes) {
-  // Degenerate geometry: every match on the horizontal axis (v = cy).
+  ExpectFailsWithOneLine(
+      Rcm({"estimate", "--calib", kRig, "--matches", MatchesOnImageRow()}), 1,
+      "do not observe n");
+  ExpectFailsWithOneLine(
+      Rcm({"estimate", "--calib", kRig, "--matches", MatchesOnImageRow(),
+           "--estimator", "closed-form"}),
+      1, "no usable correspondence");
+}
+
+TEST(EstimateCli, TooFewMatches) {
   ExpectFailsWithOneLine(
       Rcm({"estimate", "--calib", kRig, "--matches",
            test::WriteTempFile(
-               "axis.csv",
-               "xl,yl,xr,yr\n100,271.0179819820658,90,262.02195974034373\n"
-               "600,271.0179819820658,590,262.02195974034373\n")}),
-      1, "no usable correspondence");
+               "few.csv", "xl,yl,xr,yr\n100,100,90,98\n600,400,590,395\n")}),
+      1, "too few correspondences: 2 usable matches of 2");
 }
 
 TEST(EstimateCli, FailedRunWritesNoPerFrameCsv) {
   const std::string per_frame = test::TempFilePath("per_frame.csv");
   std::filesystem::remove(per_frame);
-  const RunResult result = Rcm({"estimate", "--calib", kRig, "--matches",
-                                test::WriteTempFile("empty2.csv", ""),
-                                "--per_frame_csv", per_frame});
+  const RunResult result =
+      Rcm({"estimate", "--calib", kRig, "--matches",
+           test::WriteTempFile("empty2.csv", ""), "--per-frame", per_frame});
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_FALSE(std::filesystem::exists(per_frame));
 }
@@ -272,7 +341,7 @@ TEST(EstimateCli, WarnsOnUnrectifiedRig) {
                    "  - [0.9998476951563913, 0.0, 0.01745240643728351, -0.11]\n"
                    "  - [0.0, 1.0, 0.0, 0.0]\n"
                    "  - [-0.01745240643728351, 0.0, 0.9998476951563913, 0.0]"),
-           "--matches", kDemoMatches});
+           "--matches", kDemoMatches, "--estimator", "closed-form"});
   EXPECT_EQ(result.exit_code, 0) << result.err;
   EXPECT_TRUE(IsOneLine(result.err)) << result.err;
   EXPECT_NE(
