@@ -1,11 +1,19 @@
 // Cost per correspondence of the closed form and the paper's estimator,
-// and of the first-order sigma (a Jet pass through both undistortions).
+// and of the first-order sigma (a Jet pass through both undistortions);
+// the Sampson residual of the refinement; and the refinement's run time
+// against the number of correspondences, which must grow linearly (the
+// complexity fit reported as BM_RefineRefractiveIndex_BigO).
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <vector>
 
+#include "rcm/estimation/batch_refinement.h"
 #include "rcm/estimation/closed_form.h"
 #include "rcm/estimation/paper_online_estimator.h"
+#include "rcm/estimation/prepared_correspondence.h"
+#include "rcm/estimation/sampson_coplanarity_error.h"
+#include "rcm/geometry/epipolar.h"
 #include "rcm/geometry/observability.h"
 #include "rcm/sim/reference_rigs.h"
 #include "rcm/sim/stereo_sampler.h"
@@ -13,9 +21,11 @@
 namespace rcm {
 namespace {
 
-std::vector<StereoCorrespondence> Matches(const StereoRig& rig) {
+std::vector<StereoCorrespondence> Matches(const StereoRig& rig,
+                                          int count = 4096) {
   StereoSamplerOptions options;
-  options.per_frame = 4096;
+  options.num_frames = std::max(1, count / 200);
+  options.per_frame = count / options.num_frames;
   std::vector<StereoCorrespondence> matches =
       SampleStereoCorrespondences(rig, options).value();
   AddPixelNoise(0.3, 1, &matches);
@@ -61,6 +71,60 @@ void BM_FirstOrderSigmaN(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_FirstOrderSigmaN);
+
+void BM_PrepareCorrespondence(benchmark::State& state) {
+  // Both undistortions and lens Jacobians: once per match and refinement.
+  const StereoRig rig = AlphasenseFrontUnrectifiedRig();
+  const std::vector<StereoCorrespondence> matches = Matches(rig);
+  size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(PrepareCorrespondence(rig, matches[i]));
+    i = (i + 1 == matches.size()) ? 0 : i + 1;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_PrepareCorrespondence);
+
+void BM_SampsonResidual(benchmark::State& state) {
+  // One evaluation of r(n) in double: the inner loop of the scan.
+  const StereoRig rig = AlphasenseFrontUnrectifiedRig();
+  const std::vector<PreparedCorrespondence> matches =
+      PrepareCorrespondences(rig, Matches(rig)).prepared;
+  const Eigen::Matrix3d essential = EssentialMatrix(rig.right_from_left());
+  size_t i = 0;
+  double residual;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(SampsonCoplanarityResidual<double>(
+        essential, matches[i], 1.333, nullptr, &residual));
+    benchmark::DoNotOptimize(residual);
+    i = (i + 1 == matches.size()) ? 0 : i + 1;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_SampsonResidual);
+
+void BM_RefineRefractiveIndex(benchmark::State& state) {
+  // The whole batch refinement (prepare, scan, robust and least-squares
+  // Ceres stages, covariance) with 0.5 px noise and 20 % outliers, on two
+  // threads.
+  const StereoRig rig = AlphasenseFrontUnrectifiedRig();
+  std::vector<StereoCorrespondence> matches =
+      Matches(rig, static_cast<int>(state.range(0)));
+  AddPixelNoise(0.5, 2, &matches);
+  AddOutliers(rig, 0.2, 3, &matches);
+  const RefinementOptions options;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(RefineRefractiveIndex(rig, matches, options));
+  }
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+  state.SetComplexityN(state.range(0));
+}
+BENCHMARK(BM_RefineRefractiveIndex)
+    ->RangeMultiplier(10)
+    ->Range(1000, 100000)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Complexity(benchmark::oN);
 
 }  // namespace
 }  // namespace rcm

@@ -44,16 +44,7 @@ StereoRig IdealRig(const Camera& left, const Camera& right, double baseline) {
 
 StereoRig AlphasenseIdealRig() { return AlphasenseFrontRectifiedRig(); }
 
-StereoRig AlphasenseRealisticRig() {
-  Rigid3d right_from_left;
-  right_from_left.rotation =
-      Eigen::AngleAxisd(0.5 * M_PI / 180.0,
-                        Eigen::Vector3d(0.3, 1.0, -0.4).normalized())
-          .toRotationMatrix();
-  right_from_left.translation = Eigen::Vector3d(-0.11, 0.0015, -0.002);
-  return StereoRig::Create(AlphasenseCam0(), AlphasenseCam1(), right_from_left)
-      .value();
-}
+StereoRig AlphasenseRealisticRig() { return AlphasenseFrontUnrectifiedRig(); }
 
 std::vector<StereoCorrespondence> ExactMatches(const StereoRig& rig, double n,
                                                int count, uint64_t seed) {

@@ -93,9 +93,9 @@ ceres::Solver::Summary Solve(const Eigen::Matrix3d& essential,
   solver_options.num_threads = options.num_threads;
   // Tight tolerances: one parameter (or four) and cheap iterations, and
   // the noise-free case must reach 1e-9 in n.
-  solver_options.function_tolerance = 1e-16;
+  solver_options.function_tolerance = 1e-14;
   solver_options.gradient_tolerance = 1e-16;
-  solver_options.parameter_tolerance = 1e-14;
+  solver_options.parameter_tolerance = 1e-12;
   solver_options.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
   ceres::Solve(solver_options, problem, &summary);
@@ -150,12 +150,21 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
   if (summary.n_closed_form) {
     candidate = std::clamp(*summary.n_closed_form, 1.0, 2.0);
   }
-  summary.n_seed = ScanRobustLocusCost(essential, matches, options, candidate);
   Parameters parameters;
-  parameters.n = summary.n_seed;
-  std::vector<int64_t> all(matches.size());
-  for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int64_t>(i);
-  {
+  if (!options.refine_rotation) {
+    // n alone: a 1-D search is exact and several times faster than a
+    // Ceres solve of the robust cost, whose Gauss-Newton model converges
+    // only linearly on it.
+    parameters.n = MinimizeRobustLocusCost(essential, matches, options,
+                                           candidate, &summary.n_seed);
+    summary.robust_cost =
+        0.5 * RobustLocusCost(essential, matches, parameters.n, options);
+  } else {
+    summary.n_seed =
+        ScanRobustLocusCost(essential, matches, options, candidate);
+    parameters.n = summary.n_seed;
+    std::vector<int64_t> all(matches.size());
+    for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int64_t>(i);
     ceres::Problem problem;
     const ceres::Solver::Summary stage1 = Solve(
         essential, matches, all, options.loss, options, &parameters, &problem);

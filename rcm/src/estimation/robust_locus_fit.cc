@@ -35,16 +35,33 @@ std::vector<double> LocusResiduals(
 double RobustLocusCost(const Eigen::Matrix3d& essential,
                        const std::vector<PreparedCorrespondence>& matches,
                        double n, const RefinementOptions& options) {
-  double cost = 0.0;
-  for (const PreparedCorrespondence& match : matches) {
-    double residual;
-    if (SampsonCoplanarityResidual<double>(essential, match, n, nullptr,
-                                           &residual) &&
-        std::isfinite(residual)) {
-      cost += RobustLossRho(options.loss, options.loss_scale_px,
-                            residual * residual);
+  const auto sum = [&](int64_t begin, int64_t end) {
+    double cost = 0.0;
+    for (int64_t i = begin; i < end; ++i) {
+      double residual;
+      if (SampsonCoplanarityResidual<double>(essential, matches[i], n, nullptr,
+                                             &residual) &&
+          std::isfinite(residual)) {
+        cost += RobustLossRho(options.loss, options.loss_scale_px,
+                              residual * residual);
+      }
     }
+    return cost;
+  };
+  const int64_t count = static_cast<int64_t>(matches.size());
+  if (options.num_threads == 1 || count < 2 * kMinEvaluationsPerThread) {
+    return sum(0, count);
   }
+  std::vector<double> partial(options.num_threads, 0.0);
+  ParallelFor(options.num_threads, options.num_threads, 1,
+              [&](int64_t begin, int64_t end) {
+                for (int64_t t = begin; t < end; ++t) {
+                  partial[t] = sum(count * t / options.num_threads,
+                                   count * (t + 1) / options.num_threads);
+                }
+              });
+  double cost = 0.0;
+  for (const double value : partial) cost += value;
   return cost;
 }
 
@@ -78,9 +95,11 @@ double ScanRobustLocusCost(const Eigen::Matrix3d& essential,
 double MinimizeRobustLocusCost(
     const Eigen::Matrix3d& essential,
     const std::vector<PreparedCorrespondence>& matches,
-    const RefinementOptions& options, std::optional<double> candidate) {
+    const RefinementOptions& options, std::optional<double> candidate,
+    double* scan_seed) {
   const double seed =
       ScanRobustLocusCost(essential, matches, options, candidate);
+  if (scan_seed != nullptr) *scan_seed = seed;
   const double step = 1.0 / (options.num_scan_points - 1);
   double low = std::max(1.0, seed - step);
   double high = std::min(2.0, seed + step);

@@ -1,5 +1,8 @@
 #include "rcm/sim/reference_rigs.h"
 
+#include <Eigen/Geometry>
+#include <cmath>
+
 namespace rcm {
 
 Camera AlphasenseFrontCam0() {
@@ -30,6 +33,18 @@ Camera EurocCam0() {
 StereoRig AlphasenseFrontRectifiedRig() {
   Rigid3d right_from_left;
   right_from_left.translation = Eigen::Vector3d(-0.11, 0.0, 0.0);
+  return StereoRig::Create(AlphasenseFrontCam0(), AlphasenseFrontCam1(),
+                           right_from_left)
+      .value();
+}
+
+StereoRig AlphasenseFrontUnrectifiedRig() {
+  Rigid3d right_from_left;
+  right_from_left.rotation =
+      Eigen::AngleAxisd(0.5 * M_PI / 180.0,
+                        Eigen::Vector3d(0.3, 1.0, -0.4).normalized())
+          .toRotationMatrix();
+  right_from_left.translation = Eigen::Vector3d(-0.11, 0.0015, -0.002);
   return StereoRig::Create(AlphasenseFrontCam0(), AlphasenseFrontCam1(),
                            right_from_left)
       .value();

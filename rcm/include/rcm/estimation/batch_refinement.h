@@ -7,7 +7,9 @@
 //
 //   seed:    the best of a coarse scan of the robust cost over [1, 2] and
 //            the closed-form seed (median of eq. 14 over the paper's mask);
-//   stage 1: min_n sum_i rho(r_i(n)^2)          (robust, all matches)
+//   stage 1: min_n sum_i rho(r_i(n)^2)          (robust, all matches;
+//            a 1-D golden-section search for n alone, Ceres with the
+//            rotation correction)
 //   stage 2: min_n sum_{i in inliers} r_i(n)^2  (|r_i| <= threshold)
 //
 // Uncertainty, from stage 2 with p parameters and N inliers:

@@ -21,7 +21,8 @@ std::vector<double> LocusResiduals(
     const std::vector<PreparedCorrespondence>& matches, double n);
 
 // sum_i rho(r_i(n)^2) with the options' loss and scale; undefined
-// residuals are skipped.
+// residuals are skipped. Large sets are summed on options.num_threads
+// threads (the result depends on the thread count in the last bits).
 double RobustLocusCost(const Eigen::Matrix3d& essential,
                        const std::vector<PreparedCorrespondence>& matches,
                        double n, const RefinementOptions& options);
@@ -37,11 +38,13 @@ double ScanRobustLocusCost(const Eigen::Matrix3d& essential,
 // The scan, then a golden-section search of the bracket around its best
 // point (37 evaluations for the default grid), to
 // a bracket narrower than 1e-9 in n.
+// `scan_seed`, when not null, receives the scan's best point.
 double MinimizeRobustLocusCost(
     const Eigen::Matrix3d& essential,
     const std::vector<PreparedCorrespondence>& matches,
     const RefinementOptions& options,
-    std::optional<double> candidate = std::nullopt);
+    std::optional<double> candidate = std::nullopt,
+    double* scan_seed = nullptr);
 
 // Cheirality: true when the two water-side rays of the match at n meet
 // (at their closest approach) in front of both cameras, at a positive

@@ -21,6 +21,11 @@ Camera EurocCam0();
 // derivation: right_from_left = (I, (-0.11 m, 0, 0)).
 StereoRig AlphasenseFrontRectifiedRig();
 
+// Those intrinsics on extrinsics as a real rig has them: cam1 rotated 0.5
+// degrees about a skew axis and the baseline slightly off the x axis
+// (0.11 m, 1.5 mm up, 2 mm back). Not rectified.
+StereoRig AlphasenseFrontUnrectifiedRig();
+
 }  // namespace rcm
 
 #endif  // RCM_SIM_REFERENCE_RIGS_H_
