@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "rcm/camera/refractive_camera.h"
@@ -118,6 +119,35 @@ TEST(StereoSampler, PixelNoiseHasRequestedSpread) {
   }
   // 8000 draws: the sample sigma has a relative standard error of 0.8 %.
   EXPECT_NEAR(std::sqrt(sum_squares / (4.0 * exact.size())), 0.5, 0.5 * 0.04);
+}
+
+TEST(StereoSampler, OutliersReplaceTheRequestedFractionOfRightPixels) {
+  const StereoRig rig = test::AlphasenseIdealRig();
+  const std::vector<StereoCorrespondence> exact =
+      test::ExactMatches(rig, 1.333, 1000);
+  std::vector<StereoCorrespondence> data = exact;
+  const std::vector<int64_t> outliers = AddOutliers(rig, 0.2, 5, &data);
+  ASSERT_EQ(outliers.size(), 200u);
+  EXPECT_TRUE(std::is_sorted(outliers.begin(), outliers.end()));
+  size_t changed = 0;
+  for (size_t i = 0; i < data.size(); ++i) {
+    EXPECT_EQ(data[i].left_pixel, exact[i].left_pixel);
+    EXPECT_TRUE(rig.right().InImage(data[i].right_pixel));
+    const bool is_outlier = std::binary_search(
+        outliers.begin(), outliers.end(), static_cast<int64_t>(i));
+    changed += data[i].right_pixel != exact[i].right_pixel;
+    if (!is_outlier) EXPECT_EQ(data[i].right_pixel, exact[i].right_pixel);
+  }
+  EXPECT_EQ(changed, 200u);
+  // Deterministic per seed.
+  std::vector<StereoCorrespondence> again = exact;
+  EXPECT_EQ(AddOutliers(rig, 0.2, 5, &again), outliers);
+  EXPECT_EQ(again[outliers[0]].right_pixel, data[outliers[0]].right_pixel);
+  // The edge fractions.
+  std::vector<StereoCorrespondence> none = exact;
+  EXPECT_TRUE(AddOutliers(rig, 0.0, 5, &none).empty());
+  std::vector<StereoCorrespondence> all = exact;
+  EXPECT_EQ(AddOutliers(rig, 1.0, 5, &all).size(), exact.size());
 }
 
 }  // namespace
