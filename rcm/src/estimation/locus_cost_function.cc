@@ -1,0 +1,247 @@
+#include "rcm/estimation/locus_cost_function.h"
+
+#include <ceres/jet.h>
+#include <glog/logging.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "rcm/estimation/sampson_coplanarity_error.h"
+#include "rcm/util/parallel_for.h"
+
+namespace rcm {
+namespace {
+
+using Values = std::array<double, LocusCostFunction::kNumNodes>;
+
+// Below this many residual evaluations AddMatches stays on one thread.
+constexpr int64_t kMinEvaluationsPerThread = 20000;
+
+// The barycentric interpolant of `values` at n (header formula).
+double Interpolate(const Values& values, double n) {
+  CHECK(n >= 1.0 && n <= 2.0) << "n = " << n << " is outside [1, 2]";
+  const auto& edges = LocusCostFunction::PanelEdges();
+  const auto& nodes = LocusCostFunction::Nodes();
+  // Interior edges <= n: the index of n's panel (n = 2 in the last one).
+  const int panel =
+      static_cast<int>(std::upper_bound(edges.begin() + 1, edges.end() - 1, n) -
+                       (edges.begin() + 1));
+  const int first = panel * LocusCostFunction::kDegree;
+  double numerator = 0.0;
+  double denominator = 0.0;
+  for (int j = 0; j <= LocusCostFunction::kDegree; ++j) {
+    const double difference = n - nodes[first + j];
+    if (difference == 0.0) return values[first + j];
+    double weight = (j % 2 == 0) ? 1.0 : -1.0;
+    if (j == 0 || j == LocusCostFunction::kDegree) weight *= 0.5;
+    weight /= difference;
+    numerator += weight * values[first + j];
+    denominator += weight;
+  }
+  return numerator / denominator;
+}
+
+}  // namespace
+
+const std::array<double, LocusCostFunction::kNumPanels + 1>&
+LocusCostFunction::PanelEdges() {
+  static const std::array<double, kNumPanels + 1> edges = [] {
+    std::array<double, kNumPanels + 1> e{};
+    e[0] = 1.0;
+    // 1 + 2^-(kNumPanels - 1), ..., 1 + 2^-1, 1 + 2^0: exact in binary.
+    for (int p = 1; p <= kNumPanels; ++p) {
+      e[p] = 1.0 + std::ldexp(1.0, p - kNumPanels);
+    }
+    return e;
+  }();
+  return edges;
+}
+
+const std::array<double, LocusCostFunction::kNumNodes>&
+LocusCostFunction::Nodes() {
+  static const std::array<double, kNumNodes> nodes = [] {
+    const auto& edges = PanelEdges();
+    std::array<double, kNumNodes> x{};
+    for (int p = 0; p < kNumPanels; ++p) {
+      const double center = 0.5 * (edges[p] + edges[p + 1]);
+      const double half_width = 0.5 * (edges[p + 1] - edges[p]);
+      for (int j = 0; j <= kDegree; ++j) {
+        // -cos(j pi / N) = sin(pi (2j - N) / (2N)): increasing from -1 to
+        // 1, symmetric about 0 in floating point.
+        const double t = std::sin(M_PI * (2 * j - kDegree) / (2.0 * kDegree));
+        x[p * kDegree + j] = center + half_width * t;
+      }
+      x[p * kDegree] = edges[p];
+      x[(p + 1) * kDegree] = edges[p + 1];
+    }
+    return x;
+  }();
+  return nodes;
+}
+
+int64_t LocusCostFunction::AddMatches(
+    const Eigen::Matrix3d& essential,
+    const std::vector<PreparedCorrespondence>& matches, int num_threads,
+    std::vector<int64_t>* rejected) {
+  CHECK_GE(num_threads, 1);
+  if (rejected != nullptr) rejected->clear();
+  using Jet = ceres::Jet<double, 1>;
+  const auto& nodes = Nodes();
+  const int64_t count = static_cast<int64_t>(matches.size());
+  if (count == 0) return 0;
+
+  Values cost{}, cost_derivative{}, information{};
+  std::unique_ptr<std::atomic<bool>[]> invalid(new std::atomic<bool>[count] {});
+  std::atomic<bool> any_invalid(false);
+  ParallelFor(kNumNodes, num_threads,
+              std::max<int64_t>(1, kMinEvaluationsPerThread / count),
+              [&](int64_t begin, int64_t end) {
+                for (int64_t k = begin; k < end; ++k) {
+                  const Jet n(nodes[k], 0);
+                  double c = 0.0, d = 0.0, g = 0.0;
+                  for (int64_t i = 0; i < count; ++i) {
+                    Jet r;
+                    if (!SampsonCoplanarityResidual<Jet>(essential, matches[i],
+                                                         n, nullptr, &r) ||
+                        !std::isfinite(r.a) || !std::isfinite(r.v[0])) {
+                      invalid[i].store(true, std::memory_order_relaxed);
+                      any_invalid.store(true, std::memory_order_relaxed);
+                      continue;
+                    }
+                    c += r.a * r.a;
+                    d += 2.0 * r.a * r.v[0];
+                    g += r.v[0] * r.v[0];
+                  }
+                  cost[k] = c;
+                  cost_derivative[k] = d;
+                  information[k] = g;
+                }
+              });
+  if (any_invalid.load()) {
+    // Rare (a match at an epipole): sum again without the undefined ones,
+    // so that every node sums the same matches.
+    std::vector<PreparedCorrespondence> valid;
+    for (int64_t i = 0; i < count; ++i) {
+      if (!invalid[i].load()) {
+        valid.push_back(matches[i]);
+      } else if (rejected != nullptr) {
+        rejected->push_back(i);
+      }
+    }
+    if (valid.empty()) return 0;
+    return AddMatches(essential, valid, num_threads);
+  }
+  for (int k = 0; k < kNumNodes; ++k) {
+    cost_[k] += cost[k];
+    cost_derivative_[k] += cost_derivative[k];
+    information_[k] += information[k];
+  }
+  num_matches_ += count;
+  return count;
+}
+
+void LocusCostFunction::Add(const LocusCostFunction& other) {
+  for (int k = 0; k < kNumNodes; ++k) {
+    cost_[k] += other.cost_[k];
+    cost_derivative_[k] += other.cost_derivative_[k];
+    information_[k] += other.information_[k];
+  }
+  num_matches_ += other.num_matches_;
+}
+
+void LocusCostFunction::Subtract(const LocusCostFunction& other) {
+  CHECK_LE(other.num_matches_, num_matches_)
+      << "subtracting matches that were not added";
+  for (int k = 0; k < kNumNodes; ++k) {
+    cost_[k] -= other.cost_[k];
+    cost_derivative_[k] -= other.cost_derivative_[k];
+    information_[k] -= other.information_[k];
+  }
+  num_matches_ -= other.num_matches_;
+}
+
+void LocusCostFunction::Clear() { *this = LocusCostFunction(); }
+
+double LocusCostFunction::Cost(double n) const { return Interpolate(cost_, n); }
+
+double LocusCostFunction::CostDerivative(double n) const {
+  return Interpolate(cost_derivative_, n);
+}
+
+double LocusCostFunction::Information(double n) const {
+  return Interpolate(information_, n);
+}
+
+LocusCostFunction::Minimum LocusCostFunction::Minimize() const {
+  const auto& edges = PanelEdges();
+  // The samples, increasing: each panel's kSamplesPerPanel points from its
+  // left edge, then n = 2.
+  constexpr int kNumSamples = kNumPanels * kSamplesPerPanel + 1;
+  const auto sample = [&](int s) {
+    if (s == kNumSamples - 1) return 2.0;
+    const int panel = s / kSamplesPerPanel;
+    const int offset = s % kSamplesPerPanel;
+    return edges[panel] + (edges[panel + 1] - edges[panel]) * offset /
+                              static_cast<double>(kSamplesPerPanel);
+  };
+  int best = 0;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (int s = 0; s < kNumSamples; ++s) {
+    const double c = Cost(sample(s));
+    if (c < best_cost) {
+      best_cost = c;
+      best = s;
+    }
+  }
+
+  const auto result = [&](double n) {
+    return Minimum{n, Cost(n), Information(n)};
+  };
+  const double at_best = sample(best);
+  const double slope = CostDerivative(at_best);
+  if (slope == 0.0) return result(at_best);
+  if (best == 0 && slope > 0.0) return result(1.0);
+  if (best == kNumSamples - 1 && slope < 0.0) return result(2.0);
+  // The root of C' between the best sample and the neighbour downhill.
+  double low = slope > 0.0 ? sample(best - 1) : at_best;
+  double high = slope > 0.0 ? at_best : sample(best + 1);
+  if (CostDerivative(low) < 0.0 && CostDerivative(high) > 0.0) {
+    while (true) {
+      const double middle = 0.5 * (low + high);
+      if (!(middle > low && middle < high)) break;
+      (CostDerivative(middle) > 0.0 ? high : low) = middle;
+    }
+    return result(CostDerivative(high) < -CostDerivative(low) ? high : low);
+  }
+  // C' changes sign more than once between two samples (C has a maximum
+  // and a minimum there): golden-section search of C over both neighbours.
+  low = sample(std::max(0, best - 1));
+  high = sample(std::min(kNumSamples - 1, best + 1));
+  const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
+  double a = high - ratio * (high - low);
+  double b = low + ratio * (high - low);
+  double cost_a = Cost(a);
+  double cost_b = Cost(b);
+  while (high - low > 4.0 * std::numeric_limits<double>::epsilon()) {
+    if (cost_a <= cost_b) {
+      high = b;
+      b = a;
+      cost_b = cost_a;
+      a = high - ratio * (high - low);
+      cost_a = Cost(a);
+    } else {
+      low = a;
+      a = b;
+      cost_a = cost_b;
+      b = low + ratio * (high - low);
+      cost_b = Cost(b);
+    }
+  }
+  const double middle = 0.5 * (low + high);
+  return result(Cost(middle) <= best_cost ? middle : at_best);
+}
+
+}  // namespace rcm

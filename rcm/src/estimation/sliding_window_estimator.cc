@@ -1,0 +1,177 @@
+#include "rcm/estimation/sliding_window_estimator.h"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <utility>
+
+namespace rcm {
+namespace {
+
+// z between two independent estimates (header); a zero denominator (exact
+// data) gives 0 for equal values and +inf otherwise.
+double ChangeStatistic(const LocusEstimate& a, double n_b, double sigma_b) {
+  const double difference = std::abs(a.n - n_b);
+  const double sigma = std::hypot(a.sigma_n, sigma_b);
+  if (sigma > 0.0) return difference / sigma;
+  return difference == 0.0 ? 0.0 : std::numeric_limits<double>::infinity();
+}
+
+}  // namespace
+
+Status SlidingWindowOptions::Check() const {
+  std::ostringstream error;
+  if (window_frames < 1) {
+    error << "the window needs at least 1 frame, got window_frames = "
+          << window_frames;
+  } else if (!(change_threshold > 0.0) || !std::isfinite(change_threshold)) {
+    error << "change_threshold must be a positive number, got "
+          << change_threshold;
+  } else if (confirm_frames < 1 || confirm_frames > window_frames) {
+    error << "confirm_frames must be between 1 and window_frames ("
+          << window_frames << "), got " << confirm_frames;
+  } else {
+    return Status::Ok();
+  }
+  return Status::Error(error.str());
+}
+
+SlidingWindowRefractiveIndexEstimator::SlidingWindowRefractiveIndexEstimator(
+    const StereoRig& rig, const RefinementOptions& options,
+    const SlidingWindowOptions& window_options)
+    : rig_(rig),
+      options_(options),
+      window_options_(window_options),
+      window_(window_options.window_frames) {
+  pending_.reserve(window_options.confirm_frames);
+}
+
+StatusOr<SlidingWindowRefractiveIndexEstimator>
+SlidingWindowRefractiveIndexEstimator::Create(
+    const StereoRig& rig, const RefinementOptions& options,
+    const SlidingWindowOptions& window_options) {
+  RCM_RETURN_IF_ERROR(options.Check());
+  RCM_RETURN_IF_ERROR(window_options.Check());
+  if (options.refine_rotation) {
+    return Status::Error(
+        "the sliding-window estimator estimates n alone: the rotation "
+        "correction (refine_rotation) is available in the batch refinement "
+        "only");
+  }
+  return SlidingWindowRefractiveIndexEstimator(rig, options, window_options);
+}
+
+void SlidingWindowRefractiveIndexEstimator::ResumWindow() {
+  window_cost_.Clear();
+  for (int k = 0; k < window_count_; ++k) {
+    window_cost_.Add(window_[(window_begin_ + k) % window_.size()].cost);
+  }
+}
+
+void SlidingWindowRefractiveIndexEstimator::PushToWindow(
+    const FrameCost& frame) {
+  const int capacity = static_cast<int>(window_.size());
+  if (window_count_ == capacity) {
+    window_[window_begin_] = frame;
+    window_begin_ = (window_begin_ + 1) % capacity;
+  } else {
+    window_[(window_begin_ + window_count_) % capacity] = frame;
+    ++window_count_;
+  }
+  ResumWindow();
+}
+
+SlidingWindowRefractiveIndexEstimator::WindowUpdate
+SlidingWindowRefractiveIndexEstimator::AddFrame(
+    int64_t frame, const std::vector<StereoCorrespondence>& frame_matches) {
+  WindowUpdate update;
+  update.frame = frame;
+  FrameFit fit = FitFrame(rig_, frame_matches, options_);
+  update.frame_estimate = fit.estimate;
+  if (!fit.estimate.ok()) {
+    ++num_skipped_frames_;
+    update.decision = Decision::kSkipped;
+    update.window = Current();
+    return update;
+  }
+  FrameCost frame_cost;
+  frame_cost.frame = frame;
+  frame_cost.estimate = *fit.estimate;
+  frame_cost.cost = fit.cost;
+
+  const StatusOr<Estimate> window = Current();
+  if (window.ok()) {
+    update.z = ChangeStatistic(frame_cost.estimate, window->n, window->sigma_n);
+  }
+  if (!update.z || *update.z <= window_options_.change_threshold) {
+    num_dropped_frames_ += static_cast<int64_t>(pending_.size());
+    pending_.clear();
+    PushToWindow(frame_cost);
+    update.decision = Decision::kAccepted;
+    update.window = Current();
+    return update;
+  }
+
+  // Inconsistent with the window: pending, with the frames before it when
+  // it agrees with the last of them.
+  if (!pending_.empty() &&
+      ChangeStatistic(frame_cost.estimate, pending_.back().estimate.n,
+                      pending_.back().estimate.sigma_n) >
+          window_options_.change_threshold) {
+    num_dropped_frames_ += static_cast<int64_t>(pending_.size());
+    pending_.clear();
+  }
+  pending_.push_back(std::move(frame_cost));
+  if (static_cast<int>(pending_.size()) < window_options_.confirm_frames) {
+    update.decision = Decision::kPending;
+    update.window = window;
+    return update;
+  }
+
+  // A switch: the pending frames start the new window.
+  MediumSwitch medium_switch;
+  medium_switch.first_frame = pending_.front().frame;
+  medium_switch.detected_at_frame = frame;
+  medium_switch.n_before = window->n;
+  const double n_last = pending_.back().estimate.n;
+  window_begin_ = 0;
+  window_count_ = 0;
+  for (const FrameCost& pending : pending_) PushToWindow(pending);
+  pending_.clear();
+  update.window = Current();
+  medium_switch.n_after = update.window.ok() ? update.window->n : n_last;
+  switches_.push_back(medium_switch);
+  update.decision = Decision::kSwitch;
+  update.medium_switch = medium_switch;
+  return update;
+}
+
+StatusOr<SlidingWindowRefractiveIndexEstimator::Estimate>
+SlidingWindowRefractiveIndexEstimator::Current() const {
+  const StatusOr<LocusEstimate> locus =
+      EstimateFromLocusCost(window_cost_, options_);
+  if (!locus.ok()) {
+    return locus.status().WithContext(
+        "window of " + std::to_string(window_count_) + " frames");
+  }
+  Estimate estimate;
+  estimate.n = locus->n;
+  estimate.sigma_n = locus->sigma_n;
+  estimate.crlb = locus->crlb;
+  estimate.sigma_px = locus->sigma_px;
+  estimate.inliers = locus->inliers;
+  estimate.frames = window_count_;
+  estimate.first_frame = window_[window_begin_].frame;
+  estimate.last_frame =
+      window_[(window_begin_ + window_count_ - 1) % window_.size()].frame;
+  return estimate;
+}
+
+size_t SlidingWindowRefractiveIndexEstimator::MemoryBytes() const {
+  return sizeof(*this) + window_.capacity() * sizeof(FrameCost) +
+         pending_.capacity() * sizeof(FrameCost) +
+         switches_.capacity() * sizeof(MediumSwitch);
+}
+
+}  // namespace rcm
