@@ -15,8 +15,11 @@
 
 #include "command.h"
 #include "rcm/estimation/batch_refinement.h"
+#include "rcm/estimation/online_estimator.h"
 #include "rcm/estimation/paper_online_estimator.h"
+#include "rcm/estimation/prepared_correspondence.h"
 #include "rcm/estimation/refinement_options.h"
+#include "rcm/estimation/sliding_window_estimator.h"
 #include "rcm/io/atomic_file.h"
 #include "rcm/io/correspondence_csv.h"
 #include "rcm/io/stereo_rig_file.h"
@@ -31,14 +34,23 @@ DEFINE_string(matches, "",
               "pixels (required)");
 DEFINE_string(estimator, "refine",
               "refine: robust least squares over all frames (the estimator "
-              "of record); closed-form: the paper's baseline (eq. 14, mask, "
-              "radially weighted mean)");
+              "of record); online: the same estimate updated frame by frame "
+              "in constant memory; window: over the last --window frames, "
+              "restarting when the medium changes; closed-form: the paper's "
+              "baseline (eq. 14, mask, radially weighted mean)");
+DEFINE_int32(window, 20,
+             "window: frames in the sliding window (w_s; 20 = 1 s at 20 Hz)");
+DEFINE_double(change_threshold, 5.0,
+              "window: a frame whose own n differs from the window's by more "
+              "than this many combined sigmas is inconsistent; two in a row "
+              "that agree declare a change of medium");
 DEFINE_string(left, "cam0", "camchain camera that is the left one");
 DEFINE_string(right, "cam1", "camchain camera that is the right one");
 DEFINE_string(per_frame, "",
               "also write one row per frame to this CSV: frame,t,n,sigma_n,"
-              "switch (refine: each frame's own estimate; closed-form: the "
-              "running estimate)");
+              "switch (refine: each frame's own estimate; online and "
+              "closed-form: the estimate so far; window: the window's "
+              "estimate; switch = 1 on the first frame of a new medium)");
 DEFINE_string(loss, "cauchy",
               "robust loss of the refinement's first stage: cauchy, huber or "
               "none");
@@ -63,8 +75,8 @@ constexpr char kUsage[] =
     "rcm estimate: the refractive index n of the medium from stereo\n"
     "correspondences of a rig calibrated in air.\n\n"
     "usage: rcm estimate --calib RIG.yaml --matches MATCHES.csv\n"
-    "                    [--estimator refine|closed-form] [--per-frame "
-    "OUT.csv] [--json]\n\n"
+    "                    [--estimator refine|online|window|closed-form]\n"
+    "                    [--window N] [--per-frame OUT.csv] [--json]\n\n"
     "refine fits n to the distance of every match from its refractive "
     "epipolar\nlocus (Sampson distance, pixels) over all frames: a robust "
     "stage that finds n\namong outliers, then least squares on the inliers, "
@@ -268,6 +280,125 @@ StatusOr<Report> RunRefine(const StereoRig& rig,
   return report;
 }
 
+std::string FrameLabel(int64_t frame) {
+  return "frame " + std::to_string(frame);
+}
+
+StatusOr<Report> RunOnline(const StereoRig& rig,
+                           const std::vector<Frame>& frames,
+                           const RefinementOptions& options) {
+  StatusOr<OnlineRefractiveIndexEstimator> estimator =
+      OnlineRefractiveIndexEstimator::Create(rig, options);
+  if (!estimator.ok()) return estimator.status();
+  Report report;
+  int64_t invalid = 0;
+  Progress progress("rcm estimate: frame", frames.size());
+  for (size_t i = 0; i < frames.size(); ++i) {
+    progress.Update(i + 1);
+    const OnlineRefractiveIndexEstimator::FrameUpdate update =
+        estimator->AddFrame(frames[i].matches);
+    invalid += update.correspondences - update.usable;
+    FrameRow row{frames[i].frame, frames[i].timestamp};
+    if (update.cumulative.ok()) {
+      row.n = update.cumulative->n;
+      row.sigma_n = update.cumulative->sigma_n;
+    }
+    report.rows.push_back(row);
+  }
+  const StatusOr<OnlineRefractiveIndexEstimator::Estimate> estimate =
+      estimator->Current();
+  if (!estimate.ok()) return estimate.status();
+  report.method =
+      "online robust least squares on the refractive epipolar loci (loss " +
+      LossDescription(options) + ", inliers within " +
+      FormatFixed(options.inlier_threshold_px, 2) + " px of each frame's fit)";
+  report.n = estimate->n;
+  report.sigma_n = estimate->sigma_n;
+  report.crlb = estimate->crlb;
+  report.sigma_px = estimate->sigma_px;
+  report.inliers = estimate->inliers;
+  report.invalid = invalid;
+  report.extra["skipped_frames"] = estimator->num_skipped_frames();
+  if (estimator->num_skipped_frames() > 0) {
+    report.text_lines.push_back(
+        "  skipped    " + std::to_string(estimator->num_skipped_frames()) +
+        " frames with fewer than " + std::to_string(options.min_inliers) +
+        " usable matches");
+  }
+  return report;
+}
+
+StatusOr<Report> RunWindow(const StereoRig& rig,
+                           const std::vector<Frame>& frames,
+                           const RefinementOptions& options,
+                           const SlidingWindowOptions& window_options) {
+  StatusOr<SlidingWindowRefractiveIndexEstimator> estimator =
+      SlidingWindowRefractiveIndexEstimator::Create(rig, options,
+                                                    window_options);
+  if (!estimator.ok()) return estimator.status();
+  Report report;
+  int64_t invalid = 0;
+  std::map<int64_t, size_t> row_of_frame;
+  Progress progress("rcm estimate: frame", frames.size());
+  for (size_t i = 0; i < frames.size(); ++i) {
+    progress.Update(i + 1);
+    const SlidingWindowRefractiveIndexEstimator::WindowUpdate update =
+        estimator->AddFrame(frames[i].frame, frames[i].matches);
+    for (const StereoCorrespondence& match : frames[i].matches) {
+      invalid += !PrepareCorrespondence(rig, match).has_value();
+    }
+    FrameRow row{frames[i].frame, frames[i].timestamp};
+    if (update.window.ok()) {
+      row.n = update.window->n;
+      row.sigma_n = update.window->sigma_n;
+    }
+    row_of_frame[frames[i].frame] = report.rows.size();
+    report.rows.push_back(row);
+  }
+  nlohmann::json switches = nlohmann::json::array();
+  for (const MediumSwitch& medium_switch : estimator->switches()) {
+    const auto row = row_of_frame.find(medium_switch.first_frame);
+    if (row != row_of_frame.end())
+      report.rows[row->second].medium_switch = true;
+    switches.push_back({{"frame", medium_switch.first_frame},
+                        {"detected_at_frame", medium_switch.detected_at_frame},
+                        {"n_before", medium_switch.n_before},
+                        {"n_after", medium_switch.n_after}});
+    report.text_lines.push_back(
+        "  switch     at " + FrameLabel(medium_switch.first_frame) +
+        " (confirmed at " + FrameLabel(medium_switch.detected_at_frame) +
+        "): n " + FormatFixed(medium_switch.n_before, 4) + " -> " +
+        FormatFixed(medium_switch.n_after, 4));
+  }
+  const StatusOr<SlidingWindowRefractiveIndexEstimator::Estimate> estimate =
+      estimator->Current();
+  if (!estimate.ok()) return estimate.status();
+  report.method = "sliding window of " +
+                  std::to_string(window_options.window_frames) +
+                  " frames, robust least squares on the refractive epipolar "
+                  "loci, change of medium at z > " +
+                  FormatFixed(window_options.change_threshold, 1);
+  report.n = estimate->n;
+  report.sigma_n = estimate->sigma_n;
+  report.crlb = estimate->crlb;
+  report.sigma_px = estimate->sigma_px;
+  report.inliers = estimate->inliers;
+  report.invalid = invalid;
+  report.extra["switches"] = switches;
+  report.extra["window"] = {{"frames", estimate->frames},
+                            {"first_frame", estimate->first_frame},
+                            {"last_frame", estimate->last_frame}};
+  report.extra["dropped_frames"] = estimator->num_dropped_frames();
+  report.extra["skipped_frames"] = estimator->num_skipped_frames();
+  report.text_lines.push_back(
+      "  window     " + FrameLabel(estimate->first_frame) + " to " +
+      FrameLabel(estimate->last_frame) + " (" +
+      std::to_string(estimate->frames) + " frames); " +
+      std::to_string(estimator->switches().size()) + " change" +
+      (estimator->switches().size() == 1 ? "" : "s") + " of medium");
+  return report;
+}
+
 StatusOr<Report> RunClosedForm(const StereoRig& rig,
                                const std::vector<Frame>& frames,
                                const Subcommand& command) {
@@ -345,11 +476,26 @@ int RunEstimate() {
     PrintError(command, "--matches is required (see rcm estimate --help)");
     return kExitUsage;
   }
-  const std::vector<std::string> estimators = {"refine", "closed-form"};
+  const std::vector<std::string> estimators = {"refine", "online", "window",
+                                               "closed-form"};
   if (std::find(estimators.begin(), estimators.end(), FLAGS_estimator) ==
       estimators.end()) {
-    PrintError(command, "unknown estimator '" + FLAGS_estimator +
-                            "' (available: refine, closed-form)");
+    PrintError(command,
+               "unknown estimator '" + FLAGS_estimator +
+                   "' (available: refine, online, window, closed-form)");
+    return kExitUsage;
+  }
+  if (FLAGS_refine_rotation && FLAGS_estimator != "refine") {
+    PrintError(command, "--refine-rotation works with --estimator refine only");
+    return kExitUsage;
+  }
+  SlidingWindowOptions window_options;
+  window_options.window_frames = FLAGS_window;
+  window_options.change_threshold = FLAGS_change_threshold;
+  window_options.confirm_frames =
+      std::min(window_options.confirm_frames, std::max(1, FLAGS_window));
+  if (const Status status = window_options.Check(); !status.ok()) {
+    PrintError(command, "--window/--change-threshold: " + status.message());
     return kExitUsage;
   }
   if (!RobustLossFromName(FLAGS_loss)) {
@@ -389,10 +535,16 @@ int RunEstimate() {
       });
   const std::vector<Frame> frames = SplitFrames(*matches);
 
-  const StatusOr<Report> report =
-      FLAGS_estimator == "closed-form"
-          ? RunClosedForm(*rig, frames, command)
-          : RunRefine(*rig, *matches, frames, refinement);
+  StatusOr<Report> report = Status::Error("no estimator");
+  if (FLAGS_estimator == "closed-form") {
+    report = RunClosedForm(*rig, frames, command);
+  } else if (FLAGS_estimator == "online") {
+    report = RunOnline(*rig, frames, refinement);
+  } else if (FLAGS_estimator == "window") {
+    report = RunWindow(*rig, frames, refinement, window_options);
+  } else {
+    report = RunRefine(*rig, *matches, frames, refinement);
+  }
   if (!report.ok()) {
     PrintError(command, report.status().message());
     return kExitFailure;
@@ -444,8 +596,9 @@ int RunEstimate() {
        << " correspondences in " << frames.size() << " frame"
        << (frames.size() == 1 ? "" : "s") << "\n";
   if (FLAGS_estimator != "closed-form") {
-    text << "  inliers    " << report->inliers << " (" << report->invalid
-         << " could not be undistorted)\n";
+    text << "  inliers    " << report->inliers
+         << (FLAGS_estimator == "window" ? " in the window" : "") << " ("
+         << report->invalid << " could not be undistorted)\n";
   }
   for (const std::string& line : report->text_lines) text << line << "\n";
   if (FLAGS_estimator == "closed-form") {

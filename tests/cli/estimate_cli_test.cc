@@ -108,6 +108,120 @@ TEST(EstimateCli, RefineRotationIsReported) {
   EXPECT_GE(json["sigma_n"].get<double>(), json["crlb"].get<double>());
 }
 
+TEST(EstimateCli, OnlineAgreesWithRefine) {
+  // The online estimator equals the batch to 1e-6 (online_estimator_test).
+  const RunResult refine =
+      Rcm({"estimate", "--calib", kRig, "--matches", kDemoMatches, "--json"});
+  const RunResult online =
+      Rcm({"estimate", "--calib", kRig, "--matches", kDemoMatches,
+           "--estimator", "online", "--json"});
+  ASSERT_EQ(refine.exit_code, 0) << refine.err;
+  ASSERT_EQ(online.exit_code, 0) << online.err;
+  const nlohmann::json a = nlohmann::json::parse(refine.out);
+  const nlohmann::json b = nlohmann::json::parse(online.out);
+  EXPECT_EQ(b["estimator"], "online");
+  EXPECT_NEAR(a["n"].get<double>(), b["n"].get<double>(), 1e-6);
+  EXPECT_NEAR(a["sigma_n"].get<double>(), b["sigma_n"].get<double>(), 1e-6);
+  EXPECT_EQ(a["inliers"], b["inliers"]);
+}
+
+// Air -> water -> air, 12 frames each of 150 matches with 0.3 px noise, as
+// a correspondence CSV.
+std::string MediumSwitchSequence() {
+  std::vector<StereoCorrespondence> all;
+  const double n[3] = {1.0, 1.333, 1.0};
+  for (int frame = 0; frame < 36; ++frame) {
+    StereoSamplerOptions options;
+    options.n = n[frame / 12];
+    options.per_frame = 150;
+    options.max_depth = 3.0;
+    options.seed = 50 + frame;
+    std::vector<StereoCorrespondence> matches =
+        SampleStereoCorrespondences(AlphasenseFrontRectifiedRig(), options)
+            .value();
+    AddPixelNoise(0.3, 500 + frame, &matches);
+    for (StereoCorrespondence& match : matches) {
+      match.frame = frame;
+      match.timestamp = frame / 20.0;
+      all.push_back(match);
+    }
+  }
+  return test::WriteTempFile("switches.csv", FormatCorrespondenceCsv(all));
+}
+
+TEST(EstimateCli, WindowReportsEachChangeOfMedium) {
+  const std::string per_frame = test::TempFilePath("window.csv");
+  const RunResult result =
+      Rcm({"estimate", "--calib", kRig, "--matches", MediumSwitchSequence(),
+           "--estimator", "window", "--window", "8", "--per-frame", per_frame,
+           "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json json = nlohmann::json::parse(result.out);
+  EXPECT_EQ(json["frames"].get<int>(), 36);
+  ASSERT_EQ(json["switches"].size(), 2u) << result.out;
+  for (int k = 0; k < 2; ++k) {
+    const int truth = 12 * (k + 1);
+    EXPECT_GE(json["switches"][k]["frame"].get<int>(), truth);
+    EXPECT_LE(json["switches"][k]["detected_at_frame"].get<int>(), truth + 3);
+  }
+  EXPECT_NEAR(json["n"].get<double>(), 1.0, 0.006);
+  EXPECT_EQ(json["window"]["frames"].get<int>(), 8);
+  // The per-frame CSV marks the first frame of each new medium.
+  const std::string text = test::ReadWholeFile(per_frame);
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 37);
+  for (const int frame : {json["switches"][0]["frame"].get<int>(),
+                          json["switches"][1]["frame"].get<int>()}) {
+    const size_t row = text.find("\n" + std::to_string(frame) + ",");
+    ASSERT_NE(row, std::string::npos) << text;
+    EXPECT_EQ(text.substr(text.find('\n', row + 1) - 2, 2), ",1") << text;
+  }
+  // And no other row.
+  size_t marked = 0;
+  for (size_t at = text.find(",1\n"); at != std::string::npos;
+       at = text.find(",1\n", at + 1)) {
+    ++marked;
+  }
+  EXPECT_EQ(marked, 2u) << text;
+}
+
+TEST(EstimateCli, WindowTextReportListsSwitches) {
+  const RunResult result =
+      Rcm({"estimate", "--calib", kRig, "--matches", MediumSwitchSequence(),
+           "--estimator", "window", "--window", "8"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("  switch     at frame 12"), std::string::npos)
+      << result.out;
+  EXPECT_NE(result.out.find("2 changes of medium"), std::string::npos)
+      << result.out;
+}
+
+TEST(EstimateCli, InvalidWindow) {
+  ExpectFailsWithOneLine(
+      Rcm({"estimate", "--calib", kRig, "--matches", kDemoMatches,
+           "--estimator", "window", "--window", "0"}),
+      2, "--window");
+}
+
+TEST(EstimateCli, RotationOnlyWithRefine) {
+  ExpectFailsWithOneLine(
+      Rcm({"estimate", "--calib", kRig, "--matches", kDemoMatches,
+           "--estimator", "online", "--refine-rotation"}),
+      2, "--refine-rotation works with --estimator refine");
+}
+
+TEST(EstimateCli, RefineDoesNotWarnOnUnrectifiedRig) {
+  const RunResult result =
+      Rcm({"estimate", "--calib",
+           RigWith("  - [1.0, 0.0, 0.0, -0.11]\n  - [0.0, 1.0, 0.0, 0.0]\n"
+                   "  - [0.0, 0.0, 1.0, 0.0]",
+                   "  - [0.9998476951563913, 0.0, 0.01745240643728351, -0.11]\n"
+                   "  - [0.0, 1.0, 0.0, 0.0]\n"
+                   "  - [-0.01745240643728351, 0.0, 0.9998476951563913, 0.0]"),
+           "--matches", kDemoMatches});
+  EXPECT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_TRUE(result.err.empty()) << result.err;
+}
+
 TEST(EstimateCli, DemoDataTextReport) {
   const RunResult result =
       Rcm({"estimate", "--calib", kRig, "--matches", kDemoMatches});
