@@ -10,9 +10,11 @@
 
 #include "rcm/estimation/batch_refinement.h"
 #include "rcm/estimation/closed_form.h"
+#include "rcm/estimation/online_estimator.h"
 #include "rcm/estimation/paper_online_estimator.h"
 #include "rcm/estimation/prepared_correspondence.h"
 #include "rcm/estimation/sampson_coplanarity_error.h"
+#include "rcm/estimation/sliding_window_estimator.h"
 #include "rcm/geometry/epipolar.h"
 #include "rcm/geometry/observability.h"
 #include "rcm/sim/reference_rigs.h"
@@ -125,6 +127,59 @@ BENCHMARK(BM_RefineRefractiveIndex)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Complexity(benchmark::oN);
+
+// One frame of 200 matches (0.5 px noise, 10 % outliers) into the online
+// estimator: the frame's robust fit, its inliers' cost function at the
+// Chebyshev nodes, the cumulative minimization. Time and memory per frame
+// do not depend on how many frames came before.
+std::vector<std::vector<StereoCorrespondence>> Frames(const StereoRig& rig,
+                                                      int count) {
+  std::vector<std::vector<StereoCorrespondence>> frames;
+  for (int f = 0; f < count; ++f) {
+    StereoSamplerOptions options;
+    options.per_frame = 200;
+    options.seed = 10 + f;
+    std::vector<StereoCorrespondence> matches =
+        SampleStereoCorrespondences(rig, options).value();
+    AddPixelNoise(0.5, 100 + f, &matches);
+    AddOutliers(rig, 0.1, 200 + f, &matches);
+    frames.push_back(std::move(matches));
+  }
+  return frames;
+}
+
+void BM_OnlineEstimatorAddFrame(benchmark::State& state) {
+  const StereoRig rig = AlphasenseFrontUnrectifiedRig();
+  const auto frames = Frames(rig, 16);
+  OnlineRefractiveIndexEstimator estimator =
+      OnlineRefractiveIndexEstimator::Create(rig, RefinementOptions()).value();
+  size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(estimator.AddFrame(frames[i]));
+    i = (i + 1 == frames.size()) ? 0 : i + 1;
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.counters["bytes"] = static_cast<double>(estimator.MemoryBytes());
+}
+BENCHMARK(BM_OnlineEstimatorAddFrame)->Unit(benchmark::kMillisecond);
+
+void BM_SlidingWindowAddFrame(benchmark::State& state) {
+  const StereoRig rig = AlphasenseFrontUnrectifiedRig();
+  const auto frames = Frames(rig, 16);
+  SlidingWindowRefractiveIndexEstimator estimator =
+      SlidingWindowRefractiveIndexEstimator::Create(rig, RefinementOptions(),
+                                                    SlidingWindowOptions())
+          .value();
+  int64_t frame = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(
+        estimator.AddFrame(frame, frames[frame % frames.size()]));
+    ++frame;
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.counters["bytes"] = static_cast<double>(estimator.MemoryBytes());
+}
+BENCHMARK(BM_SlidingWindowAddFrame)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace rcm
