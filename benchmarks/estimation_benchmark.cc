@@ -94,7 +94,7 @@ void BM_SampsonResidual(benchmark::State& state) {
       PrepareCorrespondences(rig, Matches(rig)).prepared;
   const Eigen::Matrix3d essential = EssentialMatrix(rig.right_from_left());
   size_t i = 0;
-  double residual;
+  double residual = 0.0;
   for (auto _ : state) {
     benchmark::DoNotOptimize(SampsonCoplanarityResidual<double>(
         essential, matches[i], 1.333, nullptr, &residual));

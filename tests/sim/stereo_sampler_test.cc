@@ -136,7 +136,9 @@ TEST(StereoSampler, OutliersReplaceTheRequestedFractionOfRightPixels) {
     const bool is_outlier = std::binary_search(
         outliers.begin(), outliers.end(), static_cast<int64_t>(i));
     changed += data[i].right_pixel != exact[i].right_pixel;
-    if (!is_outlier) EXPECT_EQ(data[i].right_pixel, exact[i].right_pixel);
+    if (!is_outlier) {
+      EXPECT_EQ(data[i].right_pixel, exact[i].right_pixel);
+    }
   }
   EXPECT_EQ(changed, 200u);
   // Deterministic per seed.

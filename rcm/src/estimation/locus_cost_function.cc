@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "rcm/estimation/sampson_coplanarity_error.h"
+#include "rcm/util/golden_section.h"
 #include "rcm/util/parallel_for.h"
 
 namespace rcm {
@@ -220,27 +221,9 @@ LocusCostFunction::Minimum LocusCostFunction::Minimize() const {
   // and a minimum there): golden-section search of C over both neighbours.
   low = sample(std::max(0, best - 1));
   high = sample(std::min(kNumSamples - 1, best + 1));
-  const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
-  double a = high - ratio * (high - low);
-  double b = low + ratio * (high - low);
-  double cost_a = Cost(a);
-  double cost_b = Cost(b);
-  while (high - low > 4.0 * std::numeric_limits<double>::epsilon()) {
-    if (cost_a <= cost_b) {
-      high = b;
-      b = a;
-      cost_b = cost_a;
-      a = high - ratio * (high - low);
-      cost_a = Cost(a);
-    } else {
-      low = a;
-      a = b;
-      cost_a = cost_b;
-      b = low + ratio * (high - low);
-      cost_b = Cost(b);
-    }
-  }
-  const double middle = 0.5 * (low + high);
+  const double middle =
+      GoldenSectionMinimize([this](double n) { return Cost(n); }, low, high,
+                            4.0 * std::numeric_limits<double>::epsilon());
   return result(Cost(middle) <= best_cost ? middle : at_best);
 }
 

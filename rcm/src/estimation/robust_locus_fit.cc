@@ -6,6 +6,7 @@
 
 #include "rcm/estimation/sampson_coplanarity_error.h"
 #include "rcm/geometry/epipolar.h"
+#include "rcm/util/golden_section.h"
 #include "rcm/util/parallel_for.h"
 
 namespace rcm {
@@ -101,34 +102,14 @@ double MinimizeRobustLocusCost(
       ScanRobustLocusCost(essential, matches, options, candidate);
   if (scan_seed != nullptr) *scan_seed = seed;
   const double step = 1.0 / (options.num_scan_points - 1);
-  double low = std::max(1.0, seed - step);
-  double high = std::min(2.0, seed + step);
+  const double low = std::max(1.0, seed - step);
+  const double high = std::min(2.0, seed + step);
   const auto cost = [&](double n) {
     return RobustLocusCost(essential, matches, n, options);
   };
-  // Golden-section search; the bracket shrinks by 0.618 per evaluation.
-  const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
-  double a = high - ratio * (high - low);
-  double b = low + ratio * (high - low);
-  double cost_a = cost(a);
-  double cost_b = cost(b);
-  while (high - low > kBracketTolerance) {
-    if (cost_a <= cost_b) {
-      high = b;
-      b = a;
-      cost_b = cost_a;
-      a = high - ratio * (high - low);
-      cost_a = cost(a);
-    } else {
-      low = a;
-      a = b;
-      cost_a = cost_b;
-      b = low + ratio * (high - low);
-      cost_b = cost(b);
-    }
-  }
+  const double middle =
+      GoldenSectionMinimize(cost, low, high, kBracketTolerance);
   // The seed itself may be better when the minimum sits on a bound.
-  const double middle = 0.5 * (low + high);
   return cost(middle) <= cost(seed) ? middle : seed;
 }
 
