@@ -17,7 +17,6 @@
 #include "rcm/estimation/batch_refinement.h"
 #include "rcm/estimation/online_estimator.h"
 #include "rcm/estimation/paper_online_estimator.h"
-#include "rcm/estimation/prepared_correspondence.h"
 #include "rcm/estimation/refinement_options.h"
 #include "rcm/estimation/sliding_window_estimator.h"
 #include "rcm/io/atomic_file.h"
@@ -280,6 +279,16 @@ StatusOr<Report> RunRefine(const StereoRig& rig,
   return report;
 }
 
+// The fields the online and window estimates share.
+template <typename Estimate>
+void CopyEstimate(const Estimate& estimate, Report* report) {
+  report->n = estimate.n;
+  report->sigma_n = estimate.sigma_n;
+  report->crlb = estimate.crlb;
+  report->sigma_px = estimate.sigma_px;
+  report->inliers = estimate.inliers;
+}
+
 std::string FrameLabel(int64_t frame) {
   return "frame " + std::to_string(frame);
 }
@@ -312,11 +321,7 @@ StatusOr<Report> RunOnline(const StereoRig& rig,
       "online robust least squares on the refractive epipolar loci (loss " +
       LossDescription(options) + ", inliers within " +
       FormatFixed(options.inlier_threshold_px, 2) + " px of each frame's fit)";
-  report.n = estimate->n;
-  report.sigma_n = estimate->sigma_n;
-  report.crlb = estimate->crlb;
-  report.sigma_px = estimate->sigma_px;
-  report.inliers = estimate->inliers;
+  CopyEstimate(*estimate, &report);
   report.invalid = invalid;
   report.extra["skipped_frames"] = estimator->num_skipped_frames();
   if (estimator->num_skipped_frames() > 0) {
@@ -344,9 +349,7 @@ StatusOr<Report> RunWindow(const StereoRig& rig,
     progress.Update(i + 1);
     const SlidingWindowRefractiveIndexEstimator::WindowUpdate update =
         estimator->AddFrame(frames[i].frame, frames[i].matches);
-    for (const StereoCorrespondence& match : frames[i].matches) {
-      invalid += !PrepareCorrespondence(rig, match).has_value();
-    }
+    invalid += update.correspondences - update.usable;
     FrameRow row{frames[i].frame, frames[i].timestamp};
     if (update.window.ok()) {
       row.n = update.window->n;
@@ -378,11 +381,7 @@ StatusOr<Report> RunWindow(const StereoRig& rig,
                   " frames, robust least squares on the refractive epipolar "
                   "loci, change of medium at z > " +
                   FormatFixed(window_options.change_threshold, 1);
-  report.n = estimate->n;
-  report.sigma_n = estimate->sigma_n;
-  report.crlb = estimate->crlb;
-  report.sigma_px = estimate->sigma_px;
-  report.inliers = estimate->inliers;
+  CopyEstimate(*estimate, &report);
   report.invalid = invalid;
   report.extra["switches"] = switches;
   report.extra["window"] = {{"frames", estimate->frames},

@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstdio>
 
-#include "rcm/camera/refractive_camera.h"
 #include "rcm/estimation/cramer_rao_bound.h"
 #include "rcm/sim/stereo_sampler.h"
 #include "support/test_rigs.h"
@@ -250,41 +249,12 @@ TEST(BatchRefinement, RotationCorrectionNotIdentifiableInNarrowField) {
   }
 }
 
-// Exact matches of the ideal Alphasense rig whose left pixels lie on one
-// image axis: normalized y = 0 (`on_row`) or x = 0, at depths 0.6-6 m.
-std::vector<StereoCorrespondence> MatchesOnAxis(bool on_row, int count) {
-  const StereoRig rig = test::AlphasenseIdealRig();
-  const RefractiveCamera left =
-      RefractiveCamera::Create(rig.left(), 1.333).value();
-  const RefractiveCamera right =
-      RefractiveCamera::Create(rig.right(), 1.333).value();
-  std::vector<StereoCorrespondence> matches;
-  for (int i = 0; i < count; ++i) {
-    const double along = -1.0 + 2.0 * (i + 0.5) / count;  // normalized
-    const Eigen::Vector2d normalized = on_row
-                                           ? Eigen::Vector2d(along, 0.0)
-                                           : Eigen::Vector2d(0.0, 0.6 * along);
-    StereoCorrespondence match;
-    match.left_pixel = rig.left().ImageFromNormalized(normalized);
-    const Eigen::Vector3d bearing =
-        left.BearingInWaterFromImage(match.left_pixel).value();
-    const double depth = 0.6 + 5.4 * ((i * 7) % count) / count;
-    const Eigen::Vector3d point = bearing * depth / bearing.z();
-    const std::optional<Eigen::Vector2d> right_pixel =
-        right.ImageFromPointInWater(rig.right_from_left().rotation * point +
-                                    rig.right_from_left().translation);
-    if (!right_pixel || !rig.right().InImage(*right_pixel)) continue;
-    match.right_pixel = *right_pixel;
-    matches.push_back(match);
-  }
-  return matches;
-}
-
 TEST(BatchRefinement, MatchesOnTheImageRowAxisAreRejected) {
   // Left pixels on the row through the principal point of the ideal rig:
   // the epipolar plane contains both optical axes, the locus is that row
   // for every n, and the data carry no information on n.
-  const std::vector<StereoCorrespondence> matches = MatchesOnAxis(true, 400);
+  const std::vector<StereoCorrespondence> matches =
+      test::ExactMatchesOnAxis(true, 400);
   ASSERT_GT(matches.size(), 200u);
   const StatusOr<RefinementSummary> summary = RefineRefractiveIndex(
       test::AlphasenseIdealRig(), matches, RefinementOptions());
@@ -298,8 +268,10 @@ TEST(BatchRefinement, MatchesOnTheImageAxesAreRejected) {
   // Both axes. On the column x = 0 the locus does depend on n, but only
   // through the disparity's second order: at 1 px of noise these 200
   // matches would know n to 0.18, above max_crlb_per_px.
-  std::vector<StereoCorrespondence> matches = MatchesOnAxis(true, 200);
-  const std::vector<StereoCorrespondence> column = MatchesOnAxis(false, 200);
+  std::vector<StereoCorrespondence> matches =
+      test::ExactMatchesOnAxis(true, 200);
+  const std::vector<StereoCorrespondence> column =
+      test::ExactMatchesOnAxis(false, 200);
   matches.insert(matches.end(), column.begin(), column.end());
   const StereoRig rig = test::AlphasenseIdealRig();
   EXPECT_GT(CramerRaoBoundN(rig, column, 1.333, 1.0).value(),

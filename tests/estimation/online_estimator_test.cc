@@ -11,7 +11,6 @@
 #include <string>
 #include <vector>
 
-#include "rcm/camera/refractive_camera.h"
 #include "rcm/estimation/batch_refinement.h"
 #include "rcm/sim/stereo_sampler.h"
 #include "support/test_rigs.h"
@@ -224,44 +223,14 @@ TEST(OnlineEstimator, FrameWithTooFewMatchesIsSkipped) {
   EXPECT_NEAR(full.cumulative->n, 1.333, kExactTolerance);
 }
 
-// Exact matches of the ideal Alphasense rig whose left pixels lie on one
-// image axis, normalized y = 0 (`on_row`) or x = 0, at depths 0.6-6 m
-// (as in batch_refinement_test.cc).
-std::vector<StereoCorrespondence> MatchesOnAxis(bool on_row, int count) {
-  const StereoRig rig = test::AlphasenseIdealRig();
-  const RefractiveCamera left =
-      RefractiveCamera::Create(rig.left(), 1.333).value();
-  const RefractiveCamera right =
-      RefractiveCamera::Create(rig.right(), 1.333).value();
-  std::vector<StereoCorrespondence> matches;
-  for (int i = 0; i < count; ++i) {
-    const double along = -1.0 + 2.0 * (i + 0.5) / count;
-    const Eigen::Vector2d normalized = on_row
-                                           ? Eigen::Vector2d(along, 0.0)
-                                           : Eigen::Vector2d(0.0, 0.6 * along);
-    StereoCorrespondence match;
-    match.left_pixel = rig.left().ImageFromNormalized(normalized);
-    const Eigen::Vector3d bearing =
-        left.BearingInWaterFromImage(match.left_pixel).value();
-    const double depth = 0.6 + 5.4 * ((i * 7) % count) / count;
-    const Eigen::Vector3d point = bearing * depth / bearing.z();
-    const std::optional<Eigen::Vector2d> right_pixel =
-        right.ImageFromPointInWater(rig.right_from_left().rotation * point +
-                                    rig.right_from_left().translation);
-    if (!right_pixel || !rig.right().InImage(*right_pixel)) continue;
-    match.right_pixel = *right_pixel;
-    matches.push_back(match);
-  }
-  return matches;
-}
-
 TEST(OnlineEstimator, MatchesOnTheImageAxesGiveNoEstimate) {
   // On the axes the loci (nearly) do not depend on n: at 1 px of noise
   // these matches would know n to worse than max_crlb_per_px, so the
   // estimator must refuse rather than report the minimizer of a flat cost.
   const StereoRig rig = test::AlphasenseIdealRig();
-  std::vector<StereoCorrespondence> axes = MatchesOnAxis(true, 200);
-  const std::vector<StereoCorrespondence> column = MatchesOnAxis(false, 200);
+  std::vector<StereoCorrespondence> axes = test::ExactMatchesOnAxis(true, 200);
+  const std::vector<StereoCorrespondence> column =
+      test::ExactMatchesOnAxis(false, 200);
   axes.insert(axes.end(), column.begin(), column.end());
   ASSERT_GT(axes.size(), 300u);
   OnlineRefractiveIndexEstimator estimator =

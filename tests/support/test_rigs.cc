@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "rcm/camera/refractive_camera.h"
 #include "rcm/sim/reference_rigs.h"
 #include "rcm/sim/stereo_sampler.h"
 
@@ -53,6 +54,34 @@ std::vector<StereoCorrespondence> ExactMatches(const StereoRig& rig, double n,
   options.per_frame = count;
   options.seed = seed;
   return SampleStereoCorrespondences(rig, options).value();
+}
+
+std::vector<StereoCorrespondence> ExactMatchesOnAxis(bool on_row, int count) {
+  const StereoRig rig = test::AlphasenseIdealRig();
+  const RefractiveCamera left =
+      RefractiveCamera::Create(rig.left(), 1.333).value();
+  const RefractiveCamera right =
+      RefractiveCamera::Create(rig.right(), 1.333).value();
+  std::vector<StereoCorrespondence> matches;
+  for (int i = 0; i < count; ++i) {
+    const double along = -1.0 + 2.0 * (i + 0.5) / count;  // normalized
+    const Eigen::Vector2d normalized = on_row
+                                           ? Eigen::Vector2d(along, 0.0)
+                                           : Eigen::Vector2d(0.0, 0.6 * along);
+    StereoCorrespondence match;
+    match.left_pixel = rig.left().ImageFromNormalized(normalized);
+    const Eigen::Vector3d bearing =
+        left.BearingInWaterFromImage(match.left_pixel).value();
+    const double depth = 0.6 + 5.4 * ((i * 7) % count) / count;
+    const Eigen::Vector3d point = bearing * depth / bearing.z();
+    const std::optional<Eigen::Vector2d> right_pixel =
+        right.ImageFromPointInWater(rig.right_from_left().rotation * point +
+                                    rig.right_from_left().translation);
+    if (!right_pixel || !rig.right().InImage(*right_pixel)) continue;
+    match.right_pixel = *right_pixel;
+    matches.push_back(match);
+  }
+  return matches;
 }
 
 std::vector<Eigen::Vector2d> ImageGrid(const Camera& camera, double step) {

@@ -40,6 +40,12 @@ StereoRig AlphasenseRealisticRig();
 std::vector<StereoCorrespondence> ExactMatches(const StereoRig& rig, double n,
                                                int count, uint64_t seed = 1);
 
+// `count` exact matches (n = 1.333, depths 0.6-6 m) of AlphasenseIdealRig()
+// whose left pixels lie on one image axis: normalized y = 0 (`on_row`,
+// where the loci do not depend on n) or x = 0 (where they barely do).
+// Matches whose right pixel leaves the image are left out.
+std::vector<StereoCorrespondence> ExactMatchesOnAxis(bool on_row, int count);
+
 // Pixels on a grid covering the whole image with `step` spacing, plus the
 // four borders (-0.5 and size - 0.5) and the exact corners.
 std::vector<Eigen::Vector2d> ImageGrid(const Camera& camera, double step);

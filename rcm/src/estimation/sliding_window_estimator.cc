@@ -88,6 +88,8 @@ SlidingWindowRefractiveIndexEstimator::AddFrame(
   WindowUpdate update;
   update.frame = frame;
   FrameFit fit = FitFrame(rig_, frame_matches, options_);
+  update.correspondences = fit.correspondences;
+  update.usable = fit.usable;
   update.frame_estimate = fit.estimate;
   if (!fit.estimate.ok()) {
     ++num_skipped_frames_;

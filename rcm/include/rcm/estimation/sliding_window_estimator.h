@@ -118,6 +118,8 @@ class SlidingWindowRefractiveIndexEstimator {
 
   struct WindowUpdate {
     int64_t frame = 0;
+    int64_t correspondences = 0;  // the frame's size
+    int64_t usable = 0;           // pixels that could be undistorted
     Decision decision = Decision::kSkipped;
     // The frame's own estimate, with the reason when there is none.
     StatusOr<LocusEstimate> frame_estimate = Status::Error("no estimate");
