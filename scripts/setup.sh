@@ -14,6 +14,7 @@ packages=(
   libgoogle-glog-dev   # CHECK macros for programmer errors
   libyaml-cpp-dev      # Kalibr camchain / ROS camera_info YAML
   nlohmann-json3-dev   # --json output
+  libopencv-dev        # images: PNG/JPEG I/O, remap, drawing plots, SIFT
   libgtest-dev libgmock-dev  # tests
   libbenchmark-dev     # benchmarks
 )

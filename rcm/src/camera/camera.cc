@@ -129,6 +129,14 @@ Eigen::Matrix2d Camera::ImageFromNormalizedJacobian(
   return result;
 }
 
+std::optional<Eigen::Vector2d> Camera::ProjectNormalized(
+    const Eigen::Vector2d& normalized) const {
+  if (!LensInvertibleAt(normalized)) return std::nullopt;
+  const Eigen::Vector2d pixel = ImageFromNormalized(normalized);
+  if (!pixel.allFinite()) return std::nullopt;
+  return pixel;
+}
+
 bool Camera::LensInvertibleAt(const Eigen::Vector2d& normalized) const {
   return ImageFromNormalizedJacobian(normalized).determinant() > 0.0;
 }

@@ -29,14 +29,6 @@ std::optional<Eigen::Vector3d> RefractiveCamera::BearingInWaterFromImage(
   return bearing.normalized();
 }
 
-std::optional<Eigen::Vector2d> RefractiveCamera::ImageFromNormalized(
-    const Eigen::Vector2d& normalized) const {
-  if (!camera_.LensInvertibleAt(normalized)) return std::nullopt;
-  const Eigen::Vector2d pixel = camera_.ImageFromNormalized(normalized);
-  if (!pixel.allFinite()) return std::nullopt;
-  return pixel;
-}
-
 std::optional<Eigen::Vector2d> RefractiveCamera::ImageFromPointInWater(
     const Eigen::Vector3d& point_in_camera) const {
   Eigen::Vector2d normalized;
@@ -44,7 +36,7 @@ std::optional<Eigen::Vector2d> RefractiveCamera::ImageFromPointInWater(
           n_, point_in_camera.data(), &normalized.x(), &normalized.y())) {
     return std::nullopt;
   }
-  return ImageFromNormalized(normalized);
+  return camera_.ProjectNormalized(normalized);
 }
 
 Eigen::Matrix3d RefractiveCamera::VirtualPinholeMatrix() const {
@@ -77,7 +69,7 @@ std::optional<Eigen::Vector2d> RefractiveCamera::ImageFromVirtualPinhole(
                                                  &normalized.y())) {
     return std::nullopt;
   }
-  return ImageFromNormalized(normalized);
+  return camera_.ProjectNormalized(normalized);
 }
 
 }  // namespace rcm

@@ -76,6 +76,11 @@ class Camera {
   template <typename T>
   void ImageFromNormalized(const T* normalized, T* pixel) const;
   Eigen::Vector2d ImageFromNormalized(const Eigen::Vector2d& normalized) const;
+  // The same, guarded: nullopt where the lens is not invertible (a folded
+  // branch, see LensInvertibleAt) or the pixel is not finite. What every
+  // projection of a ray into the image should call.
+  std::optional<Eigen::Vector2d> ProjectNormalized(
+      const Eigen::Vector2d& normalized) const;
 
   // Normalized point of a pixel; false / nullopt when undistortion fails.
   template <typename T>

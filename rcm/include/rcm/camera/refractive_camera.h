@@ -51,11 +51,6 @@ class RefractiveCamera {
  private:
   RefractiveCamera(const Camera& camera, double n) : camera_(camera), n_(n) {}
 
-  // Pixel of a lens-undistorted normalized point; nullopt where the lens is
-  // not invertible (a folded branch) or the pixel is not finite.
-  std::optional<Eigen::Vector2d> ImageFromNormalized(
-      const Eigen::Vector2d& normalized) const;
-
   Camera camera_;
   double n_;
 };

@@ -1,0 +1,254 @@
+#include "rcm/sim/flat_port.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "rcm/camera/refractive_model.h"
+#include "rcm/sim/flat_port_camera.h"
+#include "support/test_rigs.h"
+
+namespace rcm {
+namespace {
+
+// Thin port against the paper's closed-form model: the two share no code
+// and differ only by rounding (a few ulps of tan(theta) <= 7.2 at the
+// 82-degree Alphasense corners), so 1e-12 is tight.
+constexpr double kThinAgreementTolerance = 1e-12;
+// Round trip through the Newton solve, in normalized coordinates: the
+// issue asks for 1e-10; the solve converges to a few ulps of sin(theta).
+constexpr double kRoundTripTolerance = 1e-12;
+
+FlatPort ThickTiltedPort() {
+  FlatPort port;
+  port.air_gap = 0.03;
+  port.glass_thickness = 0.01;
+  port.glass_index = 1.49;
+  port.normal = TiltedPortNormal(3.0 * M_PI / 180.0, 0.7);
+  return port;
+}
+
+// Normalized points up to `max_angle` off axis in air.
+std::vector<Eigen::Vector2d> NormalizedPoints(double max_angle, int count,
+                                              uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> angle(0.0, max_angle);
+  std::uniform_real_distribution<double> azimuth(-M_PI, M_PI);
+  std::vector<Eigen::Vector2d> points;
+  for (int i = 0; i < count; ++i) {
+    const double r = std::tan(angle(rng));
+    const double a = azimuth(rng);
+    points.emplace_back(r * std::cos(a), r * std::sin(a));
+  }
+  return points;
+}
+
+TEST(FlatPort, DefaultIsTheValidThinPort) {
+  const FlatPort port;
+  EXPECT_TRUE(port.Check().ok());
+  EXPECT_TRUE(port.IsThin());
+  EXPECT_FALSE(ThickTiltedPort().IsThin());
+  EXPECT_TRUE(ThickTiltedPort().Check().ok());
+}
+
+TEST(FlatPort, CheckRejectsImpossiblePorts) {
+  FlatPort port;
+  port.air_gap = -0.001;
+  EXPECT_NE(port.Check().message().find("air_gap"), std::string::npos);
+  port = FlatPort();
+  port.glass_thickness = NAN;
+  EXPECT_NE(port.Check().message().find("glass_thickness"), std::string::npos);
+  port = FlatPort();
+  port.glass_index = 0.9;
+  EXPECT_NE(port.Check().message().find("glass_index"), std::string::npos);
+  port = FlatPort();
+  port.normal = Eigen::Vector3d::Zero();
+  EXPECT_NE(port.Check().message().find("normal"), std::string::npos);
+  port.normal = TiltedPortNormal(31.0 * M_PI / 180.0, 0.0);
+  EXPECT_NE(port.Check().message().find("tilted"), std::string::npos);
+  EXPECT_FALSE(ExactFlatPort::Create(FlatPort(), 2.1).ok());
+  EXPECT_FALSE(ExactFlatPort::Create(FlatPort(), NAN).ok());
+  EXPECT_TRUE(ExactFlatPort::Create(FlatPort(), 1.0).ok());
+}
+
+TEST(FlatPort, TiltedNormalIsUnitAndTilted) {
+  const Eigen::Vector3d normal = TiltedPortNormal(0.1, 0.3);
+  EXPECT_NEAR(normal.norm(), 1.0, 1e-15);
+  EXPECT_NEAR(std::acos(normal.z()), 0.1, 1e-12);
+  // azimuth 0 tilts about +x: the normal leans toward -y (pitch).
+  EXPECT_LT(TiltedPortNormal(0.1, 0.0).y(), 0.0);
+  EXPECT_NEAR(TiltedPortNormal(0.1, 0.0).x(), 0.0, 1e-15);
+}
+
+TEST(Refract, ObeysSnellsLawInTheplaneOfIncidence) {
+  const Eigen::Vector3d normal = TiltedPortNormal(0.2, 1.0);
+  const Eigen::Vector3d incident = Eigen::Vector3d(0.3, -0.2, 1.0).normalized();
+  for (const double eta : {1.0 / 1.49, 1.49 / 1.333, 1.0 / 1.333, 1.0}) {
+    const Eigen::Vector3d refracted = Refract(incident, normal, eta).value();
+    EXPECT_NEAR(refracted.norm(), 1.0, 1e-15);
+    // n1 sin(theta_i) = n2 sin(theta_t): |N x v_t| = eta |N x v_i|.
+    EXPECT_NEAR(normal.cross(refracted).norm(),
+                eta * normal.cross(incident).norm(), 1e-15);
+    // Coplanar with the incident ray and the normal.
+    EXPECT_NEAR(refracted.dot(normal.cross(incident)), 0.0, 1e-15);
+    EXPECT_GT(refracted.dot(normal), 0.0);
+  }
+}
+
+TEST(Refract, TotalInternalReflectionHasNoRay) {
+  // From glass (1.49) into air, past the critical angle asin(1/1.49) = 42.2
+  // degrees there is no refracted ray.
+  const Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  const double angle = 43.0 * M_PI / 180.0;
+  const Eigen::Vector3d incident(std::sin(angle), 0.0, std::cos(angle));
+  EXPECT_FALSE(Refract(incident, normal, 1.49).has_value());
+  const double below = 42.0 * M_PI / 180.0;
+  EXPECT_TRUE(Refract(Eigen::Vector3d(std::sin(below), 0.0, std::cos(below)),
+                      normal, 1.49)
+                  .has_value());
+}
+
+TEST(ExactFlatPort, ThinPortBackTraceIsThePapersBearing) {
+  for (const double n : {1.0, 1.2, 1.333, 1.6, 2.0}) {
+    const ExactFlatPort port = ExactFlatPort::Create(FlatPort(), n).value();
+    for (const Eigen::Vector2d& xb : NormalizedPoints(1.45, 500, 7)) {
+      const RayInMedium ray = port.RayFromNormalized(xb).value();
+      Eigen::Vector3d bearing;
+      FlatPortRefraction::BearingInWater(n, xb.x(), xb.y(), bearing.data());
+      EXPECT_LT((ray.direction - bearing.normalized()).norm(),
+                kThinAgreementTolerance)
+          << "n " << n << " at " << xb.transpose();
+      EXPECT_EQ(ray.origin.norm(), 0.0);
+    }
+  }
+}
+
+TEST(ExactFlatPort, ThinPortProjectionIsThePapersProjection) {
+  for (const double n : {1.0, 1.2, 1.333, 1.6, 2.0}) {
+    const ExactFlatPort port = ExactFlatPort::Create(FlatPort(), n).value();
+    int compared = 0;
+    for (const Eigen::Vector2d& xb : NormalizedPoints(1.45, 500, 8)) {
+      Eigen::Vector3d bearing;
+      FlatPortRefraction::BearingInWater(n, xb.x(), xb.y(), bearing.data());
+      const Eigen::Vector3d point = bearing * (3.7 / bearing.z());
+      Eigen::Vector2d expected;
+      ASSERT_TRUE(FlatPortRefraction::NormalizedFromPointInWater(
+          n, point.data(), &expected.x(), &expected.y()));
+      const Eigen::Vector2d actual = port.NormalizedFromPoint(point).value();
+      EXPECT_LT((actual - expected).norm(),
+                kThinAgreementTolerance * (1.0 + expected.norm()))
+          << "n " << n << " at " << xb.transpose();
+      ++compared;
+    }
+    EXPECT_EQ(compared, 500);
+  }
+}
+
+TEST(ExactFlatPort, RoundTripThickTiltedPort) {
+  for (const double n : {1.0, 1.333, 1.6}) {
+    const ExactFlatPort port =
+        ExactFlatPort::Create(ThickTiltedPort(), n).value();
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> distance(0.2, 20.0);
+    double worst = 0.0;
+    for (const Eigen::Vector2d& xb : NormalizedPoints(1.4, 2000, 9)) {
+      const std::optional<RayInMedium> ray = port.RayFromNormalized(xb);
+      ASSERT_TRUE(ray.has_value()) << xb.transpose();
+      const Eigen::Vector3d point = ray->origin + distance(rng) * ray->direction;
+      const Eigen::Vector2d back = port.NormalizedFromPoint(point).value();
+      worst = std::max(worst, (back - xb).norm() / (1.0 + xb.norm()));
+    }
+    EXPECT_LT(worst, kRoundTripTolerance) << "n " << n;
+  }
+}
+
+TEST(ExactFlatPort, RoundTripJustBeyondTheGlass) {
+  // Points a micrometer past the outer face: the last leg is tiny and the
+  // solve is dominated by the air gap and the glass.
+  const ExactFlatPort port =
+      ExactFlatPort::Create(ThickTiltedPort(), 1.333).value();
+  for (const Eigen::Vector2d& xb : NormalizedPoints(1.2, 300, 10)) {
+    const RayInMedium ray = port.RayFromNormalized(xb).value();
+    const Eigen::Vector3d point = ray.origin + 1e-6 * ray.direction;
+    const Eigen::Vector2d back = port.NormalizedFromPoint(point).value();
+    EXPECT_LT((back - xb).norm(), kRoundTripTolerance * (1.0 + xb.norm()));
+  }
+}
+
+TEST(ExactFlatPort, PlateInAirOnlyShiftsTheRay) {
+  // n = 1: a parallel glass plate displaces a ray without turning it.
+  FlatPort plate;
+  plate.air_gap = 0.01;
+  plate.glass_thickness = 0.008;
+  const ExactFlatPort port = ExactFlatPort::Create(plate, 1.0).value();
+  const Eigen::Vector2d xb(0.4, -0.3);
+  const RayInMedium ray = port.RayFromNormalized(xb).value();
+  EXPECT_LT((ray.direction - Eigen::Vector3d(0.4, -0.3, 1.0).normalized())
+                .norm(),
+            1e-15);
+  // The offset from the undeviated line through the center is the textbook
+  // plate displacement t sin(i - r) / cos(r).
+  const double incidence = std::atan(xb.norm());
+  const double in_glass = std::asin(std::sin(incidence) / 1.49);
+  const double shift = plate.glass_thickness * std::sin(incidence - in_glass) /
+                       std::cos(in_glass);
+  EXPECT_NEAR(ray.origin.cross(ray.direction).norm(), shift, 1e-15);
+}
+
+TEST(ExactFlatPort, OnAxisPointLooksAlongTheNormal) {
+  const ExactFlatPort port =
+      ExactFlatPort::Create(ThickTiltedPort(), 1.333).value();
+  const Eigen::Vector3d normal = port.port().normal;
+  const Eigen::Vector3d direction =
+      port.AirDirectionFromPoint(2.0 * normal).value();
+  EXPECT_LT((direction - normal).norm(), 1e-15);
+}
+
+TEST(ExactFlatPort, InvisiblePointsHaveNoProjection) {
+  const ExactFlatPort thick =
+      ExactFlatPort::Create(ThickTiltedPort(), 1.333).value();
+  // Inside the housing, or in the glass.
+  EXPECT_FALSE(thick.NormalizedFromPoint(Eigen::Vector3d(0, 0, 0.035)));
+  EXPECT_FALSE(thick.NormalizedFromPoint(Eigen::Vector3d(0, 0, -1.0)));
+  EXPECT_FALSE(thick.NormalizedFromPoint(Eigen::Vector3d(0, 0, NAN)));
+  // Thin port: past the critical angle of water (48.6 degrees from the
+  // axis) no ray in air reaches the point.
+  const ExactFlatPort thin = ExactFlatPort::Create(FlatPort(), 1.333).value();
+  const double critical = std::asin(1.0 / 1.333);
+  const double outside = critical + 1e-3;
+  EXPECT_FALSE(thin.NormalizedFromPoint(
+      Eigen::Vector3d(std::sin(outside), 0.0, std::cos(outside))));
+  const double inside = critical - 1e-3;
+  EXPECT_TRUE(thin.NormalizedFromPoint(
+      Eigen::Vector3d(std::sin(inside), 0.0, std::cos(inside))));
+}
+
+TEST(FlatPortCamera, PixelRoundTripThroughTheLens) {
+  // Alphasense equidistant lens, thick tilted port: pixel -> ray -> point
+  // -> pixel. Floored by the iterative lens undistortion (1e-9 px).
+  constexpr double kPixelTolerance = 1e-8;
+  const FlatPortCamera camera =
+      FlatPortCamera::Create(test::AlphasenseCam0(), ThickTiltedPort(), 1.333)
+          .value();
+  for (double u = 0.0; u < 720.0; u += 37.0) {
+    for (double v = 0.0; v < 540.0; v += 29.0) {
+      const Eigen::Vector2d pixel(u, v);
+      const RayInMedium ray = camera.RayFromImage(pixel).value();
+      const Eigen::Vector2d back =
+          camera.ImageFromPoint(ray.origin + 2.5 * ray.direction).value();
+      EXPECT_LT((back - pixel).norm(), kPixelTolerance) << pixel.transpose();
+    }
+  }
+}
+
+TEST(FlatPortCamera, RejectsInvalidPortOrIndex) {
+  FlatPort port;
+  port.air_gap = -1.0;
+  EXPECT_FALSE(FlatPortCamera::Create(test::AlphasenseCam0(), port, 1.333).ok());
+  EXPECT_FALSE(
+      FlatPortCamera::Create(test::AlphasenseCam0(), FlatPort(), 0.5).ok());
+}
+
+}  // namespace
+}  // namespace rcm
