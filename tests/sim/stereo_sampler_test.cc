@@ -4,8 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 
 #include "rcm/camera/refractive_camera.h"
+#include "rcm/estimation/batch_refinement.h"
+#include "rcm/sim/flat_port_camera.h"
 #include "support/test_rigs.h"
 
 namespace rcm {
@@ -150,6 +153,102 @@ TEST(StereoSampler, OutliersReplaceTheRequestedFractionOfRightPixels) {
   EXPECT_TRUE(AddOutliers(rig, 0.0, 5, &none).empty());
   std::vector<StereoCorrespondence> all = exact;
   EXPECT_EQ(AddOutliers(rig, 1.0, 5, &all).size(), exact.size());
+}
+
+TEST(FlatPortSampler, ThinPortReproducesTheModelSampler) {
+  // The same draws traced through the simulator's thin port and through the
+  // model: identical up to the lens undistortion's round trip (1e-9 px).
+  constexpr double kPixelTolerance = 1e-9;
+  const StereoRig rig = test::AlphasenseRealisticRig();
+  StereoSamplerOptions options;
+  options.num_frames = 2;
+  options.per_frame = 200;
+  const std::vector<StereoCorrespondence> model =
+      SampleStereoCorrespondences(rig, options).value();
+  const std::vector<StereoCorrespondence> exact =
+      SampleFlatPortCorrespondences(rig, FlatPort(), FlatPort(), options)
+          .value();
+  ASSERT_EQ(model.size(), exact.size());
+  for (size_t i = 0; i < model.size(); ++i) {
+    EXPECT_EQ(model[i].frame, exact[i].frame);
+    EXPECT_LT((model[i].left_pixel - exact[i].left_pixel).norm(),
+              kPixelTolerance);
+    EXPECT_LT((model[i].right_pixel - exact[i].right_pixel).norm(),
+              kPixelTolerance);
+  }
+}
+
+TEST(FlatPortSampler, EachFrameIsInItsOwnMedium) {
+  // Thin port, media switching per frame: the refinement recovers each
+  // frame's n exactly from that frame's matches.
+  const StereoRig rig = test::AlphasenseRealisticRig();
+  StereoSamplerOptions options;
+  options.num_frames = 3;
+  options.per_frame = 150;
+  const std::vector<double> media = {1.333, 1.0, 1.6};
+  const std::vector<StereoCorrespondence> sample =
+      SampleFlatPortCorrespondences(rig, FlatPort(), FlatPort(), options,
+                                    media)
+          .value();
+  for (int frame = 0; frame < 3; ++frame) {
+    std::vector<StereoCorrespondence> of_frame;
+    std::copy_if(sample.begin(), sample.end(), std::back_inserter(of_frame),
+                 [&](const auto& c) { return c.frame == frame; });
+    const RefinementSummary summary =
+        RefineRefractiveIndex(rig, of_frame, RefinementOptions()).value();
+    EXPECT_NEAR(summary.n, media[frame], 1e-9) << "frame " << frame;
+  }
+}
+
+TEST(FlatPortSampler, ThickPortRaysMeetAtTheScenePoint) {
+  // With 20 mm of air and 8 mm of glass the two pixels' rays in the medium
+  // (each from its own point on the glass) intersect: their distance is
+  // zero to the precision of the lens round trip (~1e-9 px at f = 345 px
+  // and a few meters: ~1e-11 m).
+  constexpr double kRayDistanceTolerance = 1e-9;  // meters
+  const StereoRig rig = test::AlphasenseRealisticRig();
+  FlatPort port;
+  port.air_gap = 0.02;
+  port.glass_thickness = 0.008;
+  StereoSamplerOptions options;
+  options.per_frame = 300;
+  const std::vector<StereoCorrespondence> sample =
+      SampleFlatPortCorrespondences(rig, port, port, options).value();
+  ASSERT_EQ(sample.size(), 300u);
+  const FlatPortCamera left =
+      FlatPortCamera::Create(rig.left(), port, options.n).value();
+  const FlatPortCamera right =
+      FlatPortCamera::Create(rig.right(), port, options.n).value();
+  const Rigid3d left_from_right = rig.right_from_left().Inverse();
+  for (const StereoCorrespondence& c : sample) {
+    const RayInMedium l = left.RayFromImage(c.left_pixel).value();
+    const RayInMedium r_in_right = right.RayFromImage(c.right_pixel).value();
+    const Eigen::Vector3d r_origin = left_from_right * r_in_right.origin;
+    const Eigen::Vector3d r_direction =
+        left_from_right.rotation * r_in_right.direction;
+    const Eigen::Vector3d normal = l.direction.cross(r_direction);
+    ASSERT_GT(normal.norm(), 1e-6);  // not parallel
+    EXPECT_LT(std::abs((r_origin - l.origin).dot(normal.normalized())),
+              kRayDistanceTolerance);
+  }
+}
+
+TEST(FlatPortSampler, RejectsBadMediaAndPorts) {
+  const StereoRig rig = test::AlphasenseRealisticRig();
+  StereoSamplerOptions options;
+  options.num_frames = 2;
+  EXPECT_FALSE(SampleFlatPortCorrespondences(rig, FlatPort(), FlatPort(),
+                                             options, {1.333})
+                   .ok());
+  EXPECT_FALSE(SampleFlatPortCorrespondences(rig, FlatPort(), FlatPort(),
+                                             options, {1.333, 2.5})
+                   .ok());
+  FlatPort bad;
+  bad.glass_index = 3.0;
+  const StatusOr<std::vector<StereoCorrespondence>> result =
+      SampleFlatPortCorrespondences(rig, FlatPort(), bad, options);
+  ASSERT_FALSE(result.ok());
+  EXPECT_NE(result.status().message().find("right port"), std::string::npos);
 }
 
 }  // namespace

@@ -2,11 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <utility>
 #include <numeric>
 #include <random>
 #include <sstream>
 
 #include "rcm/camera/refractive_camera.h"
+#include "rcm/sim/flat_port_camera.h"
 
 namespace rcm {
 
@@ -31,14 +34,19 @@ Status StereoSamplerOptions::Check() const {
   return Status::Error(message.str());
 }
 
-StatusOr<std::vector<StereoCorrespondence>> SampleStereoCorrespondences(
-    const StereoRig& rig, const StereoSamplerOptions& options) {
-  RCM_RETURN_IF_ERROR(options.Check());
-  const RefractiveCamera left =
-      RefractiveCamera::Create(rig.left(), options.n).value();
-  const RefractiveCamera right =
-      RefractiveCamera::Create(rig.right(), options.n).value();
+namespace {
 
+// Traces one drawn sample of `frame`: the point at depth Z = `depth` (left
+// camera frame) on the ray of left pixel `drawn`, imaged in both cameras.
+// Returns false when the point is not visible in both.
+using SampleTracer = std::function<bool(int frame, const Eigen::Vector2d& drawn,
+                                        double depth, Eigen::Vector2d* left,
+                                        Eigen::Vector2d* right)>;
+
+// The sampling loop shared by the model's and the flat port's sampler.
+StatusOr<std::vector<StereoCorrespondence>> SampleWithTracer(
+    const StereoRig& rig, const StereoSamplerOptions& options,
+    const SampleTracer& trace) {
   std::mt19937_64 rng(options.seed);
   std::uniform_real_distribution<double> u_dist(-0.5, rig.left().width() - 0.5);
   std::uniform_real_distribution<double> v_dist(-0.5,
@@ -64,28 +72,102 @@ StatusOr<std::vector<StereoCorrespondence>> SampleStereoCorrespondences(
       }
       const Eigen::Vector2d drawn(u_dist(rng), v_dist(rng));
       const double depth = depth_dist(rng);
-      const std::optional<Eigen::Vector3d> bearing =
-          left.BearingInWaterFromImage(drawn);
-      if (!bearing) continue;
-      const Eigen::Vector3d point_in_left = *bearing * (depth / bearing->z());
-      const std::optional<Eigen::Vector2d> left_pixel =
-          left.ImageFromPointInWater(point_in_left);
-      const std::optional<Eigen::Vector2d> right_pixel =
-          right.ImageFromPointInWater(rig.right_from_left() * point_in_left);
-      if (!left_pixel || !right_pixel || !rig.left().InImage(*left_pixel) ||
-          !rig.right().InImage(*right_pixel)) {
+      StereoCorrespondence correspondence;
+      if (!trace(frame, drawn, depth, &correspondence.left_pixel,
+                 &correspondence.right_pixel) ||
+          !rig.left().InImage(correspondence.left_pixel) ||
+          !rig.right().InImage(correspondence.right_pixel)) {
         continue;
       }
-      StereoCorrespondence correspondence;
       correspondence.frame = frame;
       correspondence.timestamp = frame / options.frame_rate;
-      correspondence.left_pixel = *left_pixel;
-      correspondence.right_pixel = *right_pixel;
       correspondences.push_back(correspondence);
       ++i;
     }
   }
   return correspondences;
+}
+
+}  // namespace
+
+StatusOr<std::vector<StereoCorrespondence>> SampleStereoCorrespondences(
+    const StereoRig& rig, const StereoSamplerOptions& options) {
+  RCM_RETURN_IF_ERROR(options.Check());
+  const RefractiveCamera left =
+      RefractiveCamera::Create(rig.left(), options.n).value();
+  const RefractiveCamera right =
+      RefractiveCamera::Create(rig.right(), options.n).value();
+  return SampleWithTracer(
+      rig, options,
+      [&](int, const Eigen::Vector2d& drawn, double depth,
+          Eigen::Vector2d* left_pixel, Eigen::Vector2d* right_pixel) {
+        const std::optional<Eigen::Vector3d> bearing =
+            left.BearingInWaterFromImage(drawn);
+        if (!bearing) return false;
+        const Eigen::Vector3d point_in_left = *bearing * (depth / bearing->z());
+        const std::optional<Eigen::Vector2d> l =
+            left.ImageFromPointInWater(point_in_left);
+        const std::optional<Eigen::Vector2d> r =
+            right.ImageFromPointInWater(rig.right_from_left() * point_in_left);
+        if (!l || !r) return false;
+        *left_pixel = *l;
+        *right_pixel = *r;
+        return true;
+      });
+}
+
+StatusOr<std::vector<StereoCorrespondence>> SampleFlatPortCorrespondences(
+    const StereoRig& rig, const FlatPort& left_port,
+    const FlatPort& right_port, const StereoSamplerOptions& options,
+    const std::vector<double>& n_of_frame) {
+  RCM_RETURN_IF_ERROR(options.Check());
+  if (!n_of_frame.empty() &&
+      n_of_frame.size() != static_cast<size_t>(options.num_frames)) {
+    std::ostringstream message;
+    message << "n_of_frame has " << n_of_frame.size() << " entries for "
+            << options.num_frames << " frames";
+    return Status::Error(message.str());
+  }
+  // One pair of port cameras per distinct medium, built once.
+  std::vector<double> media = n_of_frame;
+  if (media.empty()) media.assign(options.num_frames, options.n);
+  std::vector<std::pair<FlatPortCamera, FlatPortCamera>> cameras;
+  std::vector<size_t> camera_of_frame(media.size());
+  std::vector<double> distinct;
+  for (size_t f = 0; f < media.size(); ++f) {
+    auto it = std::find(distinct.begin(), distinct.end(), media[f]);
+    if (it == distinct.end()) {
+      StatusOr<FlatPortCamera> left =
+          FlatPortCamera::Create(rig.left(), left_port, media[f]);
+      StatusOr<FlatPortCamera> right =
+          FlatPortCamera::Create(rig.right(), right_port, media[f]);
+      if (!left.ok()) return left.status().WithContext("left port");
+      if (!right.ok()) return right.status().WithContext("right port");
+      cameras.emplace_back(left.value(), right.value());
+      distinct.push_back(media[f]);
+      it = distinct.end() - 1;
+    }
+    camera_of_frame[f] = static_cast<size_t>(it - distinct.begin());
+  }
+  return SampleWithTracer(
+      rig, options,
+      [&](int frame, const Eigen::Vector2d& drawn, double depth,
+          Eigen::Vector2d* left_pixel, Eigen::Vector2d* right_pixel) {
+        const auto& [left, right] = cameras[camera_of_frame[frame]];
+        const std::optional<RayInMedium> ray = left.RayFromImage(drawn);
+        if (!ray || !(ray->direction.z() > 0.0)) return false;
+        const Eigen::Vector3d point_in_left =
+            ray->origin +
+            ray->direction * ((depth - ray->origin.z()) / ray->direction.z());
+        const std::optional<Eigen::Vector2d> l =
+            left.ImageFromPoint(point_in_left);
+        const std::optional<Eigen::Vector2d> r =
+            right.ImageFromPoint(rig.right_from_left() * point_in_left);
+        if (!l || !r) return false;
+        *left_pixel = *l;
+        *right_pixel = *r;
+        return true;
+      });
 }
 
 void AddPixelNoise(double sigma_px, uint64_t seed,

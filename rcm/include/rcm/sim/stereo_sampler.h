@@ -1,13 +1,15 @@
-// Correspondences sampled from the refractive model itself: exact up to
-// floating point, for tests, examples and benchmarks. (An independent
-// flat-port ray tracer, which does not share code with the model, is the
-// job of the simulator; this sampler is the model's own forward map.)
+// Correspondences sampled in two ways: from the refractive model itself
+// (the model's own forward map, exact up to floating point, for tests of
+// the estimators) and from the exact flat port of the simulator (physics
+// that shares no code with the model: thick glass, air gaps, tilt), for
+// tests of the model itself.
 //
 // Sampling: a left pixel uniform over the image, a depth Z (left camera
 // frame) uniform in [min_depth, max_depth]; the scene point is the left
 // pixel's ray in the medium at that depth, and both pixels are obtained by
-// projecting it (RefractiveCamera::ImageFromPointInWater). Points whose
-// right pixel falls outside the right image are redrawn.
+// projecting it (RefractiveCamera::ImageFromPointInWater, or
+// FlatPortCamera::ImageFromPoint). Points whose right pixel falls outside
+// the right image are redrawn.
 #ifndef RCM_SIM_STEREO_SAMPLER_H_
 #define RCM_SIM_STEREO_SAMPLER_H_
 
@@ -16,6 +18,7 @@
 
 #include "rcm/geometry/stereo_correspondence.h"
 #include "rcm/geometry/stereo_rig.h"
+#include "rcm/sim/flat_port.h"
 #include "rcm/util/status.h"
 
 namespace rcm {
@@ -37,6 +40,17 @@ struct StereoSamplerOptions {
 // one in 100 draws lands in both images).
 StatusOr<std::vector<StereoCorrespondence>> SampleStereoCorrespondences(
     const StereoRig& rig, const StereoSamplerOptions& options);
+
+// The same sampling through exact flat ports (flat_port_camera.h): the
+// left pixel's ray in the medium starts on the outer glass face and the
+// point is where it reaches depth Z. The medium of frame f is
+// n_of_frame[f] when given (num_frames entries, each in [1, 2]; media that
+// switch between frames), options.n otherwise. Fails as the model sampler
+// does, or when a port is invalid.
+StatusOr<std::vector<StereoCorrespondence>> SampleFlatPortCorrespondences(
+    const StereoRig& rig, const FlatPort& left_port,
+    const FlatPort& right_port, const StereoSamplerOptions& options,
+    const std::vector<double>& n_of_frame = {});
 
 // Adds independent zero-mean Gaussian noise of standard deviation sigma_px
 // to all four pixel coordinates.
