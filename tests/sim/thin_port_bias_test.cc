@@ -1,0 +1,116 @@
+#include "rcm/sim/thin_port_bias.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "rcm/sim/reference_rigs.h"
+
+namespace rcm {
+namespace {
+
+FlatPort Port(double air_gap_mm, double glass_mm) {
+  FlatPort port;
+  port.air_gap = air_gap_mm * 1e-3;
+  port.glass_thickness = glass_mm * 1e-3;
+  return port;
+}
+
+TEST(ThinPortBias, ThinPortIsUnbiased) {
+  const ThinPortBias bias =
+      MeasureThinPortBias(AlphasenseFrontRectifiedRig(), FlatPort(),
+                          ThinPortBiasOptions())
+          .value();
+  EXPECT_LT(std::abs(bias.bias), 1e-9);
+  EXPECT_LT(bias.rms_residual, 1e-6);
+  EXPECT_EQ(bias.inliers, 2000);
+}
+
+TEST(ThinPortBias, AirGapBiasesTheEstimateDown) {
+  // The thin model explains the gap's extra lateral offset with a smaller
+  // bending: the bias is negative and grows with the gap, and the thin
+  // model visibly misfits (nonzero residuals on exact data).
+  double previous = 0.0;
+  for (const double gap_mm : {2.0, 5.0, 10.0, 20.0}) {
+    const ThinPortBias bias =
+        MeasureThinPortBias(AlphasenseFrontRectifiedRig(), Port(gap_mm, 0.0),
+                            ThinPortBiasOptions())
+            .value();
+    EXPECT_LT(bias.bias, previous) << gap_mm << " mm";
+    EXPECT_GT(bias.rms_residual, 0.0);
+    previous = bias.bias;
+  }
+}
+
+TEST(ThinPortBias, RejectsInvalidInput) {
+  ThinPortBiasOptions options;
+  options.num_matches = 5;
+  EXPECT_FALSE(MeasureThinPortBias(AlphasenseFrontRectifiedRig(), FlatPort(),
+                                   options)
+                   .ok());
+  options = ThinPortBiasOptions();
+  options.n = 2.5;
+  EXPECT_FALSE(MeasureThinPortBias(AlphasenseFrontRectifiedRig(), FlatPort(),
+                                   options)
+                   .ok());
+  EXPECT_FALSE(MeasureThinPortBias(AlphasenseFrontRectifiedRig(),
+                                   Port(-1.0, 0.0), ThinPortBiasOptions())
+                   .ok());
+}
+
+// Cells "+0.0123" of a Markdown table row "| 5 mm | +0.0123 | ... |".
+std::vector<std::string> Cells(const std::string& row) {
+  std::vector<std::string> cells;
+  std::stringstream stream(row);
+  std::string cell;
+  while (std::getline(stream, cell, '|')) {
+    const size_t begin = cell.find_first_not_of(' ');
+    if (begin == std::string::npos) continue;
+    cells.push_back(cell.substr(begin, cell.find_last_not_of(' ') - begin + 1));
+  }
+  return cells;
+}
+
+TEST(ThinPortBias, ReadmeTableIsCurrent) {
+  // The README's approximation table is examples/api/thin_port_bias_table
+  // run with its defaults (the defaults of ThinPortBiasOptions). Every cell
+  // is recomputed; printed with 4 decimals, so they agree to 5e-5.
+  constexpr double kPrintedPrecision = 5e-5 + 1e-9;
+  std::ifstream readme(std::string(RCM_SOURCE_DIR) + "/README.md");
+  ASSERT_TRUE(readme.good());
+  std::string line;
+  while (std::getline(readme, line) &&
+         line.find("<!-- thin-port-bias-table -->") == std::string::npos) {
+  }
+  ASSERT_TRUE(readme.good()) << "README has no thin-port-bias-table marker";
+  std::getline(readme, line);  // header: | air gap \ glass | 0 mm | ...
+  std::vector<double> glass_mm;
+  for (size_t i = 1; i < Cells(line).size(); ++i) {
+    glass_mm.push_back(std::stod(Cells(line)[i]));
+  }
+  ASSERT_GE(glass_mm.size(), 2u);
+  std::getline(readme, line);  // |---|---|
+  int rows = 0;
+  while (std::getline(readme, line) && line.rfind("|", 0) == 0) {
+    const std::vector<std::string> cells = Cells(line);
+    ASSERT_EQ(cells.size(), glass_mm.size() + 1) << line;
+    const double gap_mm = std::stod(cells[0]);
+    for (size_t j = 0; j < glass_mm.size(); ++j) {
+      const ThinPortBias bias =
+          MeasureThinPortBias(AlphasenseFrontRectifiedRig(),
+                              Port(gap_mm, glass_mm[j]), ThinPortBiasOptions())
+              .value();
+      EXPECT_NEAR(std::stod(cells[j + 1]), bias.bias, kPrintedPrecision)
+          << "gap " << gap_mm << " mm, glass " << glass_mm[j] << " mm";
+    }
+    ++rows;
+  }
+  EXPECT_GE(rows, 5);
+}
+
+}  // namespace
+}  // namespace rcm
