@@ -27,10 +27,14 @@ std::string DashedName(std::string name) {
   return name;
 }
 
-// Flags of this file and of the subcommand's own file.
+// Flags of this file and of the subcommand's flag files.
 bool OwnsFlag(const Subcommand& subcommand,
               const gflags::CommandLineFlagInfo& flag) {
-  return flag.filename == subcommand.source || flag.filename == __FILE__;
+  if (flag.filename == __FILE__) return true;
+  for (const char* source : subcommand.flag_sources) {
+    if (flag.filename == source) return true;
+  }
+  return false;
 }
 
 void PrintHelp(const Subcommand& subcommand) {

@@ -4,6 +4,7 @@
 #define RCM_EXAMPLES_CLI_COMMAND_H_
 
 #include <string>
+#include <vector>
 
 namespace rcm::cli {
 
@@ -16,7 +17,10 @@ struct Subcommand {
   const char* name;     // e.g. "estimate"
   const char* summary;  // one line for `rcm --help`
   const char* usage;    // the text of `rcm NAME --help` above the flags
-  const char* source;   // __FILE__ of the file that defines its flags
+  // __FILE__ of each file whose flags it takes: its own file, then shared
+  // flag files (rig_flags.cc, simulation_flags.cc). The flags of
+  // command.cc (--json) belong to every subcommand.
+  std::vector<const char*> flag_sources;
   int (*run)();         // runs after the flags are parsed
 };
 

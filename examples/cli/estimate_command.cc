@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "command.h"
+#include "rig_flags.h"
 #include "rcm/estimation/batch_refinement.h"
 #include "rcm/estimation/online_estimator.h"
 #include "rcm/estimation/paper_online_estimator.h"
@@ -25,9 +26,6 @@
 
 DECLARE_bool(json);
 
-DEFINE_string(calib, "",
-              "the in-air calibration: a Kalibr camchain YAML, or two ROS "
-              "camera_info YAML files as LEFT.yaml,RIGHT.yaml (required)");
 DEFINE_string(matches, "",
               "correspondence CSV with header frame,xl,yl,xr,yr[,t] in raw "
               "pixels (required)");
@@ -43,8 +41,6 @@ DEFINE_double(change_threshold, 5.0,
               "window: a frame whose own n differs from the window's by more "
               "than this many combined sigmas is inconsistent; two in a row "
               "that agree declare a change of medium");
-DEFINE_string(left, "cam0", "camchain camera that is the left one");
-DEFINE_string(right, "cam1", "camchain camera that is the right one");
 DEFINE_string(per_frame, "",
               "also write one row per frame to this CSV: frame,t,n,sigma_n,"
               "switch (refine: each frame's own estimate; online and "
@@ -460,8 +456,11 @@ int RunEstimate();
 }  // namespace
 
 extern const Subcommand kEstimateCommand = {
-    "estimate", "refractive index n from stereo correspondences", kUsage,
-    __FILE__, RunEstimate};
+    "estimate",
+    "refractive index n from stereo correspondences",
+    kUsage,
+    {__FILE__, kRigFlagsSource},
+    RunEstimate};
 
 namespace {
 
