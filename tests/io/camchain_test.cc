@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "rcm/io/atomic_file.h"
+#include "rcm/sim/reference_rigs.h"
 #include "support/reader_inputs.h"
 #include "support/temp_file.h"
 
@@ -776,6 +777,20 @@ TEST(CamchainCameraIndex, ReadsCanonicalNamesOnly) {
   EXPECT_FALSE(CamchainCameraIndex("cam1x").has_value());
   EXPECT_FALSE(CamchainCameraIndex("camera").has_value());
   EXPECT_FALSE(CamchainCameraIndex("cam99999999999").has_value());
+}
+
+TEST(Camchain, FromStereoRigReadsBackAsTheSameRig) {
+  const StereoRig rig = AlphasenseFrontUnrectifiedRig();
+  const Camchain camchain = CamchainFromStereoRig(rig);
+  const Camchain parsed =
+      ParseCamchain(FormatCamchain(camchain), "rig.yaml").value();
+  const StereoRig back = StereoRigFromCamchain(parsed, 0, 1).value();
+  EXPECT_EQ(back.left(), rig.left());
+  EXPECT_EQ(back.right(), rig.right());
+  EXPECT_EQ(back.right_from_left().rotation, rig.right_from_left().rotation);
+  EXPECT_EQ(back.right_from_left().translation,
+            rig.right_from_left().translation);
+  EXPECT_EQ(parsed.cameras[0].cam_overlaps, std::vector<int>{1});
 }
 
 }  // namespace

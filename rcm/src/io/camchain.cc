@@ -517,4 +517,14 @@ StatusOr<StereoRig> StereoRigFromCamchain(const Camchain& camchain,
   return rig;
 }
 
+Camchain CamchainFromStereoRig(const StereoRig& rig) {
+  Camchain camchain;
+  CamchainCamera left{rig.left(), std::nullopt, std::nullopt, std::nullopt,
+                      {1}, ""};
+  CamchainCamera right{rig.right(), rig.right_from_left(), std::nullopt,
+                       std::nullopt, {0}, ""};
+  camchain.cameras = {left, right};
+  return camchain;
+}
+
 }  // namespace rcm

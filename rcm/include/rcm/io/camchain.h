@@ -96,6 +96,10 @@ Status WriteCamchain(const std::string& path, const Camchain& camchain);
 StatusOr<StereoRig> StereoRigFromCamchain(const Camchain& camchain,
                                           int left_index, int right_index);
 
+// The two-camera camchain of a rig: cam0 the left camera, cam1 the right
+// one with T_cn_cnm1 = right_from_left, each listing the other as overlap.
+Camchain CamchainFromStereoRig(const StereoRig& rig);
+
 }  // namespace rcm
 
 #endif  // RCM_IO_CAMCHAIN_H_
