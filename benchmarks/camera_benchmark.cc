@@ -2,10 +2,12 @@
 // loop of undistortion maps, feature normalization and the estimators.
 #include <benchmark/benchmark.h>
 
+#include <opencv2/core.hpp>
 #include <vector>
 
 #include "rcm/camera/camera.h"
 #include "rcm/camera/refractive_camera.h"
+#include "rcm/camera/virtual_pinhole_remap.h"
 #include "rcm/sim/reference_rigs.h"
 
 namespace rcm {
@@ -96,6 +98,58 @@ void BM_ImageFromPointInWater(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_ImageFromPointInWater);
+
+// Virtual pinhole maps of the 720x540 Alphasense camera: n = range(0) /
+// 1000 on range(1) threads, for the K_n view.
+void BM_BuildVirtualPinholeMaps(benchmark::State& state) {
+  const RefractiveCamera camera =
+      RefractiveCamera::Create(AlphasenseFrontCam0(), state.range(0) / 1000.0)
+          .value();
+  const VirtualPinholeView view = ChooseVirtualPinholeView(camera).value();
+  const int num_threads = static_cast<int>(state.range(1));
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(
+        BuildVirtualPinholeMaps(camera, view, num_threads).value());
+  }
+  state.SetItemsProcessed(state.iterations() * view.width * view.height);
+}
+BENCHMARK(BM_BuildVirtualPinholeMaps)
+    ->ArgsProduct({{1000, 1333, 1500}, {1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// The bisection for the view without black borders (n = 1.333).
+void BM_NoBorderVirtualPinholeView(benchmark::State& state) {
+  const RefractiveCamera camera =
+      RefractiveCamera::Create(AlphasenseFrontCam0(), 1.333).value();
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(
+        ChooseVirtualPinholeView(camera, VirtualPinholeFit::kNoBorder).value());
+  }
+}
+BENCHMARK(BM_NoBorderVirtualPinholeView)->Unit(benchmark::kMillisecond);
+
+// Remapping one 720x540 CV_8UC1 image (n = 1.333): range(0) = 1 with the
+// fixed-point maps, 0 with the float maps.
+void BM_RemapToVirtualPinhole(benchmark::State& state) {
+  const RefractiveCamera camera =
+      RefractiveCamera::Create(AlphasenseFrontCam0(), 1.333).value();
+  const VirtualPinholeView view = ChooseVirtualPinholeView(camera).value();
+  const RemapMaps maps =
+      BuildVirtualPinholeMaps(camera, view, 2, state.range(0) != 0).value();
+  cv::Mat raw(540, 720, CV_8UC1);
+  cv::RNG rng(1);
+  rng.fill(raw, cv::RNG::UNIFORM, 0, 256);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(RemapToVirtualPinhole(raw, maps));
+  }
+  state.SetLabel(state.range(0) != 0 ? "fixed-point maps" : "float maps");
+}
+BENCHMARK(BM_RemapToVirtualPinhole)
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace rcm

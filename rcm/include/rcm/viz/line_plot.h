@@ -11,10 +11,15 @@
 //
 // The data range is the extent of every finite value with a margin (5 % of
 // the span in y, 2 % in x) unless set explicitly. Ticks are "nice" numbers:
-// multiples of a step s = m 10^k with m in {1, 2, 5}, as many as fit
-// without their labels touching, printed with max(0, -k) decimals (step
-// 0.005 -> "1.335"). NaN (or infinite) values are not drawn: they break a
-// line or a band in two and a marker is skipped.
+// multiples of a step s = m 10^k with m in {1, 2, 5}, as many as fit with
+// two digits of space between x labels and 4.5 text heights between y
+// labels, printed with max(0, -k) decimals (step 0.005 -> "1.335"). NaN
+// (or infinite) values are not drawn: they break a line or a band in two
+// and a marker is skipped.
+//
+// Text is OpenCV's Hershey font; everything is drawn at 3x the output size
+// with cv::LINE_AA and averaged down, and text and strokes scale with the
+// image (sqrt of its area over 1000 x 600).
 //
 // Colors are BGR, as everywhere in OpenCV; a series without a color takes
 // the next one of a ten-color palette (matplotlib's "tab10").
@@ -24,6 +29,7 @@
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace rcm {
@@ -32,13 +38,17 @@ namespace rcm {
 // brown, pink, gray, olive, cyan.
 cv::Scalar PaletteColor(int index);
 
-// At most max_ticks (>= 2) nice ticks inside [lo, hi] (lo < hi, finite) with
-// the smallest nice step that allows it: consecutive multiples of the step,
-// the first within one step of lo, the last within one step of hi.
-std::vector<double> NiceTicks(double lo, double hi, int max_ticks);
-// The step of NiceTicks: the smallest m 10^k (m in {1, 2, 5}) >= span /
-// max_ticks.
-double NiceTickStep(double span, int max_ticks);
+// Tick marks of an axis.
+struct AxisTicks {
+  std::vector<double> values;  // consecutive multiples of step, ascending
+  double step = 1.0;           // m 10^k, m in {1, 2, 5}
+  int decimals = 0;            // TickDecimals(step)
+};
+
+// The ticks inside [lo, hi] (finite, lo < hi) with the smallest nice step
+// that gives at most max_ticks (>= 2) of them. There is at least one; the
+// first lies within one step of lo, the last within one step of hi.
+AxisTicks NiceTicks(double lo, double hi, int max_ticks);
 // Decimals that print every multiple of `step` exactly: max(0, -k).
 int TickDecimals(double step);
 // "%.*f" with `decimals`, without a minus sign on zero.
@@ -74,7 +84,8 @@ enum class LegendPosition {
   kTopLeft,
   kBottomRight,
   kBottomLeft,
-  // Centered under the x-axis label, entries side by side.
+  // Centered under the x-axis label, the entries in as many columns as
+  // fit the image width.
   kBelow,
   kNone,
 };
@@ -87,8 +98,8 @@ struct PlotAxes {
   double y_max = 1.0;
   // The plot area in output pixels.
   cv::Rect2d area;
-  std::vector<double> x_ticks;
-  std::vector<double> y_ticks;
+  AxisTicks x_ticks;
+  AxisTicks y_ticks;
 
   // (u, v) of the formula at the top of this file.
   cv::Point2d PixelFromData(double x, double y) const;
@@ -106,8 +117,9 @@ class LinePlot {
 
   // Series. x and y (and y_low, y_high) have equal lengths (CHECKed); an
   // empty label keeps the series out of the legend. Series are drawn in
-  // layers whatever the order of the calls: bands, then reference lines,
-  // then lines, then markers; within a layer in the order added.
+  // layers whatever the order of the calls: bands, then reference lines
+  // (horizontal and vertical), then lines, then markers; within a layer in
+  // the order added. Legend entries follow the order of the calls.
   // A polyline through (x_i, y_i).
   void AddLine(std::vector<double> x, std::vector<double> y, std::string label,
                const LineStyle& style = LineStyle());
@@ -149,8 +161,17 @@ class LinePlot {
   struct Layout;
   class Canvas;
 
+  // What DrawData draws: the plot, or where a legend would hide lines
+  // (markers, reference lines) or bands.
+  enum class DataPass { kColor, kLinesMask, kBandsMask };
+
   cv::Scalar NextColor(const std::optional<cv::Scalar>& color);
+  bool HasLegendEntries() const;
+  // The layout without the legend inside the plot area placed.
   Layout ComputeLayout(int width, int height, bool legend_below) const;
+  // The layout with the legend placed (LegendPosition resolved).
+  Layout ResolveLayout(int width, int height) const;
+  void DrawData(const Layout& layout, DataPass pass, Canvas* canvas) const;
   void DrawLegend(const Layout& layout, Canvas* canvas) const;
 
   std::string title_;
