@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "command.h"
+#include "progress.h"
 #include "rig_flags.h"
 #include "rcm/estimation/batch_refinement.h"
 #include "rcm/estimation/online_estimator.h"
@@ -22,6 +23,7 @@
 #include "rcm/estimation/sliding_window_estimator.h"
 #include "rcm/io/atomic_file.h"
 #include "rcm/io/correspondence_csv.h"
+#include "rcm/io/number_format.h"
 #include "rcm/io/stereo_rig_file.h"
 
 DECLARE_bool(json);
@@ -86,15 +88,6 @@ constexpr double kRectifiedToleranceDeg = 0.05;
 
 double Degrees(double radians) { return radians * 180.0 / M_PI; }
 
-std::string FormatFixed(double value, int digits) {
-  if (!std::isfinite(value)) return "n/a";
-  std::ostringstream out;
-  out.setf(std::ios::fixed);
-  out.precision(digits);
-  out << value;
-  return out.str();
-}
-
 // JSON number, or null when not finite.
 nlohmann::json JsonNumber(double value) {
   return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json();
@@ -146,29 +139,6 @@ std::string FormatFrameRows(const std::vector<FrameRow>& rows) {
   }
   return out.str();
 }
-
-// Shows "frame k of N" on a terminal (stderr) for runs long enough to
-// wait for; silent when stderr is redirected.
-class Progress {
- public:
-  Progress(const char* what, size_t total)
-      : what_(what), total_(total), enabled_(isatty(STDERR_FILENO) != 0) {}
-  ~Progress() {
-    if (shown_) std::cerr << "\r\033[K" << std::flush;
-  }
-  void Update(size_t done) {
-    if (!enabled_ || total_ < 2) return;
-    std::cerr << "\r" << what_ << " " << done << " of " << total_ << " ("
-              << (100 * done / total_) << " %)" << std::flush;
-    shown_ = true;
-  }
-
- private:
-  const char* what_;
-  size_t total_;
-  bool enabled_;
-  bool shown_ = false;
-};
 
 // What every estimator reports; fields an estimator does not have stay
 // NaN / empty and print as null.

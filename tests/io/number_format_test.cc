@@ -105,5 +105,13 @@ TEST(QuoteForMessage, ShortensTextPast40Bytes) {
             "'" + std::string(39, 'x') + "\\x0a...'");
 }
 
+TEST(FormatFixed, PrintsFixedDecimalsAndNaForNonFinite) {
+  EXPECT_EQ(FormatFixed(1.334981, 5), "1.33498");
+  EXPECT_EQ(FormatFixed(0.5, 0), "0");
+  EXPECT_EQ(FormatFixed(-2.0, 2), "-2.00");
+  EXPECT_EQ(FormatFixed(NAN, 3), "n/a");
+  EXPECT_EQ(FormatFixed(-INFINITY, 3), "n/a");
+}
+
 }  // namespace
 }  // namespace rcm

@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
+#include <sstream>
 #include <string_view>
 #include <system_error>
 
@@ -61,6 +62,15 @@ std::string FormatDouble(double value) {
   if (magnitude < 10) out += '0';
   out += std::to_string(magnitude);
   return out;
+}
+
+std::string FormatFixed(double value, int digits) {
+  if (!std::isfinite(value)) return "n/a";
+  std::ostringstream out;
+  out.setf(std::ios::fixed);
+  out.precision(digits);
+  out << value;
+  return out.str();
 }
 
 }  // namespace rcm

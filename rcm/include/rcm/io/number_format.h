@@ -23,6 +23,10 @@ namespace rcm {
 
 std::string FormatDouble(double value);
 
+// For people rather than files: `digits` decimals in fixed notation
+// ("1.33498"), "n/a" when the value is not finite.
+std::string FormatFixed(double value, int digits);
+
 }  // namespace rcm
 
 #endif  // RCM_IO_NUMBER_FORMAT_H_
