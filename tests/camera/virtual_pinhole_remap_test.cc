@@ -263,6 +263,36 @@ TEST(VirtualPinholeRemap, GridPointsLandWhereTheVirtualPinholeSeesThem) {
   }
 }
 
+TEST(VirtualPinholeRemap, RotatedViewSeesTheRotatedRays) {
+  // A view rotated by R sees the ray R d_view at the output pixel K' d_view:
+  // the map holds the raw pixel of that ray in the medium.
+  const RefractiveCamera camera = Refractive(test::AlphasenseCam0(), 1.333);
+  VirtualPinholeView view = ChooseVirtualPinholeView(camera).value();
+  view.camera_from_view =
+      Eigen::AngleAxisd(0.05, Eigen::Vector3d(0.3, -1.0, 0.2).normalized())
+          .toRotationMatrix();
+  const RemapMaps maps = BuildVirtualPinholeMaps(camera, view).value();
+  int compared = 0;
+  for (int v = 0; v < view.height; v += 23) {
+    for (int u = 0; u < view.width; u += 31) {
+      const Eigen::Vector3d ray =
+          view.camera_from_view * view.k.inverse() * Eigen::Vector3d(u, v, 1);
+      const std::optional<Eigen::Vector2d> raw =
+          camera.ImageFromPointInWater(ray);
+      if (!raw || !camera.camera().InImage(*raw)) {
+        EXPECT_EQ(maps.map_x.at<float>(v, u), -1.0f);
+        continue;
+      }
+      EXPECT_NEAR(maps.map_x.at<float>(v, u), raw->x(), kMapTolerance);
+      EXPECT_NEAR(maps.map_y.at<float>(v, u), raw->y(), kMapTolerance);
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 400);
+  view.camera_from_view(0, 0) = 1.1;  // not a rotation
+  EXPECT_FALSE(BuildVirtualPinholeMaps(camera, view).ok());
+}
+
 TEST(VirtualPinholeRemap, RejectsBadInput) {
   const RefractiveCamera refractive = Refractive(test::AlphasenseCam0(), 1.33);
   VirtualPinholeView view = ChooseVirtualPinholeView(refractive).value();

@@ -1,5 +1,6 @@
 #include "rcm/camera/virtual_pinhole_remap.h"
 
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <cmath>
 #include <cstdint>
@@ -14,10 +15,12 @@
 namespace rcm {
 namespace {
 
-// K_n K'^-1: output pixel to virtual pinhole pixel of the camera.
+// H = K_n R K'^-1: output pixel to (homogeneous) virtual pinhole pixel of
+// the camera.
 Eigen::Matrix3d VirtualFromOutput(const RefractiveCamera& camera,
                                   const VirtualPinholeView& view) {
-  return camera.VirtualPinholeMatrix() * view.k.inverse();
+  return camera.VirtualPinholeMatrix() * view.camera_from_view *
+         view.k.inverse();
 }
 
 // The view K_n with both focal lengths scaled by `scale`.
@@ -131,6 +134,14 @@ Status VirtualPinholeView::Check() const {
             << k.row(0) << "; " << k.row(1) << "; " << k.row(2) << "]";
     return Status::Error(message.str());
   }
+  constexpr double kRotationTolerance = 1e-9;
+  if (!camera_from_view.allFinite() ||
+      !(camera_from_view.transpose() * camera_from_view)
+           .isIdentity(kRotationTolerance) ||
+      std::abs(camera_from_view.determinant() - 1.0) > kRotationTolerance) {
+    return Status::Error(
+        "virtual pinhole view: camera_from_view is not a rotation");
+  }
   return Status::Ok();
 }
 
@@ -178,12 +189,12 @@ StatusOr<RemapMaps> BuildVirtualPinholeMaps(const RefractiveCamera& camera,
       float* map_x = maps.map_x.ptr<float>(v);
       float* map_y = maps.map_y.ptr<float>(v);
       for (int u = 0; u < view.width; ++u) {
-        // K_n K'^-1 is affine without skew (both are, Check ensures it).
-        const Eigen::Vector2d virtual_pixel(
-            virtual_from_output(0, 0) * u + virtual_from_output(0, 2),
-            virtual_from_output(1, 1) * v + virtual_from_output(1, 2));
-        const std::optional<Eigen::Vector2d> raw =
-            camera.ImageFromVirtualPinhole(virtual_pixel);
+        const Eigen::Vector3d virtual_point =
+            virtual_from_output * Eigen::Vector3d(u, v, 1.0);
+        std::optional<Eigen::Vector2d> raw;
+        if (virtual_point.z() > 0.0) {
+          raw = camera.ImageFromVirtualPinhole(virtual_point.hnormalized());
+        }
         if (raw && lens.InImage(*raw)) {
           map_x[u] = static_cast<float>(raw->x());
           map_y[u] = static_cast<float>(raw->y());

@@ -3,12 +3,15 @@
 // in the medium, which stereo and VIO pipelines built for pinhole cameras
 // consume unchanged (paper Sec. III-B, eq. 9).
 //
-// An output view K' = [fx', 0, cx'; 0, fy', cy'; 0, 0, 1] of size w' x h'
-// sees a ray (X, Y, Z) in the medium at p' = K' (X/Z, Y/Z, 1). The camera's
-// own virtual pinhole K_n = diag(n fx, n fy, 1) (principal point cx, cy)
-// sees it at K_n (X/Z, Y/Z, 1), so the raw pixel behind output pixel p' is
+// An output view K' = [fx', 0, cx'; 0, fy', cy'; 0, 0, 1] of size w' x h',
+// rotated by R = camera_from_view (identity unless the view is rectified,
+// e.g. stereo_rectification.h), sees a ray d in the medium (camera frame)
+// at p' ~ K' R^T d. The camera's own virtual pinhole K_n = diag(n fx, n fy,
+// 1) (principal point cx, cy) sees it at K_n d, so the raw pixel behind
+// output pixel p' is, with H = K_n R K'^-1 (a homography; affine when
+// R = I) and h(x) = (x_0 / x_2, x_1 / x_2):
 //
-//   raw(p') = ImageFromVirtualPinhole(K_n K'^-1 p')
+//   raw(p') = ImageFromVirtualPinhole(h(H p'))     (H p' in front: x_2 > 0)
 //
 // (RefractiveCamera, refractive_camera.h). The remap maps store raw(p') for
 // every output pixel center; cv::remap samples the raw image there
@@ -26,14 +29,17 @@
 
 namespace rcm {
 
-// The output image: a pinhole without skew.
+// The output image: a pinhole without skew, optionally rotated.
 struct VirtualPinholeView {
   Eigen::Matrix3d k = Eigen::Matrix3d::Identity();
   int width = 0;
   int height = 0;
+  // Rotation taking view coordinates to camera coordinates (identity: the
+  // view looks along the camera's optical axis).
+  Eigen::Matrix3d camera_from_view = Eigen::Matrix3d::Identity();
 
   // Size positive, k finite with positive focal lengths, zero skew and
-  // last row (0, 0, 1).
+  // last row (0, 0, 1), camera_from_view a rotation (to 1e-9).
   Status Check() const;
 };
 
