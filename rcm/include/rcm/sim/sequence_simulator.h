@@ -1,0 +1,113 @@
+// SequenceSimulator: a synthetic underwater stereo sequence with ground
+// truth. A robot moves through a textured tank (tank_scene.h, trajectory.h)
+// with the stereo rig behind exact flat ports (flat_port.h); each frame is
+// in the medium the schedule gives (media_schedule.h, e.g. air -> water ->
+// air). Per frame it renders both 8-bit images (stereo_renderer.h) and
+// samples exact correspondences that are consistent with the images: a
+// left pixel's ray is cast into the tank, the surface point it hits is
+// projected exactly into the right camera, and it is kept when the right
+// camera's ray through that pixel hits the same point (visible, in both
+// images). Noise and outliers are then added as configured.
+//
+// Everything depends only on the options and the seed: the same options
+// give the same images and matches, bit for bit, however many threads.
+#ifndef RCM_SIM_SEQUENCE_SIMULATOR_H_
+#define RCM_SIM_SEQUENCE_SIMULATOR_H_
+
+#include <cstdint>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "rcm/geometry/rigid3d.h"
+#include "rcm/geometry/stereo_correspondence.h"
+#include "rcm/geometry/stereo_rig.h"
+#include "rcm/sim/flat_port.h"
+#include "rcm/sim/flat_port_camera.h"
+#include "rcm/sim/media_schedule.h"
+#include "rcm/sim/stereo_renderer.h"
+#include "rcm/sim/tank_scene.h"
+#include "rcm/sim/trajectory.h"
+#include "rcm/util/status.h"
+
+namespace rcm {
+
+struct SequenceOptions {
+  // The medium of each frame; its length is the sequence's. Default: 20
+  // frames of water.
+  std::vector<MediaSegment> media =
+      std::vector<MediaSegment>(1, MediaSegment{1.333, 20});
+  FlatPort left_port;   // default: the paper's thin port
+  FlatPort right_port;  // default: the paper's thin port
+  TankSceneOptions scene;
+  // Its frames is replaced by the media schedule's frame count.
+  TrajectoryOptions trajectory;
+  RenderOptions render;
+  bool render_images = true;  // false: poses and matches only (fast)
+  int matches_per_frame = 0;  // exact scene correspondences per frame, >= 0
+  double match_noise_px = 0.0;    // Gaussian noise on all four coordinates
+  double outlier_fraction = 0.0;  // of each frame's matches, in [0, 1]
+  // Seeds everything (scene, trajectory, sensor noise, matches); the seeds
+  // in `scene`, `trajectory` and `render` are replaced by ones derived
+  // from it.
+  uint64_t seed = 1;
+
+  Status Check() const;
+};
+
+struct SequenceFrame {
+  int index = 0;
+  double t = 0.0;  // seconds
+  double n = 1.0;  // the medium of this frame
+  Rigid3d world_from_cam0;
+  cv::Mat left;   // CV_8UC1; empty when images are not rendered
+  cv::Mat right;  // CV_8UC1; empty when images are not rendered
+  // Raw pixels, frame = index, timestamp = t. Exact unless noise or
+  // outliers were asked for; outlier_indices lists the replaced ones.
+  std::vector<StereoCorrespondence> matches;
+  std::vector<int64_t> outlier_indices;
+};
+
+class SequenceSimulator {
+ public:
+  // Builds the tank textures and the trajectory. Fails on invalid options,
+  // a trajectory that does not fit in the tank, or ports/media the exact
+  // port refuses.
+  static StatusOr<std::unique_ptr<SequenceSimulator>> Create(
+      const StereoRig& rig, const SequenceOptions& options);
+
+  const StereoRig& rig() const { return rig_; }
+  const SequenceOptions& options() const { return options_; }
+  const MediaSchedule& media() const { return media_; }
+  int num_frames() const { return media_.num_frames(); }
+  const std::vector<TimedPose>& poses() const { return poses_; }
+  const TankScene& scene() const { return *scene_; }
+  // n of every frame.
+  const std::vector<double>& n_of_frame() const { return n_of_frame_; }
+
+  // Renders frame `index` (in [0, num_frames())) and samples up to
+  // matches_per_frame matches (fewer only when the two cameras barely
+  // overlap, e.g. facing a wall close up).
+  // Not thread-safe (the renderer caches rays per medium).
+  StatusOr<SequenceFrame> Frame(int index);
+
+ private:
+  SequenceSimulator(const StereoRig& rig, const SequenceOptions& options,
+                    MediaSchedule media)
+      : rig_(rig), options_(options), media_(std::move(media)) {}
+
+  std::vector<StereoCorrespondence> SampleMatches(
+      int index, const FlatPortCamera& left, const FlatPortCamera& right);
+
+  StereoRig rig_;
+  SequenceOptions options_;
+  MediaSchedule media_;
+  std::vector<double> n_of_frame_;
+  std::unique_ptr<TankScene> scene_;
+  std::vector<TimedPose> poses_;
+  std::unique_ptr<StereoRenderer> renderer_;
+};
+
+}  // namespace rcm
+
+#endif  // RCM_SIM_SEQUENCE_SIMULATOR_H_

@@ -1,0 +1,184 @@
+#include "rcm/sim/sequence_simulator.h"
+
+#include <cmath>
+#include <random>
+#include <sstream>
+#include <utility>
+
+#include "rcm/sim/stereo_sampler.h"
+
+namespace rcm {
+namespace {
+
+// A point is visible in the right image when the right camera's ray
+// through its exact pixel hits the tank within this distance of it (the
+// exact port and lens round trip to ~1e-11 m; an occluding surface is
+// centimeters or more away).
+constexpr double kVisibilityTolerance = 1e-6;  // meters
+// Draws per requested match before a frame gives up (a frame that faces a
+// wall close up may see little in both images).
+constexpr int kDrawsPerMatch = 50;
+
+// splitmix64: independent seeds for each part from one user seed.
+uint64_t DeriveSeed(uint64_t seed, uint64_t stream) {
+  uint64_t z = seed + 0x9E3779B97F4A7C15ull * (stream + 1);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+enum SeedStream : uint64_t {
+  kSceneSeed = 1,
+  kTrajectorySeed = 2,
+  kRenderSeed = 3,
+  kMatchSeed = 4,
+  kNoiseSeed = 5,
+  kOutlierSeed = 6,
+};
+
+}  // namespace
+
+Status SequenceOptions::Check() const {
+  RCM_RETURN_IF_ERROR(MediaSchedule::Create(media).status());
+  RCM_RETURN_IF_ERROR(left_port.Check().WithContext("left port"));
+  RCM_RETURN_IF_ERROR(right_port.Check().WithContext("right port"));
+  RCM_RETURN_IF_ERROR(scene.Check());
+  RCM_RETURN_IF_ERROR(render.Check());
+  std::ostringstream message;
+  if (matches_per_frame < 0) {
+    message << "matches_per_frame = " << matches_per_frame << " must be >= 0";
+  } else if (!std::isfinite(match_noise_px) || match_noise_px < 0.0) {
+    message << "match noise = " << match_noise_px << " px must be >= 0";
+  } else if (!(outlier_fraction >= 0.0 && outlier_fraction <= 1.0)) {
+    message << "outlier fraction = " << outlier_fraction
+            << " is outside [0, 1]";
+  } else {
+    return Status::Ok();
+  }
+  return Status::Error(message.str());
+}
+
+StatusOr<std::unique_ptr<SequenceSimulator>> SequenceSimulator::Create(
+    const StereoRig& rig, const SequenceOptions& options) {
+  RCM_RETURN_IF_ERROR(options.Check());
+  std::unique_ptr<SequenceSimulator> simulator(new SequenceSimulator(
+      rig, options, MediaSchedule::Create(options.media).value()));
+  simulator->n_of_frame_ = simulator->media_.PerFrame();
+
+  TankSceneOptions scene_options = options.scene;
+  scene_options.seed = DeriveSeed(options.seed, kSceneSeed);
+  StatusOr<TankScene> scene = TankScene::Create(scene_options);
+  if (!scene.ok()) return scene.status();
+  simulator->scene_ = std::make_unique<TankScene>(std::move(scene).value());
+
+  TrajectoryOptions trajectory = options.trajectory;
+  trajectory.frames = simulator->num_frames();
+  trajectory.seed = DeriveSeed(options.seed, kTrajectorySeed);
+  StatusOr<std::vector<TimedPose>> poses =
+      GenerateTrajectory(*simulator->scene_, trajectory);
+  if (!poses.ok()) return poses.status();
+  simulator->poses_ = std::move(poses).value();
+
+  if (options.render_images) {
+    RenderOptions render = options.render;
+    render.seed = DeriveSeed(options.seed, kRenderSeed);
+    StatusOr<StereoRenderer> renderer =
+        StereoRenderer::Create(rig, options.left_port, options.right_port,
+                               simulator->scene_.get(), render);
+    if (!renderer.ok()) return renderer.status();
+    simulator->renderer_ =
+        std::make_unique<StereoRenderer>(std::move(renderer).value());
+  }
+  return simulator;
+}
+
+std::vector<StereoCorrespondence> SequenceSimulator::SampleMatches(
+    int index, const FlatPortCamera& left, const FlatPortCamera& right) {
+  const Rigid3d& world_from_left = poses_[index].world_from_cam0;
+  const Rigid3d world_from_right =
+      world_from_left * rig_.right_from_left().Inverse();
+  const Rigid3d right_from_world = world_from_right.Inverse();
+  const Camera& left_camera = rig_.left();
+  const Camera& right_camera = rig_.right();
+
+  std::mt19937_64 rng(
+      DeriveSeed(DeriveSeed(options_.seed, kMatchSeed), index));
+  std::uniform_real_distribution<double> u(-0.5, left_camera.width() - 0.5);
+  std::uniform_real_distribution<double> v(-0.5, left_camera.height() - 0.5);
+
+  std::vector<StereoCorrespondence> matches;
+  matches.reserve(options_.matches_per_frame);
+  const int64_t max_draws =
+      static_cast<int64_t>(kDrawsPerMatch) * options_.matches_per_frame;
+  for (int64_t draw = 0; draw < max_draws &&
+                         static_cast<int>(matches.size()) <
+                             options_.matches_per_frame;
+       ++draw) {
+    const Eigen::Vector2d left_pixel(u(rng), v(rng));
+    const std::optional<RayInMedium> left_ray = left.RayFromImage(left_pixel);
+    if (!left_ray) continue;
+    const std::optional<SurfaceHit> hit =
+        scene_->Intersect(world_from_left * left_ray->origin,
+                          world_from_left.rotation * left_ray->direction);
+    if (!hit) continue;
+    const std::optional<Eigen::Vector2d> right_pixel =
+        right.ImageFromPoint(right_from_world * hit->point);
+    if (!right_pixel || !right_camera.InImage(*right_pixel)) continue;
+    const std::optional<RayInMedium> right_ray =
+        right.RayFromImage(*right_pixel);
+    if (!right_ray) continue;
+    const std::optional<SurfaceHit> right_hit =
+        scene_->Intersect(world_from_right * right_ray->origin,
+                          world_from_right.rotation * right_ray->direction);
+    if (!right_hit ||
+        (right_hit->point - hit->point).norm() > kVisibilityTolerance) {
+      continue;
+    }
+    StereoCorrespondence match;
+    match.frame = index;
+    match.timestamp = poses_[index].t;
+    match.left_pixel = left_pixel;
+    match.right_pixel = *right_pixel;
+    matches.push_back(match);
+  }
+  return matches;
+}
+
+StatusOr<SequenceFrame> SequenceSimulator::Frame(int index) {
+  CHECK(index >= 0 && index < num_frames()) << index;
+  SequenceFrame frame;
+  frame.index = index;
+  frame.t = poses_[index].t;
+  frame.n = n_of_frame_[index];
+  frame.world_from_cam0 = poses_[index].world_from_cam0;
+  if (renderer_ != nullptr) {
+    StatusOr<StereoImages> images =
+        renderer_->Render(frame.world_from_cam0, frame.n, index);
+    if (!images.ok()) return images.status();
+    frame.left = images.value().left;
+    frame.right = images.value().right;
+  }
+  if (options_.matches_per_frame > 0) {
+    StatusOr<FlatPortCamera> left =
+        FlatPortCamera::Create(rig_.left(), options_.left_port, frame.n);
+    StatusOr<FlatPortCamera> right =
+        FlatPortCamera::Create(rig_.right(), options_.right_port, frame.n);
+    if (!left.ok()) return left.status().WithContext("left port");
+    if (!right.ok()) return right.status().WithContext("right port");
+    frame.matches = SampleMatches(index, left.value(), right.value());
+    if (options_.match_noise_px > 0.0) {
+      AddPixelNoise(options_.match_noise_px,
+                    DeriveSeed(DeriveSeed(options_.seed, kNoiseSeed), index),
+                    &frame.matches);
+    }
+    if (options_.outlier_fraction > 0.0) {
+      frame.outlier_indices = AddOutliers(
+          rig_, options_.outlier_fraction,
+          DeriveSeed(DeriveSeed(options_.seed, kOutlierSeed), index),
+          &frame.matches);
+    }
+  }
+  return frame;
+}
+
+}  // namespace rcm

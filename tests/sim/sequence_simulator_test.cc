@@ -1,0 +1,178 @@
+#include "rcm/sim/sequence_simulator.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <opencv2/imgproc.hpp>
+
+#include "rcm/estimation/batch_refinement.h"
+#include "rcm/sim/reference_rigs.h"
+
+namespace rcm {
+namespace {
+
+// Poses and matches only, no images: fast.
+SequenceOptions MatchesOnly(std::vector<MediaSegment> media,
+                            int matches_per_frame = 300) {
+  SequenceOptions options;
+  options.media = std::move(media);
+  options.render_images = false;
+  options.matches_per_frame = matches_per_frame;
+  return options;
+}
+
+// Small, quick images: one ray per pixel.
+SequenceOptions WithImages(int frames) {
+  SequenceOptions options;
+  options.media = {MediaSegment{1.333, frames}};
+  options.render.supersampling = 1;
+  options.matches_per_frame = 100;
+  return options;
+}
+
+TEST(SequenceSimulator, ThinPortMatchesGiveEachFramesIndexExactly) {
+  // Thin port: the scene matches obey the paper's model, so the refinement
+  // returns each frame's medium to 1e-9 (air, water, a denser liquid).
+  const StereoRig rig = AlphasenseFrontUnrectifiedRig();
+  std::unique_ptr<SequenceSimulator> simulator =
+      SequenceSimulator::Create(
+          rig, MatchesOnly({{1.0, 1}, {1.333, 1}, {1.6, 1}}))
+          .value();
+  ASSERT_EQ(simulator->num_frames(), 3);
+  for (int i = 0; i < 3; ++i) {
+    const SequenceFrame frame = simulator->Frame(i).value();
+    EXPECT_EQ(frame.matches.size(), 300u);
+    EXPECT_TRUE(frame.left.empty());
+    for (const StereoCorrespondence& match : frame.matches) {
+      EXPECT_EQ(match.frame, i);
+      EXPECT_EQ(match.timestamp.value(), frame.t);
+      EXPECT_TRUE(rig.left().InImage(match.left_pixel));
+      EXPECT_TRUE(rig.right().InImage(match.right_pixel));
+    }
+    const RefinementSummary summary =
+        RefineRefractiveIndex(rig, frame.matches, RefinementOptions())
+            .value();
+    EXPECT_NEAR(summary.n, frame.n, 1e-9) << "frame " << i;
+  }
+}
+
+TEST(SequenceSimulator, ScenePointsAreInTheTank) {
+  // The matches come from a pool seen 16 degrees down from 1.2 m: depths
+  // are bounded by the tank's size (12 x 8 x 3 m).
+  std::unique_ptr<SequenceSimulator> simulator =
+      SequenceSimulator::Create(AlphasenseFrontRectifiedRig(),
+                                MatchesOnly({{1.333, 2}}))
+          .value();
+  const TankScene& scene = simulator->scene();
+  for (const TimedPose& pose : simulator->poses()) {
+    EXPECT_TRUE(scene.Contains(pose.world_from_cam0.translation, 0.5));
+  }
+  const double diagonal = std::hypot(scene.length(), scene.width(),
+                                     scene.depth());
+  EXPECT_LT(diagonal, 15.0);
+}
+
+TEST(SequenceSimulator, NoiseAndOutliersAreApplied) {
+  const StereoRig rig = AlphasenseFrontRectifiedRig();
+  SequenceOptions exact_options = MatchesOnly({{1.333, 1}}, 400);
+  SequenceOptions noisy_options = exact_options;
+  noisy_options.match_noise_px = 0.5;
+  noisy_options.outlier_fraction = 0.25;
+  const SequenceFrame exact =
+      SequenceSimulator::Create(rig, exact_options).value()->Frame(0).value();
+  const SequenceFrame noisy =
+      SequenceSimulator::Create(rig, noisy_options).value()->Frame(0).value();
+  ASSERT_EQ(exact.matches.size(), noisy.matches.size());
+  EXPECT_EQ(noisy.outlier_indices.size(), 100u);
+  // The left pixels differ by the noise alone: its RMS per coordinate is
+  // 0.5 px within 4 standard errors (0.5 / sqrt(2 * 800) * 4 = 0.05).
+  double sum_squares = 0.0;
+  for (size_t i = 0; i < exact.matches.size(); ++i) {
+    sum_squares +=
+        (noisy.matches[i].left_pixel - exact.matches[i].left_pixel)
+            .squaredNorm();
+  }
+  EXPECT_NEAR(std::sqrt(sum_squares / (2.0 * exact.matches.size())), 0.5,
+              0.05);
+}
+
+TEST(SequenceSimulator, SameSeedSameFrames) {
+  const StereoRig rig = AlphasenseFrontRectifiedRig();
+  SequenceOptions options = WithImages(1);
+  options.seed = 7;
+  const SequenceFrame a =
+      SequenceSimulator::Create(rig, options).value()->Frame(0).value();
+  const SequenceFrame b =
+      SequenceSimulator::Create(rig, options).value()->Frame(0).value();
+  ASSERT_EQ(a.left.size(), cv::Size(720, 540));
+  ASSERT_EQ(a.left.type(), CV_8UC1);
+  EXPECT_EQ(cv::norm(a.left, b.left, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(a.right, b.right, cv::NORM_INF), 0.0);
+  ASSERT_EQ(a.matches.size(), b.matches.size());
+  for (size_t i = 0; i < a.matches.size(); ++i) {
+    EXPECT_EQ(a.matches[i].left_pixel, b.matches[i].left_pixel);
+    EXPECT_EQ(a.matches[i].right_pixel, b.matches[i].right_pixel);
+  }
+  options.seed = 8;
+  const SequenceFrame c =
+      SequenceSimulator::Create(rig, options).value()->Frame(0).value();
+  EXPECT_GT(cv::norm(a.left, c.left, cv::NORM_L1), 0.0);
+}
+
+TEST(SequenceSimulator, MatchesLandOnTheSameTextureInBothImages) {
+  // The matches are consistent with the rendered images: 11x11 patches
+  // around the two pixels of a match correlate (thick tilted port, so the
+  // renderer's and the sampler's ports must agree exactly).
+  SequenceOptions options = WithImages(1);
+  options.left_port.air_gap = 0.01;
+  options.left_port.glass_thickness = 0.006;
+  options.right_port = options.left_port;
+  const SequenceFrame frame =
+      SequenceSimulator::Create(AlphasenseFrontUnrectifiedRig(), options)
+          .value()
+          ->Frame(0)
+          .value();
+  std::vector<double> correlations;
+  constexpr int kHalf = 5;
+  for (const StereoCorrespondence& match : frame.matches) {
+    const cv::Point l(std::lround(match.left_pixel.x()),
+                      std::lround(match.left_pixel.y()));
+    const cv::Point r(std::lround(match.right_pixel.x()),
+                      std::lround(match.right_pixel.y()));
+    const cv::Rect inner(kHalf, kHalf, 720 - 2 * kHalf, 540 - 2 * kHalf);
+    if (!inner.contains(l) || !inner.contains(r)) continue;
+    cv::Mat result;
+    cv::matchTemplate(
+        frame.left(cv::Rect(l.x - kHalf, l.y - kHalf, 2 * kHalf + 1,
+                            2 * kHalf + 1)),
+        frame.right(cv::Rect(r.x - kHalf, r.y - kHalf, 2 * kHalf + 1,
+                             2 * kHalf + 1)),
+        result, cv::TM_CCOEFF_NORMED);
+    correlations.push_back(result.at<float>(0, 0));
+  }
+  ASSERT_GT(correlations.size(), 50u);
+  std::sort(correlations.begin(), correlations.end());
+  // Median well above what unrelated patches give (~0).
+  EXPECT_GT(correlations[correlations.size() / 2], 0.8);
+}
+
+TEST(SequenceSimulator, RejectsInvalidOptions) {
+  const StereoRig rig = AlphasenseFrontRectifiedRig();
+  SequenceOptions options = MatchesOnly({{2.5, 3}});
+  EXPECT_FALSE(SequenceSimulator::Create(rig, options).ok());
+  options = MatchesOnly({{1.333, 3}});
+  options.matches_per_frame = -1;
+  EXPECT_FALSE(SequenceSimulator::Create(rig, options).ok());
+  options = MatchesOnly({{1.333, 3}});
+  options.outlier_fraction = 1.5;
+  EXPECT_FALSE(SequenceSimulator::Create(rig, options).ok());
+  options = MatchesOnly({{1.333, 3}});
+  options.left_port.air_gap = -0.01;
+  const StatusOr<std::unique_ptr<SequenceSimulator>> bad_port =
+      SequenceSimulator::Create(rig, options);
+  ASSERT_FALSE(bad_port.ok());
+  EXPECT_NE(bad_port.status().message().find("left port"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace rcm

@@ -1,0 +1,115 @@
+#include "rcm/sim/sequence_writer.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "rcm/io/camchain.h"
+#include "rcm/io/correspondence_csv.h"
+#include "rcm/io/image_file.h"
+#include "rcm/sim/reference_rigs.h"
+#include "support/temp_file.h"
+
+namespace rcm {
+namespace {
+
+namespace fs = std::filesystem;
+
+SequenceOptions MatchesOnly(std::vector<MediaSegment> media,
+                            int matches_per_frame) {
+  SequenceOptions options;
+  options.media = std::move(media);
+  options.render_images = false;
+  options.matches_per_frame = matches_per_frame;
+  return options;
+}
+
+TEST(SequenceWriter, WritesTheFolderAndItReadsBack) {
+  const StereoRig rig = AlphasenseFrontRectifiedRig();
+  SequenceOptions options;
+  options.media = {MediaSegment{1.333, 2}};
+  options.render.supersampling = 1;
+  options.matches_per_frame = 100;
+  std::unique_ptr<SequenceSimulator> simulator =
+      SequenceSimulator::Create(rig, options).value();
+  const std::string folder = test::TempFilePath("sequence");
+  fs::remove_all(folder);
+  int calls = 0;
+  SequenceWriterOptions writer;
+  writer.progress = [&](int done, int total) {
+    EXPECT_EQ(done, ++calls);
+    EXPECT_EQ(total, 2);
+  };
+  ASSERT_TRUE(WriteSequence(folder, simulator.get(), writer).ok());
+  EXPECT_EQ(calls, 2);
+  for (const char* name : {"000000.png", "000001.png"}) {
+    const cv::Mat left =
+        ReadImage(folder + "/left/" + name, /*grayscale=*/true).value();
+    EXPECT_EQ(left.size(), cv::Size(720, 540));
+    EXPECT_TRUE(fs::exists(folder + "/right/" + name));
+  }
+  const StereoRig back =
+      StereoRigFromCamchain(ReadCamchain(folder + "/camchain.yaml").value(),
+                            0, 1)
+          .value();
+  EXPECT_EQ(back.left(), rig.left());
+  const std::vector<StereoCorrespondence> matches =
+      ReadCorrespondenceCsv(folder + "/matches.csv").value();
+  EXPECT_EQ(matches.size(), 200u);
+  std::ifstream truth(folder + "/truth.csv");
+  std::string line;
+  std::getline(truth, line);
+  EXPECT_EQ(line, "frame,t,n,tx,ty,tz,qx,qy,qz,qw");
+  std::getline(truth, line);
+  EXPECT_EQ(line.rfind("0,0.0,1.333,", 0), 0u) << line;
+  std::getline(truth, line);
+  EXPECT_EQ(line.rfind("1,0.05,1.333,", 0), 0u) << line;
+}
+
+TEST(SequenceWriter, RefusesToOverwriteUnlessAsked) {
+  const StereoRig rig = AlphasenseFrontRectifiedRig();
+  const std::string folder = test::TempFilePath("sequence");
+  fs::remove_all(folder);
+  std::unique_ptr<SequenceSimulator> three =
+      SequenceSimulator::Create(rig, MatchesOnly({{1.333, 3}}, 20)).value();
+  ASSERT_TRUE(WriteSequence(folder, three.get(), {}).ok());
+  // Stale frame images of an earlier, longer run.
+  fs::create_directories(folder + "/left");
+  std::ofstream(folder + "/left/000009.png") << "stale";
+  std::ofstream(folder + "/notes.txt") << "mine";
+
+  std::unique_ptr<SequenceSimulator> one =
+      SequenceSimulator::Create(rig, MatchesOnly({{1.0, 1}}, 20)).value();
+  const Status refused = WriteSequence(folder, one.get(), {});
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.message().find("--overwrite"), std::string::npos);
+  EXPECT_EQ(ReadCorrespondenceCsv(folder + "/matches.csv").value().size(),
+            60u);  // untouched
+
+  SequenceWriterOptions overwrite;
+  overwrite.overwrite = true;
+  ASSERT_TRUE(WriteSequence(folder, one.get(), overwrite).ok());
+  EXPECT_EQ(ReadCorrespondenceCsv(folder + "/matches.csv").value().size(),
+            20u);
+  EXPECT_FALSE(fs::exists(folder + "/left/000009.png"));
+  EXPECT_TRUE(fs::exists(folder + "/notes.txt"));
+}
+
+TEST(SequenceWriter, UnwritableFolderIsOneLineError) {
+  std::unique_ptr<SequenceSimulator> simulator =
+      SequenceSimulator::Create(AlphasenseFrontRectifiedRig(),
+                                MatchesOnly({{1.333, 1}}, 10))
+          .value();
+  const std::string file = test::WriteTempFile("a_file", "x");
+  const Status status = WriteSequence(file + "/sub", simulator.get(), {});
+  ASSERT_FALSE(status.ok());
+  EXPECT_EQ(status.message().find('\n'), std::string::npos);
+  const Status not_folder = WriteSequence(file, simulator.get(), {});
+  ASSERT_FALSE(not_folder.ok());
+  EXPECT_NE(not_folder.message().find("not a folder"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace rcm
