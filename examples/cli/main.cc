@@ -10,14 +10,18 @@
 #include "command.h"
 
 namespace rcm::cli {
+extern const Subcommand kDemoCommand;
 extern const Subcommand kEstimateCommand;
+extern const Subcommand kSimulateCommand;
 }  // namespace rcm::cli
 
 namespace {
 
 using rcm::cli::Subcommand;
 
-const Subcommand* const kSubcommands[] = {&rcm::cli::kEstimateCommand};
+const Subcommand* const kSubcommands[] = {&rcm::cli::kDemoCommand,
+                                          &rcm::cli::kEstimateCommand,
+                                          &rcm::cli::kSimulateCommand};
 
 void PrintUsage(std::ostream& out) {
   out << "rcm: the refractive index of the water from a stereo camera "

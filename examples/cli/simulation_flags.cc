@@ -1,0 +1,111 @@
+#include "simulation_flags.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "rcm/io/stereo_rig_file.h"
+#include "rcm/sim/media_schedule.h"
+#include "rcm/sim/reference_rigs.h"
+
+DEFINE_double(n, 1.333, "refractive index of the water, in [1, 2]");
+DEFINE_string(media, "",
+              "media per frame, MEDIUM:FRAMES,... with MEDIUM air, water (= "
+              "--n) or an index, e.g. water:30,air:30,water:30 (default: "
+              "water for --frames frames)");
+DEFINE_int32(frames, 20, "frames to simulate (20 Hz) when --media is not set");
+DEFINE_string(rig, "alphasense",
+              "built-in rig when --calib is not given: alphasense (the "
+              "dataset rig of DESIGN.md Sec. 5 on rectified extrinsics) or "
+              "alphasense-unrectified (0.5 deg rotation, baseline off axis)");
+DEFINE_double(air_gap, 0.0,
+              "port: air between the camera center and the glass, meters "
+              "(0 = the paper's thin port)");
+DEFINE_double(glass_thickness, 0.0, "port: glass thickness, meters");
+DEFINE_double(glass_index, 1.49, "port: refractive index of the glass");
+DEFINE_double(port_tilt, 0.0,
+              "port: tilt of the glass normal from the optical axis "
+              "(pitch), degrees");
+DEFINE_double(image_noise, 1.5,
+              "sensor read noise, standard deviation in 8-bit levels");
+DEFINE_int32(supersampling, 2,
+             "rays per pixel along each axis (anti-aliasing), 1-4");
+DEFINE_uint64(seed, 1, "random seed; the outputs depend only on the flags");
+DEFINE_string(out, "",
+              "output folder (rcm simulate: required; rcm demo: default "
+              "./rcm_demo)");
+
+namespace rcm::cli {
+
+extern const char kSimulationFlagsSource[] = __FILE__;
+
+StatusOr<Simulation> SimulationFromFlags(const std::string& calib) {
+  Simulation simulation{AlphasenseFrontRectifiedRig(), "alphasense", {}};
+  if (!calib.empty()) {
+    StatusOr<StereoRig> rig = ReadStereoRig(calib);
+    if (!rig.ok()) return rig.status();
+    simulation.rig = rig.value();
+    simulation.rig_name = calib;
+  } else if (FLAGS_rig == "alphasense-unrectified" ||
+             FLAGS_rig == "alphasense_unrectified") {
+    simulation.rig = AlphasenseFrontUnrectifiedRig();
+    simulation.rig_name = "alphasense-unrectified";
+  } else if (FLAGS_rig != "alphasense") {
+    return Status::Error("--rig " + FLAGS_rig +
+                         ": expected alphasense or alphasense-unrectified");
+  }
+
+  if (!std::isfinite(FLAGS_n) || FLAGS_n < 1.0 || FLAGS_n > 2.0) {
+    std::ostringstream message;
+    message << "--n " << FLAGS_n << " is outside [1, 2]";
+    return Status::Error(message.str());
+  }
+  StatusOr<MediaSchedule> media =
+      FLAGS_media.empty() ? MediaSchedule::Constant(FLAGS_n, FLAGS_frames)
+                          : MediaSchedule::Parse(FLAGS_media, FLAGS_n);
+  if (!media.ok()) {
+    return media.status().WithContext(FLAGS_media.empty() ? "--frames"
+                                                          : "--media");
+  }
+  SequenceOptions& options = simulation.options;
+  options.media = media.value().segments();
+  FlatPort port;
+  port.air_gap = FLAGS_air_gap;
+  port.glass_thickness = FLAGS_glass_thickness;
+  port.glass_index = FLAGS_glass_index;
+  port.normal = TiltedPortNormal(FLAGS_port_tilt * M_PI / 180.0, 0.0);
+  RCM_RETURN_IF_ERROR(port.Check());
+  options.left_port = port;
+  options.right_port = port;
+  if (!std::isfinite(FLAGS_image_noise) || FLAGS_image_noise < 0.0) {
+    return Status::Error("--image-noise must be >= 0");
+  }
+  if (FLAGS_supersampling < 1 || FLAGS_supersampling > 4) {
+    return Status::Error("--supersampling must be in [1, 4]");
+  }
+  options.render.read_noise = FLAGS_image_noise;
+  options.render.supersampling = FLAGS_supersampling;
+  options.seed = FLAGS_seed;
+  RCM_RETURN_IF_ERROR(options.Check());
+  return simulation;
+}
+
+nlohmann::json SimulationFlagsJson(const Simulation& simulation) {
+  const SequenceOptions& options = simulation.options;
+  nlohmann::json media = nlohmann::json::array();
+  for (const MediaSegment& segment : options.media) {
+    media.push_back({{"n", segment.n}, {"frames", segment.frames}});
+  }
+  const FlatPort& port = options.left_port;
+  return {{"rig", simulation.rig_name},
+          {"media", media},
+          {"port",
+           {{"air_gap", port.air_gap},
+            {"glass_thickness", port.glass_thickness},
+            {"glass_index", port.glass_index},
+            {"normal", {port.normal.x(), port.normal.y(), port.normal.z()}}}},
+          {"image_noise", FLAGS_image_noise},
+          {"supersampling", FLAGS_supersampling},
+          {"seed", options.seed}};
+}
+
+}  // namespace rcm::cli

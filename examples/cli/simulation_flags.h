@@ -1,0 +1,48 @@
+// Flags that describe a simulated sequence, shared by rcm simulate and
+// rcm demo, and the simulator options they make.
+#ifndef RCM_EXAMPLES_CLI_SIMULATION_FLAGS_H_
+#define RCM_EXAMPLES_CLI_SIMULATION_FLAGS_H_
+
+#include <gflags/gflags.h>
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "rcm/geometry/stereo_rig.h"
+#include "rcm/sim/sequence_simulator.h"
+#include "rcm/util/status.h"
+
+DECLARE_double(n);
+DECLARE_string(media);
+DECLARE_int32(frames);
+DECLARE_string(rig);
+DECLARE_double(air_gap);
+DECLARE_double(glass_thickness);
+DECLARE_double(glass_index);
+DECLARE_double(port_tilt);
+DECLARE_double(image_noise);
+DECLARE_int32(supersampling);
+DECLARE_uint64(seed);
+DECLARE_string(out);
+
+namespace rcm::cli {
+
+// __FILE__ of simulation_flags.cc, for Subcommand::flag_sources.
+extern const char kSimulationFlagsSource[];
+
+struct Simulation {
+  StereoRig rig;
+  std::string rig_name;  // "alphasense", or the --calib path
+  SequenceOptions options;
+};
+
+// The rig (--rig, or `calib` when not empty) and the sequence options of
+// the flags. Fails with one line on a bad value.
+StatusOr<Simulation> SimulationFromFlags(const std::string& calib);
+
+// The flags' values, for the JSON a run writes next to its outputs.
+nlohmann::json SimulationFlagsJson(const Simulation& simulation);
+
+}  // namespace rcm::cli
+
+#endif  // RCM_EXAMPLES_CLI_SIMULATION_FLAGS_H_
