@@ -91,7 +91,8 @@ struct FrameResult {
   double sigma_frame = NAN;
   double n_window = NAN;
   double sigma_window = NAN;
-  bool medium_switch = false;
+  bool medium_switch = false;  // this frame confirmed a switch
+  int switch_first_frame = -1;  // the switch's first frame of the new medium
 };
 
 // The stereo pair side by side on a BGR canvas with a title strip.
@@ -202,8 +203,13 @@ cv::Mat PlotNPerFrame(const std::vector<FrameResult>& frames,
     window_high.push_back(f.n_window + f.sigma_window);
   }
   LinePlot plot;
+  const bool switched =
+      std::any_of(frames.begin(), frames.end(),
+                  [](const FrameResult& f) { return f.medium_switch; });
   std::ostringstream title;
-  title << "n from the images: " << FormatFixed(n_final, 4) << " +- "
+  title << (switched ? "n from the images since the last switch: "
+                     : "n from the images: ")
+        << FormatFixed(n_final, 4) << " +- "
         << FormatFixed(sigma_final, 4) << " (truth "
         << FormatFixed(frames.back().n_true, 3) << ")";
   plot.SetTitle(title.str());
@@ -220,7 +226,7 @@ cv::Mat PlotNPerFrame(const std::vector<FrameResult>& frames,
                   MarkerStyle{PaletteColor(7), MarkerShape::kCircle, 3.5});
   for (const FrameResult& f : frames) {
     if (f.medium_switch) {
-      plot.AddVerticalMarker(f.frame, "switch",
+      plot.AddVerticalMarker(f.switch_first_frame - 0.5, "switch",
                              LineStyle{PaletteColor(3), 1.5, 6.0, 4.0});
     }
   }
@@ -266,6 +272,7 @@ int RunDemo() {
   SiftMatcherOptions matcher;
   std::vector<FrameResult> results;
   std::vector<StereoCorrespondence> since_switch;  // matches of this medium
+  int first_frame_of_medium = 0;
   cv::Mat first_left;
   cv::Mat first_right;
   std::vector<StereoCorrespondence> first_matches;
@@ -309,7 +316,19 @@ int RunDemo() {
       result.sigma_window = update.window.value().sigma_n;
     }
     result.medium_switch = update.medium_switch.has_value();
-    if (result.medium_switch) since_switch.clear();
+    if (result.medium_switch) {
+      // The new medium began at the switch's first frame: keep its
+      // matches, drop the older ones.
+      result.switch_first_frame =
+          static_cast<int>(update.medium_switch->first_frame);
+      first_frame_of_medium = result.switch_first_frame;
+      since_switch.erase(
+          std::remove_if(since_switch.begin(), since_switch.end(),
+                         [&](const StereoCorrespondence& match) {
+                           return match.frame < first_frame_of_medium;
+                         }),
+          since_switch.end());
+    }
     since_switch.insert(since_switch.end(), matches.value().begin(),
                         matches.value().end());
     if (i == 0) {
@@ -492,7 +511,7 @@ int RunDemo() {
       {"error", error_n},
       {"error_sigmas", error_n / estimate.sigma_n},
       {"frames", num_frames},
-      {"frames_used", since_switch.empty() ? 0 : results.size()},
+      {"frames_used", num_frames - first_frame_of_medium},
       {"matches", since_switch.size()},
       {"inliers", estimate.inliers.size()},
       {"median_locus_distance_px",
@@ -534,7 +553,10 @@ int RunDemo() {
   std::cout << "rcm demo: n = " << FormatFixed(estimate.n, 5) << " +- "
             << FormatFixed(estimate.sigma_n, 5) << " from "
             << estimate.inliers.size() << " matched features in "
-            << results.size() << " frames (truth " << FormatFixed(truth, 5)
+            << (num_frames - first_frame_of_medium)
+            << (first_frame_of_medium > 0 ? " frames since the last switch"
+                                          : " frames")
+            << " (truth " << FormatFixed(truth, 5)
             << ", off by " << FormatFixed(std::abs(error_n / estimate.sigma_n), 1)
             << " sigma)\n"
             << "  matches lie " << FormatFixed(residual_air, 2)
