@@ -2,6 +2,7 @@
 #include <gflags/gflags.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -27,6 +28,10 @@ DEFINE_double(match_noise, 0.0,
               "deviation in pixels");
 DEFINE_double(outliers, 0.0,
               "fraction of each frame's matches replaced by gross outliers");
+DEFINE_string(depth_range, "",
+              "MIN,MAX in meters: sample the matches at depths uniform in "
+              "[MIN, MAX] on random left pixels' rays instead of on the "
+              "tank's surfaces (needs --noimages)");
 DEFINE_bool(images, true, "render the images (--noimages: matches only)");
 DEFINE_bool(overwrite, false,
             "replace a sequence already in --out (its frames, matches, "
@@ -52,6 +57,8 @@ constexpr char kUsage[] =
     "  camchain.yaml         the in-air calibration (Kalibr)\n"
     "  truth.csv             frame,t,n,tx,ty,tz,qx,qy,qz,qw (world_from_cam0)\n"
     "  matches.csv           with --matches-per-frame: frame,xl,yl,xr,yr,t\n"
+    "                        (points of the tank's surfaces, or with\n"
+    "                        --depth-range points at sampled depths)\n"
     "  simulation.json       the settings, to reproduce the run\n"
     "truth.csv is written last; the same flags give the same bytes.";
 
@@ -87,6 +94,28 @@ int RunSimulate() {
   options.matches_per_frame = FLAGS_matches_per_frame;
   options.match_noise_px = FLAGS_match_noise;
   options.outlier_fraction = FLAGS_outliers;
+  if (!FLAGS_depth_range.empty()) {
+    const size_t comma = FLAGS_depth_range.find(',');
+    char* end = nullptr;
+    const std::string min_text = FLAGS_depth_range.substr(0, comma);
+    options.match_min_depth = std::strtod(min_text.c_str(), &end);
+    bool ok = comma != std::string::npos && !min_text.empty() && *end == '\0';
+    if (ok) {
+      const std::string max_text = FLAGS_depth_range.substr(comma + 1);
+      options.match_max_depth = std::strtod(max_text.c_str(), &end);
+      ok = !max_text.empty() && *end == '\0';
+    }
+    if (!ok) {
+      PrintError(command, "--depth-range " + FLAGS_depth_range +
+                              ": expected MIN,MAX in meters, e.g. 0.6,6");
+      return kExitUsage;
+    }
+    const Status valid = options.Check();
+    if (!valid.ok()) {
+      PrintError(command, "--depth-range: " + valid.message());
+      return kExitUsage;
+    }
+  }
   if (!options.render_images && options.matches_per_frame == 0) {
     PrintError(command,
                "--noimages without --matches-per-frame would write no data");
@@ -115,6 +144,7 @@ int RunSimulate() {
   settings["match_noise"] = FLAGS_match_noise;
   settings["outliers"] = FLAGS_outliers;
   settings["images"] = FLAGS_images;
+  settings["depth_range"] = FLAGS_depth_range;
   const Status settings_written = WriteFileAtomically(
       FLAGS_out + "/simulation.json", settings.dump(2) + "\n");
   if (!settings_written.ok()) {

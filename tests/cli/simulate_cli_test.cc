@@ -96,6 +96,30 @@ TEST(SimulateCli, MediaSwitchesAreInTheTruth) {
   EXPECT_FALSE(fs::exists(folder + "/left"));
 }
 
+TEST(SimulateCli, DepthRangeMatchesWithoutImages) {
+  // The correspondence generator alone: thin port, close range, exact.
+  const std::string folder = Folder("depths");
+  const RunResult simulated =
+      Rcm({"simulate", "--out", folder, "--noimages", "--depth-range",
+           "0.3,1.5", "--matches-per-frame", "150", "--frames", "2", "--n",
+           "1.6"});
+  ASSERT_EQ(simulated.exit_code, 0) << simulated.err;
+  const RunResult estimated =
+      Rcm({"estimate", "--calib", folder + "/camchain.yaml", "--matches",
+           folder + "/matches.csv", "--json"});
+  ASSERT_EQ(estimated.exit_code, 0) << estimated.err;
+  EXPECT_NEAR(nlohmann::json::parse(estimated.out)["n"].get<double>(), 1.6,
+              1e-9);
+  ExpectFailsWithOneLine(
+      Rcm({"simulate", "--out", Folder("bad_range"), "--depth-range", "0.3",
+           "--noimages", "--matches-per-frame", "5"}),
+      2, "MIN,MAX");
+  ExpectFailsWithOneLine(
+      Rcm({"simulate", "--out", Folder("with_images"), "--depth-range",
+           "0.3,1.5", "--matches-per-frame", "5"}),
+      2, "no images");
+}
+
 TEST(SimulateCli, BadFlagsGiveOneLine) {
   const std::string folder = Folder("bad");
   ExpectFailsWithOneLine(Rcm({"simulate"}), 2, "--out is required");

@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "rcm/estimation/batch_refinement.h"
+#include "rcm/sim/flat_port_camera.h"
 #include "rcm/sim/reference_rigs.h"
 
 namespace rcm {
@@ -154,6 +155,56 @@ TEST(SequenceSimulator, MatchesLandOnTheSameTextureInBothImages) {
   std::sort(correlations.begin(), correlations.end());
   // Median well above what unrelated patches give (~0).
   EXPECT_GT(correlations[correlations.size() / 2], 0.8);
+}
+
+TEST(SequenceSimulator, DepthRangeMatchesAreAtTheRequestedDepths) {
+  // Through a thick port the two rays of a match meet (to ~1e-11 m, the
+  // lens round trip) at a point whose depth Z lies in the range.
+  constexpr double kRayDistanceTolerance = 1e-9;  // meters
+  const StereoRig rig = AlphasenseFrontUnrectifiedRig();
+  SequenceOptions options = MatchesOnly({{1.333, 1}, {1.0, 1}}, 100);
+  options.left_port.air_gap = 0.01;
+  options.left_port.glass_thickness = 0.005;
+  options.right_port = options.left_port;
+  options.match_min_depth = 0.4;
+  options.match_max_depth = 1.2;
+  std::unique_ptr<SequenceSimulator> simulator =
+      SequenceSimulator::Create(rig, options).value();
+  for (int i = 0; i < 2; ++i) {
+    const SequenceFrame frame = simulator->Frame(i).value();
+    ASSERT_EQ(frame.matches.size(), 100u);
+    const FlatPortCamera left =
+        FlatPortCamera::Create(rig.left(), options.left_port, frame.n).value();
+    const FlatPortCamera right =
+        FlatPortCamera::Create(rig.right(), options.right_port, frame.n)
+            .value();
+    const Rigid3d left_from_right = rig.right_from_left().Inverse();
+    for (const StereoCorrespondence& match : frame.matches) {
+      EXPECT_EQ(match.frame, i);
+      const RayInMedium l = left.RayFromImage(match.left_pixel).value();
+      const RayInMedium r = right.RayFromImage(match.right_pixel).value();
+      const Eigen::Vector3d r_origin = left_from_right * r.origin;
+      const Eigen::Vector3d r_direction =
+          left_from_right.rotation * r.direction;
+      // Closest points of the two lines.
+      const Eigen::Vector3d w = l.origin - r_origin;
+      const double b = l.direction.dot(r_direction);
+      const double d = l.direction.dot(w);
+      const double e = r_direction.dot(w);
+      const double s = (b * e - d) / (1.0 - b * b);
+      const double t = (e - b * d) / (1.0 - b * b);
+      const Eigen::Vector3d on_left = l.origin + s * l.direction;
+      const Eigen::Vector3d on_right = r_origin + t * r_direction;
+      EXPECT_LT((on_left - on_right).norm(), kRayDistanceTolerance);
+      EXPECT_GE(on_left.z(), 0.4 - 1e-9);
+      EXPECT_LE(on_left.z(), 1.2 + 1e-9);
+    }
+  }
+  options.render_images = true;
+  EXPECT_FALSE(SequenceSimulator::Create(rig, options).ok());
+  options.render_images = false;
+  options.match_max_depth = 0.2;
+  EXPECT_FALSE(SequenceSimulator::Create(rig, options).ok());
 }
 
 TEST(SequenceSimulator, RejectsInvalidOptions) {

@@ -52,6 +52,14 @@ Status SequenceOptions::Check() const {
   } else if (!(outlier_fraction >= 0.0 && outlier_fraction <= 1.0)) {
     message << "outlier fraction = " << outlier_fraction
             << " is outside [0, 1]";
+  } else if (UsesDepthRange() &&
+             !(match_min_depth > 0.0 && match_max_depth >= match_min_depth &&
+               std::isfinite(match_max_depth))) {
+    message << "match depth range [" << match_min_depth << ", "
+            << match_max_depth << "] must satisfy 0 < min <= max < inf";
+  } else if (UsesDepthRange() && render_images) {
+    message << "matches over a depth range do not belong to the images; "
+               "render no images with them";
   } else {
     return Status::Ok();
   }
@@ -165,7 +173,25 @@ StatusOr<SequenceFrame> SequenceSimulator::Frame(int index) {
         FlatPortCamera::Create(rig_.right(), options_.right_port, frame.n);
     if (!left.ok()) return left.status().WithContext("left port");
     if (!right.ok()) return right.status().WithContext("right port");
-    frame.matches = SampleMatches(index, left.value(), right.value());
+    if (options_.UsesDepthRange()) {
+      StereoSamplerOptions sampler;
+      sampler.n = frame.n;
+      sampler.min_depth = options_.match_min_depth;
+      sampler.max_depth = options_.match_max_depth;
+      sampler.per_frame = options_.matches_per_frame;
+      sampler.seed = DeriveSeed(DeriveSeed(options_.seed, kMatchSeed), index);
+      StatusOr<std::vector<StereoCorrespondence>> sampled =
+          SampleFlatPortCorrespondences(rig_, options_.left_port,
+                                        options_.right_port, sampler);
+      if (!sampled.ok()) return sampled.status();
+      frame.matches = std::move(sampled).value();
+      for (StereoCorrespondence& match : frame.matches) {
+        match.frame = index;
+        match.timestamp = frame.t;
+      }
+    } else {
+      frame.matches = SampleMatches(index, left.value(), right.value());
+    }
     if (options_.match_noise_px > 0.0) {
       AddPixelNoise(options_.match_noise_px,
                     DeriveSeed(DeriveSeed(options_.seed, kNoiseSeed), index),

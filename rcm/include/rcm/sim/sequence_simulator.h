@@ -7,7 +7,9 @@
 // left pixel's ray is cast into the tank, the surface point it hits is
 // projected exactly into the right camera, and it is kept when the right
 // camera's ray through that pixel hits the same point (visible, in both
-// images). Noise and outliers are then added as configured.
+// images). Or, for studies over a controlled depth range, points at
+// sampled depths (no images then). Noise and outliers are then added as
+// configured.
 //
 // Everything depends only on the options and the seed: the same options
 // give the same images and matches, bit for bit, however many threads.
@@ -47,12 +49,23 @@ struct SequenceOptions {
   int matches_per_frame = 0;  // exact scene correspondences per frame, >= 0
   double match_noise_px = 0.0;    // Gaussian noise on all four coordinates
   double outlier_fraction = 0.0;  // of each frame's matches, in [0, 1]
+  // Both zero (the default): matches are points of the tank's surfaces.
+  // Otherwise 0 < min <= max: matches are points at depths Z uniform in
+  // [min, max] (left camera frame) on the rays of uniform left pixels
+  // (SampleFlatPortCorrespondences), for studies over a controlled depth
+  // range; they do not belong to the images, so render_images must be
+  // false.
+  double match_min_depth = 0.0;  // meters
+  double match_max_depth = 0.0;  // meters
   // Seeds everything (scene, trajectory, sensor noise, matches); the seeds
   // in `scene`, `trajectory` and `render` are replaced by ones derived
   // from it.
   uint64_t seed = 1;
 
   Status Check() const;
+  bool UsesDepthRange() const {
+    return match_min_depth != 0.0 || match_max_depth != 0.0;
+  }
 };
 
 struct SequenceFrame {
