@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "rcm/sim/stereo_sampler.h"
+#include "rcm/util/splitmix64.h"
 
 namespace rcm {
 namespace {
@@ -19,12 +20,10 @@ constexpr double kVisibilityTolerance = 1e-6;  // meters
 // wall close up may see little in both images).
 constexpr int kDrawsPerMatch = 50;
 
-// splitmix64: independent seeds for each part from one user seed.
+// Independent seeds for each part from one user seed: SplitMix64 at the
+// stream's position in the seed's sequence.
 uint64_t DeriveSeed(uint64_t seed, uint64_t stream) {
-  uint64_t z = seed + 0x9E3779B97F4A7C15ull * (stream + 1);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
+  return SplitMix64(seed + 0x9E3779B97F4A7C15ull * stream);
 }
 
 enum SeedStream : uint64_t {

@@ -8,6 +8,7 @@
 
 #include "rcm/sim/flat_port_camera.h"
 #include "rcm/util/parallel_for.h"
+#include "rcm/util/splitmix64.h"
 
 namespace rcm {
 namespace {
@@ -17,13 +18,6 @@ constexpr int kMaxSupersampling = 8;
 constexpr int kFloatsPerSample = 7;
 // Rows per thread below which ParallelFor stays on one thread.
 constexpr int64_t kMinRowsPerThread = 8;
-
-uint64_t SplitMix64(uint64_t x) {
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
-}
 
 // A standard normal draw from one 64-bit hash (Box-Muller on its halves).
 double GaussianFromHash(uint64_t hash) {

@@ -10,6 +10,8 @@
 #include <utility>
 #include <vector>
 
+#include "rcm/util/splitmix64.h"
+
 namespace rcm {
 namespace {
 
@@ -23,13 +25,6 @@ constexpr double kInsideTolerance = 1e-9;
 // Anisotropic lookups treat rays more grazing than this (|cos theta|) as
 // this grazing: the footprint is capped at 64 times its width.
 constexpr double kMinFootprintCosine = 1.0 / 64.0;
-
-uint64_t SplitMix64(uint64_t x) {
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
-}
 
 int AlignedSize(double meters, double texel_size) {
   const int texels = static_cast<int>(std::ceil(meters / texel_size));

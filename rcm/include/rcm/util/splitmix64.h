@@ -1,0 +1,23 @@
+// SplitMix64 (Steele, Lea and Flood, 2014): a fast, stateless 64-bit mixer.
+// The simulator derives every random stream from it (seeds of its parts,
+// texture draws, per-pixel sensor noise keyed by (seed, frame, camera,
+// pixel)), so results do not depend on the order in which threads run.
+#ifndef RCM_UTIL_SPLITMIX64_H_
+#define RCM_UTIL_SPLITMIX64_H_
+
+#include <cstdint>
+
+namespace rcm {
+
+// The SplitMix64 output for state x: the golden-ratio increment, then the
+// two xor-shift-multiply rounds and a final xor-shift.
+constexpr uint64_t SplitMix64(uint64_t x) {
+  x += 0x9E3779B97F4A7C15ull;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+  return x ^ (x >> 31);
+}
+
+}  // namespace rcm
+
+#endif  // RCM_UTIL_SPLITMIX64_H_
