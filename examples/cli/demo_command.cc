@@ -169,10 +169,7 @@ double Median(std::vector<double> values) {
 
 // Median |r| of the matches' distances from their loci at n (pixels).
 double MedianLocusDistance(const StereoRig& rig,
-                           const std::vector<StereoCorrespondence>& matches,
-                           double n) {
-  const PreparedCorrespondences prepared =
-      PrepareCorrespondences(rig, matches);
+                           const PreparedCorrespondences& prepared, double n) {
   std::vector<double> residuals = LocusResiduals(
       EssentialMatrix(rig.right_from_left()), prepared.prepared, n);
   residuals.erase(std::remove_if(residuals.begin(), residuals.end(),
@@ -360,9 +357,10 @@ int RunDemo() {
   const RefinementSummary& estimate = summary.value();
   const double truth = results.back().n_true;
   const double error_n = estimate.n - truth;
-  const double residual_air = MedianLocusDistance(rig, since_switch, 1.0);
-  const double residual_fit = MedianLocusDistance(rig, since_switch,
-                                                  estimate.n);
+  const PreparedCorrespondences prepared =
+      PrepareCorrespondences(rig, since_switch);
+  const double residual_air = MedianLocusDistance(rig, prepared, 1.0);
+  const double residual_fit = MedianLocusDistance(rig, prepared, estimate.n);
 
   // Pictures: the plot and the first pair before and after correction.
   const std::string plot_path = folder + "/n_per_frame.png";
@@ -377,6 +375,11 @@ int RunDemo() {
       RefractiveCamera::Create(rig.left(), estimate.n).value();
   const RefractiveCamera right_water =
       RefractiveCamera::Create(rig.right(), estimate.n).value();
+  // The lens corrected but the water ignored (n = 1), for comparison.
+  const RefractiveCamera left_air =
+      RefractiveCamera::Create(rig.left(), 1.0).value();
+  const RefractiveCamera right_air =
+      RefractiveCamera::Create(rig.right(), 1.0).value();
   const StereoRectification rectification = RectifyStereoRig(rig);
   VirtualPinholeView left_view = ChooseVirtualPinholeView(left_water).value();
   left_view.camera_from_view = rectification.left_camera_from_rect;
@@ -393,15 +396,14 @@ int RunDemo() {
                                 .message());
     return kExitFailure;
   }
-  // Pixel of a raw pixel in a rectified view at index n (n = 1: the lens
-  // corrected, water ignored).
-  const auto rectified_pixel = [&](const Camera& camera, double n,
+  // Pixel of a raw pixel in a rectified view through `camera` (at n = 1:
+  // the lens corrected, the water ignored).
+  const auto rectified_pixel = [&](const RefractiveCamera& camera,
                                    const Eigen::Matrix3d& camera_from_view,
                                    const Eigen::Vector2d& raw)
       -> std::optional<Eigen::Vector2d> {
     const std::optional<Eigen::Vector3d> bearing =
-        RefractiveCamera::Create(camera, n).value().BearingInWaterFromImage(
-            raw);
+        camera.BearingInWaterFromImage(raw);
     if (!bearing) return std::nullopt;
     const Eigen::Vector3d in_view = camera_from_view.transpose() * *bearing;
     if (!(in_view.z() > 0.0)) return std::nullopt;
@@ -427,18 +429,14 @@ int RunDemo() {
   std::vector<double> rows_air;
   std::vector<double> rows_water;
   for (const StereoCorrespondence& match : inliers_first) {
-    const auto air_l = rectified_pixel(rig.left(), 1.0,
-                                       rectification.left_camera_from_rect,
-                                       match.left_pixel);
-    const auto air_r = rectified_pixel(rig.right(), 1.0,
-                                       rectification.right_camera_from_rect,
-                                       match.right_pixel);
+    const auto air_l = rectified_pixel(
+        left_air, rectification.left_camera_from_rect, match.left_pixel);
+    const auto air_r = rectified_pixel(
+        right_air, rectification.right_camera_from_rect, match.right_pixel);
     const auto water_l = rectified_pixel(
-        rig.left(), estimate.n, rectification.left_camera_from_rect,
-        match.left_pixel);
+        left_water, rectification.left_camera_from_rect, match.left_pixel);
     const auto water_r = rectified_pixel(
-        rig.right(), estimate.n, rectification.right_camera_from_rect,
-        match.right_pixel);
+        right_water, rectification.right_camera_from_rect, match.right_pixel);
     if (!air_l || !air_r || !water_l || !water_r) continue;
     rows_raw.push_back(std::abs(match.left_pixel.y() - match.right_pixel.y()));
     rows_air.push_back(std::abs(air_l->y() - air_r->y()));
@@ -455,12 +453,10 @@ int RunDemo() {
   std::vector<Eigen::Vector2d> corrected_left;
   std::vector<Eigen::Vector2d> corrected_right;
   for (const StereoCorrespondence& match : shown) {
-    const auto l = rectified_pixel(rig.left(), estimate.n,
-                                   rectification.left_camera_from_rect,
-                                   match.left_pixel);
-    const auto r = rectified_pixel(rig.right(), estimate.n,
-                                   rectification.right_camera_from_rect,
-                                   match.right_pixel);
+    const auto l = rectified_pixel(
+        left_water, rectification.left_camera_from_rect, match.left_pixel);
+    const auto r = rectified_pixel(
+        right_water, rectification.right_camera_from_rect, match.right_pixel);
     if (!l || !r) continue;
     raw_left.push_back(match.left_pixel);
     raw_right.push_back(match.right_pixel);
