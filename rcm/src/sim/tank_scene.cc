@@ -438,6 +438,31 @@ float MosaicTone(uint64_t hash, float base) {
   return base + tone + 0.03f * jitter;
 }
 
+// Paints a tile mosaic: each tile its tone (tones[tile_y * tiles_x +
+// tile_x]), blended toward `grout_tone` by the anti-aliased grout coverage
+// of the texel, times (1 + grain * uniform noise in [-1, 1]).
+void PaintMosaic(const TileGrid& grid, const std::vector<float>& tones,
+                 float grout_tone, float grain, Draws* draws, cv::Mat* albedo) {
+  const cv::Size size = albedo->size();
+  std::vector<float> white(size.width);
+  cv::Mat white_row(1, size.width, CV_32F, white.data());
+  cv::RNG* rng = &draws->rng();
+  for (int y = 0; y < size.height; ++y) {
+    uint8_t* row = albedo->ptr<uint8_t>(y);
+    rng->fill(white_row, cv::RNG::UNIFORM, -1.0, 1.0);
+    const float* tone_row =
+        tones.data() + static_cast<size_t>(grid.tile_of_row[y]) * grid.tiles_x;
+    const float grout_v = grid.grout_of_row[y];
+    for (int x = 0; x < size.width; ++x) {
+      const float grout_u = grid.grout_of_column[x];
+      const float grout = grout_u + grout_v - grout_u * grout_v;
+      const float tile = tone_row[grid.tile_of_column[x]];
+      row[x] = ToByte((tile + (grout_tone - tile) * grout) *
+                      (1.0f + grain * white[x]));
+    }
+  }
+}
+
 // Floor: a mosaic of 5 cm tiles in a random blend with dark lane lines,
 // painted marks and tags, then sand drifts, algae stains, grime and the
 // caustic network of sunlight, then debris on top.
@@ -471,23 +496,10 @@ void FloorTexture(const TankSceneOptions& options, double texel,
       tones[index] = tone;
     }
   }
+  PaintMosaic(grid, tones, 0.42f, 0.04f, &draws, albedo);
   std::vector<float> white(size.width);
   cv::Mat white_row(1, size.width, CV_32F, white.data());
   cv::RNG* rng = &draws.rng();
-  for (int y = 0; y < size.height; ++y) {
-    uint8_t* row = albedo->ptr<uint8_t>(y);
-    rng->fill(white_row, cv::RNG::UNIFORM, -1.0, 1.0);
-    const float* tone_row =
-        tones.data() + static_cast<size_t>(grid.tile_of_row[y]) * grid.tiles_x;
-    const float grout_v = grid.grout_of_row[y];
-    for (int x = 0; x < size.width; ++x) {
-      const float grout_u = grid.grout_of_column[x];
-      const float grout = grout_u + grout_v - grout_u * grout_v;
-      const float tile = tone_row[grid.tile_of_column[x]];
-      row[x] =
-          ToByte((tile + (0.42f - tile) * grout) * (1.0f + 0.04f * white[x]));
-    }
-  }
   PaintMarks(albedo, texel, 0.5, 0.06, 0.4, false, &draws);
 
   // Sand grain 1-10 cm, drifts 0.2-2 m, algae stains 2 cm-0.5 m, grime
@@ -572,23 +584,8 @@ void WallTexture(const TankSceneOptions& options, double texel,
       tones[index] = tone;
     }
   }
-  std::vector<float> white(size.width);
-  cv::Mat white_row(1, size.width, CV_32F, white.data());
+  PaintMosaic(grid, tones, 0.5f, 0.03f, &draws, albedo);
   cv::RNG* rng = &draws.rng();
-  for (int y = 0; y < size.height; ++y) {
-    uint8_t* row = albedo->ptr<uint8_t>(y);
-    rng->fill(white_row, cv::RNG::UNIFORM, -1.0, 1.0);
-    const float* tone_row =
-        tones.data() + static_cast<size_t>(grid.tile_of_row[y]) * grid.tiles_x;
-    const float grout_v = grid.grout_of_row[y];
-    for (int x = 0; x < size.width; ++x) {
-      const float grout_u = grid.grout_of_column[x];
-      const float grout = grout_u + grout_v - grout_u * grout_v;
-      const float tile = tone_row[grid.tile_of_column[x]];
-      row[x] =
-          ToByte((tile + (0.5f - tile) * grout) * (1.0f + 0.03f * white[x]));
-    }
-  }
   for (double u = draws.Uniform(0.8, 1.6); u < perimeter - 0.5;
        u += draws.Uniform(1.8, 3.2)) {
     std::ostringstream label;
