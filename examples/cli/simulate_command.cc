@@ -81,10 +81,8 @@ int RunSimulate() {
     PrintError(command, "--out is required (see rcm simulate --help)");
     return kExitUsage;
   }
-  if (FLAGS_left != "cam0" || FLAGS_right != "cam1") {
-    // The rig reader takes them; the simulator writes cam0/cam1 as given.
-  }
-  StatusOr<Simulation> simulation = SimulationFromFlags(FLAGS_calib);
+  StatusOr<Simulation> simulation =
+      SimulationFromFlags(FLAGS_calib, FLAGS_left, FLAGS_right);
   if (!simulation.ok()) {
     PrintError(command, simulation.status().message());
     return kExitFailure;

@@ -38,10 +38,12 @@ namespace rcm::cli {
 
 extern const char kSimulationFlagsSource[] = __FILE__;
 
-StatusOr<Simulation> SimulationFromFlags(const std::string& calib) {
+StatusOr<Simulation> SimulationFromFlags(const std::string& calib,
+                                         const std::string& left,
+                                         const std::string& right) {
   Simulation simulation{AlphasenseFrontRectifiedRig(), "alphasense", {}};
   if (!calib.empty()) {
-    StatusOr<StereoRig> rig = ReadStereoRig(calib);
+    StatusOr<StereoRig> rig = ReadStereoRig(calib, left, right);
     if (!rig.ok()) return rig.status();
     simulation.rig = rig.value();
     simulation.rig_name = calib;

@@ -36,9 +36,12 @@ struct Simulation {
   SequenceOptions options;
 };
 
-// The rig (--rig, or `calib` when not empty) and the sequence options of
-// the flags. Fails with one line on a bad value.
-StatusOr<Simulation> SimulationFromFlags(const std::string& calib);
+// The rig (--rig, or the cameras `left` and `right` of the file `calib`
+// when it is not empty) and the sequence options of the flags. Fails with
+// one line on a bad value.
+StatusOr<Simulation> SimulationFromFlags(const std::string& calib,
+                                         const std::string& left = "cam0",
+                                         const std::string& right = "cam1");
 
 // The flags' values, for the JSON a run writes next to its outputs.
 nlohmann::json SimulationFlagsJson(const Simulation& simulation);

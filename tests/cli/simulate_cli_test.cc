@@ -120,6 +120,26 @@ TEST(SimulateCli, DepthRangeMatchesWithoutImages) {
       2, "no images");
 }
 
+TEST(SimulateCli, UsesTheCamerasOfAGivenRigFile) {
+  // --left cam1 --right cam0 swaps the pair: the written camchain's cam0 is
+  // the file's cam1 (fx 344.39...).
+  const std::string folder = Folder("swapped");
+  const RunResult result = Rcm(
+      {"simulate", "--out", folder, "--calib",
+       std::string(RCM_SOURCE_DIR) +
+           "/examples/data/alphasense_front_rectified.yaml",
+       "--left", "cam1", "--right", "cam0", "--noimages",
+       "--matches-per-frame", "20", "--frames", "1"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const std::string camchain = test::ReadWholeFile(folder + "/camchain.yaml");
+  const size_t cam0 = camchain.find("cam0:");
+  const size_t cam1 = camchain.find("cam1:");
+  const size_t fx = camchain.find("344.3933991977547");
+  ASSERT_NE(fx, std::string::npos) << camchain;
+  EXPECT_LT(cam0, fx);
+  EXPECT_LT(fx, cam1);
+}
+
 TEST(SimulateCli, BadFlagsGiveOneLine) {
   const std::string folder = Folder("bad");
   ExpectFailsWithOneLine(Rcm({"simulate"}), 2, "--out is required");
