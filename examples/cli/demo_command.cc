@@ -95,11 +95,14 @@ struct FrameResult {
   int switch_first_frame = -1;  // the switch's first frame of the new medium
 };
 
+// Layout of a side-by-side picture: a title strip of kTitle pixels above
+// the two images, kGap pixels between them.
+constexpr int kTitle = 34;
+constexpr int kGap = 8;
+
 // The stereo pair side by side on a BGR canvas with a title strip.
 cv::Mat SideBySide(const cv::Mat& left, const cv::Mat& right,
                    const std::string& title) {
-  constexpr int kGap = 8;
-  constexpr int kTitle = 34;
   cv::Mat canvas(left.rows + kTitle, left.cols + kGap + right.cols, CV_8UC3,
                  cv::Scalar(255, 255, 255));
   cv::Mat left_bgr;
@@ -120,7 +123,6 @@ cv::Mat SideBySide(const cv::Mat& left, const cv::Mat& right,
 void DrawMatchesOnRows(const std::vector<Eigen::Vector2d>& left_points,
                        const std::vector<Eigen::Vector2d>& right_points,
                        int right_offset, cv::Mat* canvas) {
-  constexpr int kTitle = 34;
   for (size_t i = 0; i < left_points.size(); ++i) {
     const cv::Scalar color = PaletteColor(static_cast<int>(i));
     const cv::Point2d l(left_points[i].x(), left_points[i].y() + kTitle);
@@ -467,14 +469,14 @@ int RunDemo() {
       first_left, first_right,
       "before: frame 0 as the cameras see it. Matches are " +
           FormatFixed(row_gap_raw, 1) + " px apart in rows (median)");
-  DrawMatchesOnRows(raw_left, raw_right, first_left.cols + 8, &before);
+  DrawMatchesOnRows(raw_left, raw_right, first_left.cols + kGap, &before);
   cv::Mat after = SideBySide(
       RemapToVirtualPinhole(first_left, left_maps.value()),
       RemapToVirtualPinhole(first_right, right_maps.value()),
       "after: refraction corrected at n = " + FormatFixed(estimate.n, 4) +
           ", rectified: " + FormatFixed(row_gap_water, 2) + " px (" +
           FormatFixed(row_gap_air, 2) + " px if the water is ignored)");
-  DrawMatchesOnRows(corrected_left, corrected_right, first_left.cols + 8,
+  DrawMatchesOnRows(corrected_left, corrected_right, first_left.cols + kGap,
                     &after);
 
   nlohmann::json per_frame = nlohmann::json::array();

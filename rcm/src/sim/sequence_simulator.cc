@@ -5,6 +5,7 @@
 #include <sstream>
 #include <utility>
 
+#include "rcm/sim/flat_port_camera.h"
 #include "rcm/sim/stereo_sampler.h"
 #include "rcm/util/splitmix64.h"
 
@@ -99,8 +100,13 @@ StatusOr<std::unique_ptr<SequenceSimulator>> SequenceSimulator::Create(
   return simulator;
 }
 
-std::vector<StereoCorrespondence> SequenceSimulator::SampleMatches(
-    int index, const FlatPortCamera& left, const FlatPortCamera& right) {
+std::vector<StereoCorrespondence> SequenceSimulator::SampleMatches(int index,
+                                                                  double n) {
+  // Ports and media passed SequenceOptions::Check in Create.
+  const FlatPortCamera left =
+      FlatPortCamera::Create(rig_.left(), options_.left_port, n).value();
+  const FlatPortCamera right =
+      FlatPortCamera::Create(rig_.right(), options_.right_port, n).value();
   const Rigid3d& world_from_left = poses_[index].world_from_cam0;
   const Rigid3d world_from_right =
       world_from_left * rig_.right_from_left().Inverse();
@@ -166,12 +172,6 @@ StatusOr<SequenceFrame> SequenceSimulator::Frame(int index) {
     frame.right = images.value().right;
   }
   if (options_.matches_per_frame > 0) {
-    StatusOr<FlatPortCamera> left =
-        FlatPortCamera::Create(rig_.left(), options_.left_port, frame.n);
-    StatusOr<FlatPortCamera> right =
-        FlatPortCamera::Create(rig_.right(), options_.right_port, frame.n);
-    if (!left.ok()) return left.status().WithContext("left port");
-    if (!right.ok()) return right.status().WithContext("right port");
     if (options_.UsesDepthRange()) {
       StereoSamplerOptions sampler;
       sampler.n = frame.n;
@@ -189,7 +189,7 @@ StatusOr<SequenceFrame> SequenceSimulator::Frame(int index) {
         match.timestamp = frame.t;
       }
     } else {
-      frame.matches = SampleMatches(index, left.value(), right.value());
+      frame.matches = SampleMatches(index, frame.n);
     }
     if (options_.match_noise_px > 0.0) {
       AddPixelNoise(options_.match_noise_px,

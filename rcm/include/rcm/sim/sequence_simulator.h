@@ -25,7 +25,6 @@
 #include "rcm/geometry/stereo_correspondence.h"
 #include "rcm/geometry/stereo_rig.h"
 #include "rcm/sim/flat_port.h"
-#include "rcm/sim/flat_port_camera.h"
 #include "rcm/sim/media_schedule.h"
 #include "rcm/sim/stereo_renderer.h"
 #include "rcm/sim/tank_scene.h"
@@ -109,8 +108,8 @@ class SequenceSimulator {
                     MediaSchedule media)
       : rig_(rig), options_(options), media_(std::move(media)) {}
 
-  std::vector<StereoCorrespondence> SampleMatches(
-      int index, const FlatPortCamera& left, const FlatPortCamera& right);
+  // Matches of frame `index` on the tank's surfaces, in a medium of index n.
+  std::vector<StereoCorrespondence> SampleMatches(int index, double n);
 
   StereoRig rig_;
   SequenceOptions options_;
