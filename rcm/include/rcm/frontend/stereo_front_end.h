@@ -1,0 +1,110 @@
+// The per-pair stereo front end: from a raw stereo pair to the raw-pixel
+// correspondences the estimators (rcm/estimation) take.
+//
+//   1. preprocess   gray, optional CLAHE            (image_preprocessing.h)
+//   2. detect       keypoints + descriptors          (feature_detector.h)
+//   3. match        descriptors within the refractive
+//                   epipolar band of an n interval   (guided_matcher.h)
+//   4. refine       right pixels to subpixel         (subpixel_refinement.h)
+//   5. verify       refined pairs still in the band  (locus_band.h)
+//
+// Stages 1-2 (and the band keys) run on the two images at once. The band
+// is the prior search range until an estimate exists; a caller that has
+// one (n, sigma_n) passes RefractiveIndexInterval::Around(...) as the
+// guide, which narrows the band to the locus of the current estimate. When
+// the medium changes (the robot surfaces), true matches leave that narrow
+// band: a guided frame that keeps fewer than reacquire_fraction of the
+// matches the prior band last gave is matched again with the prior band,
+// and the result says so (StereoMatches::reacquired).
+#ifndef RCM_FRONTEND_STEREO_FRONT_END_H_
+#define RCM_FRONTEND_STEREO_FRONT_END_H_
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "rcm/frontend/feature_detector.h"
+#include "rcm/frontend/guided_matcher.h"
+#include "rcm/frontend/image_preprocessing.h"
+#include "rcm/frontend/locus_band.h"
+#include "rcm/frontend/subpixel_refinement.h"
+#include "rcm/geometry/stereo_correspondence.h"
+#include "rcm/geometry/stereo_rig.h"
+#include "rcm/util/status.h"
+
+namespace rcm {
+
+struct StereoFrontEndOptions {
+  ClaheOptions clahe;
+  FeatureOptions features;
+  LocusBandOptions band;
+  GuidedMatchOptions matching;
+  SubpixelOptions subpixel;
+  // Where n may be before anything is known: air (1) to well past any
+  // water (seawater 1.34, a port's glass would be 1.5).
+  RefractiveIndexInterval search_range{1.0, 1.6};
+  // A guided frame with fewer than this fraction of the matches of the last
+  // frame matched with search_range is matched again with it; in [0, 1]
+  // (0 never re-acquires).
+  double reacquire_fraction = 0.5;
+  // Threads; >= 1. 2 runs the two images' stages 1-2 at once.
+  int num_threads = 2;
+
+  Status Check() const;
+};
+
+// Milliseconds spent in each stage (wall clock).
+struct FrontEndTimings {
+  double preprocess_ms = 0.0;
+  double detect_ms = 0.0;  // detection + descriptors + band keys
+  double match_ms = 0.0;
+  double refine_ms = 0.0;  // subpixel + verification
+  double total_ms = 0.0;
+};
+
+struct StereoMatches {
+  std::vector<StereoCorrespondence> matches;  // raw pixels
+  int left_keypoints = 0;
+  int right_keypoints = 0;
+  int descriptor_matches = 0;  // after stage 3
+  RefractiveIndexInterval band;  // the interval the matches were found in
+  bool reacquired = false;       // a guided frame matched again (above)
+  FrontEndTimings timings;
+};
+
+class StereoFrontEnd {
+ public:
+  // Errors: options.Check().
+  static StatusOr<StereoFrontEnd> Create(const StereoRig& rig,
+                                         const StereoFrontEndOptions& options);
+
+  // Matches of one stereo pair, each with `frame` and `timestamp`. `guide`:
+  // the interval of the current estimate of n, or nullopt for the prior
+  // search range. Errors: CheckStereoImages, images whose size differs
+  // from the rig's calibration, guide->Check().
+  StatusOr<StereoMatches> Match(
+      const cv::Mat& left, const cv::Mat& right, int64_t frame = 0,
+      std::optional<double> timestamp = std::nullopt,
+      const std::optional<RefractiveIndexInterval>& guide = std::nullopt);
+
+  const StereoFrontEndOptions& options() const { return options_; }
+
+ private:
+  StereoFrontEnd(const StereoRig& rig, const StereoFrontEndOptions& options,
+                 FeatureDetector left_detector, FeatureDetector right_detector)
+      : rig_(rig),
+        options_(options),
+        left_detector_(std::move(left_detector)),
+        right_detector_(std::move(right_detector)) {}
+
+  StereoRig rig_;
+  StereoFrontEndOptions options_;
+  FeatureDetector left_detector_;
+  FeatureDetector right_detector_;
+  // Matches of the last frame matched with the prior search range.
+  int prior_band_matches_ = -1;
+};
+
+}  // namespace rcm
+
+#endif  // RCM_FRONTEND_STEREO_FRONT_END_H_
