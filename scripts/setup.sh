@@ -17,6 +17,9 @@ packages=(
   libopencv-dev        # images: PNG/JPEG I/O, remap, drawing plots, SIFT
   libgtest-dev libgmock-dev  # tests
   libbenchmark-dev     # benchmarks
+  librosbag-storage-dev libsensor-msgs-dev  # ROS1 bags: rcm estimate/undistort --bag
+  pluginlib-dev libclass-loader-dev librcpputils-dev librcutils-dev \
+    libament-index-cpp-dev  # ROS 2 headers that rosbag's headers include
 )
 
 missing=()

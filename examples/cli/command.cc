@@ -11,6 +11,10 @@
 
 // Flags every subcommand shares.
 DEFINE_bool(json, false, "print one JSON object on stdout instead of text");
+DEFINE_string(out, "",
+              "output folder (rcm simulate: required; rcm demo: default "
+              "./rcm_demo; rcm estimate: optional, for the pictures and "
+              "files of the run)");
 
 namespace rcm::cli {
 namespace {

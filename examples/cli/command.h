@@ -3,8 +3,14 @@
 #ifndef RCM_EXAMPLES_CLI_COMMAND_H_
 #define RCM_EXAMPLES_CLI_COMMAND_H_
 
+#include <gflags/gflags.h>
+
 #include <string>
 #include <vector>
+
+// Flags every subcommand has (defined in command.cc).
+DECLARE_bool(json);
+DECLARE_string(out);
 
 namespace rcm::cli {
 

@@ -31,7 +31,6 @@
 #include "rcm/viz/line_plot.h"
 #include "simulation_flags.h"
 
-DECLARE_bool(json);
 
 namespace rcm::cli {
 namespace {

@@ -5,7 +5,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -14,9 +18,14 @@
 #include <vector>
 
 #include "command.h"
+#include "image_input_flags.h"
 #include "progress.h"
 #include "rig_flags.h"
 #include "rcm/estimation/batch_refinement.h"
+#include "rcm/estimation/match_refractive_index.h"
+#include "rcm/estimation/prepared_correspondence.h"
+#include "rcm/frontend/stereo_front_end.h"
+#include "rcm/geometry/epipolar.h"
 #include "rcm/estimation/online_estimator.h"
 #include "rcm/estimation/paper_online_estimator.h"
 #include "rcm/estimation/refinement_options.h"
@@ -24,13 +33,31 @@
 #include "rcm/io/atomic_file.h"
 #include "rcm/io/correspondence_csv.h"
 #include "rcm/io/number_format.h"
+#include "rcm/io/image_file.h"
 #include "rcm/io/stereo_rig_file.h"
+#include "rcm/viz/line_plot.h"
+#include "rcm/viz/match_index_image.h"
 
-DECLARE_bool(json);
 
 DEFINE_string(matches, "",
               "correspondence CSV with header frame,xl,yl,xr,yr[,t] in raw "
-              "pixels (required)");
+              "pixels (instead of images)");
+DEFINE_string(features, "orb",
+              "images: keypoints and descriptors: orb (fast, the default), "
+              "sift (the paper's) or akaze");
+DEFINE_int32(max_features, 2000, "images: keypoints per image");
+DEFINE_bool(clahe, false,
+            "images: equalize contrast (CLAHE) before detection, for dark "
+            "or hazy water");
+DEFINE_double(ratio, 0.8,
+              "images: Lowe's ratio test among the candidates in a "
+              "keypoint's refractive epipolar band");
+DEFINE_string(search_range, "1.0,1.6",
+              "images: MIN,MAX, the refractive indices matching considers "
+              "before an estimate exists (and when re-acquiring)");
+DEFINE_int32(picture_frame, -1,
+             "images: the frame drawn in matches_by_n.png (-1: the pair in "
+             "the middle of the run)");
 DEFINE_string(estimator, "refine",
               "refine: robust least squares over all frames (the estimator "
               "of record); online: the same estimate updated frame by frame "
@@ -71,9 +98,19 @@ namespace {
 constexpr char kUsage[] =
     "rcm estimate: the refractive index n of the medium from stereo\n"
     "correspondences of a rig calibrated in air.\n\n"
-    "usage: rcm estimate --calib RIG.yaml --matches MATCHES.csv\n"
-    "                    [--estimator refine|online|window|closed-form]\n"
-    "                    [--window N] [--per-frame OUT.csv] [--json]\n\n"
+    "usage: rcm estimate --calib RIG.yaml --left DIR --right DIR [--out DIR]\n"
+    "       rcm estimate --calib RIG.yaml --bag BAG --left-topic T0 "
+    "--right-topic T1\n"
+    "       rcm estimate --calib RIG.yaml --matches MATCHES.csv\n"
+    "   [--estimator refine|online|window|closed-form] [--window N]\n"
+    "   [--from S --to S --stride K] [--features orb|sift|akaze] [--clahe]\n"
+    "   [--per-frame OUT.csv] [--json]\n\n"
+    "From images, each pair's keypoints are matched within the band of the\n"
+    "refractive epipolar loci of the current n (the previous pair's own\n"
+    "estimate; --search-range before there is one), refined to subpixel and\n"
+    "fed to the estimator. Folders pair by file name (or sorted order, or a\n"
+    "--pairs list); names that are stamps (ns or s) give the times that\n"
+    "--from/--to count. Bags pair the two topics by header stamp.\n\n"
     "refine fits n to the distance of every match from its refractive "
     "epipolar\nlocus (Sampson distance, pixels) over all frames: a robust "
     "stage that finds n\namong outliers, then least squares on the inliers, "
@@ -156,6 +193,125 @@ struct Report {
   std::vector<std::string> text_lines;  // estimator-specific lines
 };
 
+// The front end's pass over an image sequence: the matches of every pair,
+// each pair guided by the previous pair's own estimate.
+struct ImageRun {
+  std::string source;  // the source's Describe()
+  std::vector<Frame> frames;
+  std::vector<StereoCorrespondence> matches;  // all frames, in order
+  std::vector<FrameRow> own_rows;             // each pair's own estimate
+  FrontEndTimings stage_ms;                   // sums over the pairs
+  double read_ms = 0.0;                       // decoding, summed
+  double guide_ms = 0.0;                      // per-pair estimates, summed
+  double seconds = 0.0;                       // wall clock of the pass
+  int reacquired = 0;
+  // The pair drawn in matches_by_n.png.
+  cv::Mat picture_left;
+  int64_t picture_frame = -1;
+  std::vector<StereoCorrespondence> picture_matches;
+};
+
+// The guide of the next pair: the last pair's own estimate of n, widened
+// to 6 sigma and at least +-0.01 (a few frames' drift of a real medium).
+constexpr double kGuideSigmas = 6.0;
+constexpr double kGuideMinHalfWidth = 0.01;
+
+double Milliseconds(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(
+             std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+StatusOr<ImageRun> RunFrontEnd(const StereoRig& rig,
+                               StereoImageSource* source,
+                               const StereoFrontEndOptions& options,
+                               const RefinementOptions& refinement) {
+  StatusOr<StereoFrontEnd> front_end = StereoFrontEnd::Create(rig, options);
+  if (!front_end.ok()) return front_end.status();
+  RefinementOptions own_options = refinement;
+  own_options.refine_rotation = false;
+  ImageRun run;
+  run.source = source->Describe();
+  const size_t pairs = source->NumPairs();
+  const size_t picture_index =
+      FLAGS_picture_frame >= 0 ? std::numeric_limits<size_t>::max()
+                               : pairs / 2;
+  std::optional<RefractiveIndexInterval> guide;
+  Progress progress("rcm estimate: pair", pairs);
+  const auto start = std::chrono::steady_clock::now();
+  for (size_t i = 0; i < pairs; ++i) {
+    const auto read_start = std::chrono::steady_clock::now();
+    StatusOr<StereoImagePair> pair = source->ReadPair(i);
+    if (!pair.ok()) return pair.status();
+    run.read_ms += Milliseconds(read_start);
+    StatusOr<StereoMatches> matched = front_end->Match(
+        pair->left, pair->right, pair->frame, pair->timestamp, guide);
+    if (!matched.ok()) {
+      return matched.status().WithContext(pair->left_name + " and " +
+                                          pair->right_name);
+    }
+    run.stage_ms.preprocess_ms += matched->timings.preprocess_ms;
+    run.stage_ms.detect_ms += matched->timings.detect_ms;
+    run.stage_ms.match_ms += matched->timings.match_ms;
+    run.stage_ms.refine_ms += matched->timings.refine_ms;
+    run.stage_ms.total_ms += matched->timings.total_ms;
+    run.reacquired += matched->reacquired ? 1 : 0;
+
+    const auto guide_start = std::chrono::steady_clock::now();
+    const StatusOr<RefinementSummary> own =
+        RefineRefractiveIndex(rig, matched->matches, own_options);
+    run.guide_ms += Milliseconds(guide_start);
+    FrameRow row{pair->frame, pair->timestamp};
+    std::string status = std::to_string(matched->matches.size()) + " matches";
+    if (own.ok()) {
+      row.n = own->n;
+      row.sigma_n = own->sigma_n;
+      guide = RefractiveIndexInterval::Around(own->n, own->sigma_n,
+                                              kGuideSigmas, kGuideMinHalfWidth);
+      status += ", n = " + FormatFixed(own->n, 4) + " +- " +
+                FormatFixed(own->sigma_n, 4);
+    } else {
+      guide.reset();  // back to the prior search range
+    }
+    run.own_rows.push_back(row);
+    if (i == picture_index || pair->frame == FLAGS_picture_frame) {
+      run.picture_left = pair->left;
+      run.picture_frame = pair->frame;
+      run.picture_matches = matched->matches;
+    }
+    run.frames.push_back({pair->frame, pair->timestamp, matched->matches});
+    run.matches.insert(run.matches.end(), matched->matches.begin(),
+                       matched->matches.end());
+    progress.Update(i + 1, status);
+  }
+  run.seconds = Milliseconds(start) / 1000.0;
+  return run;
+}
+
+StatusOr<StereoFrontEndOptions> FrontEndOptionsFromFlags() {
+  StereoFrontEndOptions options;
+  const std::optional<FeatureType> type = FeatureTypeFromName(FLAGS_features);
+  if (!type) {
+    return Status::Error("unknown --features '" + FLAGS_features +
+                         "' (available: orb, sift, akaze)");
+  }
+  options.features.type = *type;
+  options.features.max_features = FLAGS_max_features;
+  options.clahe.enabled = FLAGS_clahe;
+  options.matching.ratio = FLAGS_ratio;
+  double low = 0.0;
+  double high = 0.0;
+  char tail = 0;
+  if (std::sscanf(FLAGS_search_range.c_str(), "%lf,%lf%c", &low, &high,
+                  &tail) != 2) {
+    return Status::Error("--search-range must be MIN,MAX, got '" +
+                         FLAGS_search_range + "'");
+  }
+  options.search_range = {low, high};
+  RCM_RETURN_IF_ERROR(options.Check());
+  return options;
+}
+
 RefinementOptions RefinementOptionsFromFlags() {
   RefinementOptions options;
   options.loss = RobustLossFromName(FLAGS_loss).value_or(RobustLoss::kCauchy);
@@ -176,7 +332,8 @@ std::string LossDescription(const RefinementOptions& options) {
 StatusOr<Report> RunRefine(const StereoRig& rig,
                            const std::vector<StereoCorrespondence>& matches,
                            const std::vector<Frame>& frames,
-                           const RefinementOptions& options) {
+                           const RefinementOptions& options,
+                           const std::vector<FrameRow>* own_rows) {
   StatusOr<RefinementSummary> summary =
       RefineRefractiveIndex(rig, matches, options);
   if (!summary.ok()) return summary.status();
@@ -224,7 +381,9 @@ StatusOr<Report> RunRefine(const StereoRig& rig,
          << FormatFixed(rotation.multiple_correlation_with_n, 2);
     report.text_lines.push_back(line.str());
   }
-  if (!FLAGS_per_frame.empty()) {
+  if (own_rows != nullptr) {
+    report.rows = *own_rows;  // computed by the front end's pass
+  } else if (!FLAGS_per_frame.empty() || !FLAGS_out.empty()) {
     // Each frame's own estimate, for a look at how n varies over time.
     RefinementOptions frame_options = options;
     frame_options.num_threads = 1;
@@ -421,6 +580,72 @@ StatusOr<Report> RunClosedForm(const StereoRig& rig,
   return report;
 }
 
+// n per frame with its 1-sigma band, and the final estimate.
+cv::Mat PlotPerFrame(const Report& report) {
+  std::vector<double> x, n, low, high;
+  for (const FrameRow& row : report.rows) {
+    if (!std::isfinite(row.n)) continue;
+    x.push_back(static_cast<double>(row.frame));
+    n.push_back(row.n);
+    const double sigma = std::isfinite(row.sigma_n) ? row.sigma_n : 0.0;
+    low.push_back(row.n - sigma);
+    high.push_back(row.n + sigma);
+  }
+  LinePlot plot;
+  plot.SetTitle("n = " + FormatFixed(report.n, 5) + " +- " +
+                FormatFixed(report.sigma_n, 5) + " (" + FLAGS_estimator +
+                ")");
+  plot.SetXLabel("frame");
+  plot.SetYLabel("refractive index n");
+  const std::string what = FLAGS_estimator == "refine" ? "each frame alone"
+                           : FLAGS_estimator == "window"
+                               ? "window estimate"
+                               : "estimate so far";
+  if (!x.empty()) {
+    plot.AddBand(x, low, high, what + ": 1 sigma", PaletteColor(7), 0.2);
+    plot.AddLine(x, n, what, LineStyle{PaletteColor(7)});
+    plot.AddMarkers(x, n, "",
+                    MarkerStyle{PaletteColor(7), MarkerShape::kCircle, 3.0});
+  }
+  if (std::isfinite(report.n)) {
+    plot.AddHorizontalLine(report.n, "final estimate",
+                           LineStyle{PaletteColor(0), 2.0});
+  }
+  for (const FrameRow& row : report.rows) {
+    if (row.medium_switch) {
+      plot.AddVerticalMarker(static_cast<double>(row.frame) - 0.5, "switch",
+                             LineStyle{PaletteColor(3), 1.5, 6.0, 4.0});
+    }
+  }
+  return plot.Render(1000, 600);
+}
+
+// The paper's Fig. 6b: a pair's matches colored by their own n.
+cv::Mat MatchesByIndexPicture(const StereoRig& rig, const ImageRun& run,
+                              double n) {
+  const Eigen::Matrix3d essential = EssentialMatrix(rig.right_from_left());
+  std::vector<Eigen::Vector2d> pixels;
+  std::vector<std::optional<double>> values;
+  int with_value = 0;
+  for (const StereoCorrespondence& match : run.picture_matches) {
+    pixels.push_back(match.left_pixel);
+    const std::optional<PreparedCorrespondence> prepared =
+        PrepareCorrespondence(rig, match);
+    values.push_back(prepared ? RefractiveIndexOfMatch(essential, *prepared)
+                              : std::nullopt);
+    with_value += values.back() ? 1 : 0;
+  }
+  MatchIndexImageOptions options;
+  options.center = std::isfinite(n) ? n : 1.333;
+  options.half_range = 0.05;
+  options.title = "frame " + std::to_string(run.picture_frame) + ": " +
+                  std::to_string(with_value) + " of " +
+                  std::to_string(pixels.size()) +
+                  " matches by their own n (rings: none in [1, 2])";
+  return DrawMatchesByRefractiveIndex(run.picture_left, pixels, values,
+                                      options);
+}
+
 int RunEstimate();
 
 }  // namespace
@@ -429,7 +654,7 @@ extern const Subcommand kEstimateCommand = {
     "estimate",
     "refractive index n from stereo correspondences",
     kUsage,
-    {__FILE__, kRigFlagsSource},
+    {__FILE__, kRigFlagsSource, kImageInputFlagsSource},
     RunEstimate};
 
 namespace {
@@ -438,10 +663,6 @@ int RunEstimate() {
   const Subcommand& command = kEstimateCommand;
   if (FLAGS_calib.empty()) {
     PrintError(command, "--calib is required (see rcm estimate --help)");
-    return kExitUsage;
-  }
-  if (FLAGS_matches.empty()) {
-    PrintError(command, "--matches is required (see rcm estimate --help)");
     return kExitUsage;
   }
   const std::vector<std::string> estimators = {"refine", "online", "window",
@@ -483,25 +704,78 @@ int RunEstimate() {
     return kExitUsage;
   }
 
+  const bool images = ImageInputGiven();
+  if (images == !FLAGS_matches.empty()) {
+    PrintError(command,
+               images ? "give either --matches or images, not both"
+                      : "no input: give --left DIR --right DIR, --pairs "
+                        "LIST, --bag BAG or --matches CSV (see rcm estimate "
+                        "--help)");
+    return kExitUsage;
+  }
+  std::optional<StereoFrontEndOptions> front_end_options;
+  if (images) {
+    StatusOr<StereoFrontEndOptions> options = FrontEndOptionsFromFlags();
+    if (!options.ok()) {
+      PrintError(command, options.status().message());
+      return kExitUsage;
+    }
+    front_end_options = *options;
+  }
+
   const StatusOr<StereoRig> rig =
-      ReadStereoRig(FLAGS_calib, FLAGS_left, FLAGS_right);
+      ReadStereoRig(FLAGS_calib, FLAGS_left_camera, FLAGS_right_camera);
   if (!rig.ok()) {
     PrintError(command, rig.status().message());
     return kExitFailure;
   }
-  StatusOr<std::vector<StereoCorrespondence>> matches =
-      ReadCorrespondenceCsv(FLAGS_matches);
-  if (!matches.ok()) {
-    PrintError(command, matches.status().message());
-    return kExitFailure;
+  // The output folder first: a run is not wasted on one that cannot be
+  // written.
+  if (!FLAGS_out.empty()) {
+    std::error_code error;
+    std::filesystem::create_directories(FLAGS_out, error);
+    if (error || !std::filesystem::is_directory(FLAGS_out)) {
+      PrintError(command, FLAGS_out + ": cannot create the output folder" +
+                              (error ? " (" + error.message() + ")" : ""));
+      return kExitFailure;
+    }
   }
-  // Frames in time order; matches of a frame stay in file order.
-  std::stable_sort(
-      matches->begin(), matches->end(),
-      [](const StereoCorrespondence& a, const StereoCorrespondence& b) {
-        return a.frame < b.frame;
-      });
-  const std::vector<Frame> frames = SplitFrames(*matches);
+
+  std::vector<StereoCorrespondence> matches;
+  std::vector<Frame> frames;
+  std::optional<ImageRun> run;
+  if (images) {
+    StatusOr<std::unique_ptr<StereoImageSource>> source =
+        OpenImageInputFromFlags();
+    if (!source.ok()) {
+      PrintError(command, source.status().message());
+      return kExitFailure;
+    }
+    StatusOr<ImageRun> pass =
+        RunFrontEnd(*rig, source->get(), *front_end_options, refinement);
+    if (!pass.ok()) {
+      PrintError(command, pass.status().message());
+      return kExitFailure;
+    }
+    run = std::move(*pass);
+    matches = run->matches;
+    frames = run->frames;
+  } else {
+    StatusOr<std::vector<StereoCorrespondence>> read =
+        ReadCorrespondenceCsv(FLAGS_matches);
+    if (!read.ok()) {
+      PrintError(command, read.status().message());
+      return kExitFailure;
+    }
+    matches = std::move(*read);
+    // Frames in time order; matches of a frame stay in file order.
+    std::stable_sort(
+        matches.begin(), matches.end(),
+        [](const StereoCorrespondence& a, const StereoCorrespondence& b) {
+          return a.frame < b.frame;
+        });
+    frames = SplitFrames(matches);
+  }
 
   StatusOr<Report> report = Status::Error("no estimator");
   if (FLAGS_estimator == "closed-form") {
@@ -511,45 +785,103 @@ int RunEstimate() {
   } else if (FLAGS_estimator == "window") {
     report = RunWindow(*rig, frames, refinement, window_options);
   } else {
-    report = RunRefine(*rig, *matches, frames, refinement);
+    report = RunRefine(*rig, matches, frames, refinement,
+                       run ? &run->own_rows : nullptr);
   }
   if (!report.ok()) {
     PrintError(command, report.status().message());
     return kExitFailure;
   }
-  if (!FLAGS_per_frame.empty()) {
-    const Status written =
-        WriteFileAtomically(FLAGS_per_frame, FormatFrameRows(report->rows));
-    if (!written.ok()) {
-      PrintError(command, written.message());
-      return kExitFailure;
-    }
-  }
 
   const StereoRig::RectificationDeviation deviation =
       rig->DeviationFromRectified();
+  nlohmann::json json;
+  json["estimator"] = FLAGS_estimator;
+  json["n"] = JsonNumber(report->n);
+  json["sigma_n"] = JsonNumber(report->sigma_n);
+  json["n_closed_form"] = JsonNumber(report->n_closed_form);
+  json["crlb"] = JsonNumber(report->crlb);
+  json["sigma_px"] = JsonNumber(report->sigma_px);
+  json["inliers"] = report->inliers;
+  json["invalid"] = report->invalid;
+  json["correspondences"] = matches.size();
+  json["frames"] = frames.size();
+  json.update(report->extra);
+  json["rig"] = {
+      {"calib", FLAGS_calib},
+      {"left", FLAGS_left_camera},
+      {"right", FLAGS_right_camera},
+      {"baseline_m", rig->Baseline()},
+      {"rotation_deg", Degrees(deviation.rotation)},
+      {"baseline_off_axis_deg", Degrees(deviation.baseline_off_axis)}};
+  if (run) {
+    const double pairs = std::max<double>(1.0, run->frames.size());
+    json["images"] = {
+        {"source", run->source},
+        {"pairs", run->frames.size()},
+        {"features", FLAGS_features},
+        {"clahe", FLAGS_clahe},
+        {"matches_per_pair", matches.size() / pairs},
+        {"reacquired_pairs", run->reacquired},
+        {"pairs_per_second", run->frames.size() / std::max(run->seconds, 1e-9)},
+        {"ms_per_pair",
+         {{"decode", run->read_ms / pairs},
+          {"preprocess", run->stage_ms.preprocess_ms / pairs},
+          {"detect", run->stage_ms.detect_ms / pairs},
+          {"match", run->stage_ms.match_ms / pairs},
+          {"refine", run->stage_ms.refine_ms / pairs},
+          {"own_estimate", run->guide_ms / pairs}}}};
+  } else {
+    json["matches"] = FLAGS_matches;
+  }
+
+  // Files: each written whole or not at all (atomic), the summary last.
+  std::vector<std::string> written;
+  const auto write = [&](const std::string& path, const Status& status) {
+    if (!status.ok()) {
+      PrintError(command, status.message());
+      return false;
+    }
+    written.push_back(path);
+    return true;
+  };
+  if (!FLAGS_per_frame.empty() &&
+      !write(FLAGS_per_frame, WriteFileAtomically(
+                                  FLAGS_per_frame,
+                                  FormatFrameRows(report->rows)))) {
+    return kExitFailure;
+  }
+  if (!FLAGS_out.empty()) {
+    const std::filesystem::path out(FLAGS_out);
+    const std::string per_frame = (out / "per_frame.csv").string();
+    const std::string plot = (out / "n_per_frame.png").string();
+    if (!write(per_frame, WriteFileAtomically(
+                              per_frame, FormatFrameRows(report->rows))) ||
+        !write(plot, WritePng(PlotPerFrame(*report), plot))) {
+      return kExitFailure;
+    }
+    if (run) {
+      const std::string csv = (out / "matches.csv").string();
+      if (!write(csv, WriteCorrespondenceCsv(csv, matches))) {
+        return kExitFailure;
+      }
+      if (!run->picture_left.empty()) {
+        const std::string picture = (out / "matches_by_n.png").string();
+        if (!write(picture,
+                   WritePng(MatchesByIndexPicture(*rig, *run, report->n),
+                            picture))) {
+          return kExitFailure;
+        }
+      }
+    }
+    const std::string summary = (out / "estimate.json").string();
+    if (!write(summary,
+               WriteFileAtomically(summary, json.dump(2) + "\n"))) {
+      return kExitFailure;
+    }
+  }
   if (FLAGS_json) {
-    nlohmann::json out;
-    out["estimator"] = FLAGS_estimator;
-    out["n"] = JsonNumber(report->n);
-    out["sigma_n"] = JsonNumber(report->sigma_n);
-    out["n_closed_form"] = JsonNumber(report->n_closed_form);
-    out["crlb"] = JsonNumber(report->crlb);
-    out["sigma_px"] = JsonNumber(report->sigma_px);
-    out["inliers"] = report->inliers;
-    out["invalid"] = report->invalid;
-    out["correspondences"] = matches->size();
-    out["frames"] = frames.size();
-    out.update(report->extra);
-    out["rig"] = {
-        {"calib", FLAGS_calib},
-        {"left", FLAGS_left},
-        {"right", FLAGS_right},
-        {"baseline_m", rig->Baseline()},
-        {"rotation_deg", Degrees(deviation.rotation)},
-        {"baseline_off_axis_deg", Degrees(deviation.baseline_off_axis)}};
-    out["matches"] = FLAGS_matches;
-    std::cout << out.dump(2) << std::endl;
+    std::cout << json.dump(2) << std::endl;
     return kExitOk;
   }
 
@@ -557,12 +889,33 @@ int RunEstimate() {
       Degrees(std::max(deviation.rotation, deviation.baseline_off_axis));
   std::ostringstream text;
   text << "rcm estimate: " << report->method << "\n"
-       << "  rig        " << FLAGS_calib << " (" << FLAGS_left << " left, "
-       << FLAGS_right << " right), baseline " << FormatFixed(rig->Baseline(), 4)
-       << " m, " << FormatFixed(deviation_deg, 3) << " deg from rectified\n"
-       << "  matches    " << FLAGS_matches << ": " << matches->size()
-       << " correspondences in " << frames.size() << " frame"
-       << (frames.size() == 1 ? "" : "s") << "\n";
+       << "  rig        " << FLAGS_calib << " (" << FLAGS_left_camera
+       << " left, " << FLAGS_right_camera << " right), baseline "
+       << FormatFixed(rig->Baseline(), 4) << " m, "
+       << FormatFixed(deviation_deg, 3) << " deg from rectified\n";
+  if (run) {
+    const double pairs = std::max<double>(1.0, run->frames.size());
+    text << "  images     " << run->source << "\n"
+         << "  front end  " << FLAGS_features << (FLAGS_clahe ? " + CLAHE" : "")
+         << ": " << FormatFixed(matches.size() / pairs, 0)
+         << " matches per pair, "
+         << FormatFixed(run->frames.size() / std::max(run->seconds, 1e-9), 1)
+         << " pairs/s (ms per pair: decode "
+         << FormatFixed(run->read_ms / pairs, 1) << ", detect "
+         << FormatFixed(run->stage_ms.detect_ms / pairs, 1) << ", match "
+         << FormatFixed(run->stage_ms.match_ms / pairs, 1) << ", refine "
+         << FormatFixed(run->stage_ms.refine_ms / pairs, 1) << ", estimate "
+         << FormatFixed(run->guide_ms / pairs, 1) << ")\n";
+    if (run->reacquired > 0) {
+      text << "  re-acquired " << run->reacquired
+           << " pairs whose matches left the band of the estimate (a change "
+              "of medium?)\n";
+    }
+  } else {
+    text << "  matches    " << FLAGS_matches << ": " << matches.size()
+         << " correspondences in " << frames.size() << " frame"
+         << (frames.size() == 1 ? "" : "s") << "\n";
+  }
   if (FLAGS_estimator != "closed-form") {
     text << "  inliers    " << report->inliers
          << (FLAGS_estimator == "window" ? " in the window" : "") << " ("
@@ -579,8 +932,10 @@ int RunEstimate() {
          << "  pixel noise " << FormatFixed(report->sigma_px, 3)
          << " px (estimated from the inliers)\n";
   }
-  if (!FLAGS_per_frame.empty()) {
-    text << "  per frame  " << FLAGS_per_frame << "\n";
+  if (!written.empty()) {
+    text << "  wrote     ";
+    for (const std::string& path : written) text << " " << path;
+    text << "\n";
   }
   std::cout << text.str() << std::flush;
   return kExitOk;

@@ -6,8 +6,8 @@
 #include <gflags/gflags.h>
 
 DECLARE_string(calib);
-DECLARE_string(left);
-DECLARE_string(right);
+DECLARE_string(left_camera);
+DECLARE_string(right_camera);
 
 namespace rcm::cli {
 

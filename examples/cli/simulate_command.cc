@@ -17,7 +17,6 @@
 #include "rig_flags.h"
 #include "simulation_flags.h"
 
-DECLARE_bool(json);
 
 DEFINE_int32(matches_per_frame, 0,
              "also write matches.csv with this many exact correspondences "
@@ -82,7 +81,7 @@ int RunSimulate() {
     return kExitUsage;
   }
   StatusOr<Simulation> simulation =
-      SimulationFromFlags(FLAGS_calib, FLAGS_left, FLAGS_right);
+      SimulationFromFlags(FLAGS_calib, FLAGS_left_camera, FLAGS_right_camera);
   if (!simulation.ok()) {
     PrintError(command, simulation.status().message());
     return kExitFailure;

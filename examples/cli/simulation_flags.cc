@@ -30,9 +30,6 @@ DEFINE_double(image_noise, 1.5,
 DEFINE_int32(supersampling, 2,
              "rays per pixel along each axis (anti-aliasing), 1-4");
 DEFINE_uint64(seed, 1, "random seed; the outputs depend only on the flags");
-DEFINE_string(out, "",
-              "output folder (rcm simulate: required; rcm demo: default "
-              "./rcm_demo)");
 
 namespace rcm::cli {
 

@@ -23,7 +23,6 @@ DECLARE_double(port_tilt);
 DECLARE_double(image_noise);
 DECLARE_int32(supersampling);
 DECLARE_uint64(seed);
-DECLARE_string(out);
 
 namespace rcm::cli {
 

@@ -279,9 +279,15 @@ TEST(EstimateCli, MissingCalibFlag) {
                          "--calib is required");
 }
 
-TEST(EstimateCli, MissingMatchesFlag) {
+TEST(EstimateCli, MissingInput) {
   ExpectFailsWithOneLine(Rcm({"estimate", "--calib", kRig}), 2,
-                         "--matches is required");
+                         "no input: give --left DIR --right DIR");
+}
+
+TEST(EstimateCli, MatchesAndImagesTogether) {
+  ExpectFailsWithOneLine(Rcm({"estimate", "--calib", kRig, "--matches",
+                              kDemoMatches, "--left", "l", "--right", "r"}),
+                         2, "give either --matches or images, not both");
 }
 
 TEST(EstimateCli, UnknownFlag) {

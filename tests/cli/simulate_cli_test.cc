@@ -121,14 +121,14 @@ TEST(SimulateCli, DepthRangeMatchesWithoutImages) {
 }
 
 TEST(SimulateCli, UsesTheCamerasOfAGivenRigFile) {
-  // --left cam1 --right cam0 swaps the pair: the written camchain's cam0 is
+  // --left-camera cam1 --right-camera cam0 swaps the pair: the written camchain's cam0 is
   // the file's cam1 (fx 344.39...).
   const std::string folder = Folder("swapped");
   const RunResult result = Rcm(
       {"simulate", "--out", folder, "--calib",
        std::string(RCM_SOURCE_DIR) +
            "/examples/data/alphasense_front_rectified.yaml",
-       "--left", "cam1", "--right", "cam0", "--noimages",
+       "--left-camera", "cam1", "--right-camera", "cam0", "--noimages",
        "--matches-per-frame", "20", "--frames", "1"});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const std::string camchain = test::ReadWholeFile(folder + "/camchain.yaml");
