@@ -21,7 +21,7 @@
 #include "rcm/estimation/prepared_correspondence.h"
 #include "rcm/estimation/robust_locus_fit.h"
 #include "rcm/estimation/sliding_window_estimator.h"
-#include "rcm/frontend/sift_matcher.h"
+#include "rcm/frontend/stereo_front_end.h"
 #include "rcm/geometry/epipolar.h"
 #include "rcm/geometry/stereo_rectification.h"
 #include "rcm/io/atomic_file.h"
@@ -42,8 +42,8 @@ constexpr char kUsage[] =
     "usage: rcm demo [--out DIR] [--frames 20] [--n 1.333] [--seed 1]\n\n"
     "Simulates a short sequence of the paper's dataset rig (Alphasense, "
     "720x540,\nequidistant lenses, calibrated in air) moving through a pool "
-    "behind flat\nports, detects and matches SIFT features in each stereo "
-    "pair, estimates the\nrefractive index n of the water from the matches "
+    "behind flat\nports, matches features in each stereo pair along the "
+    "refractive epipolar\nloci (the front end of rcm estimate), estimates the\nrefractive index n of the water from the matches "
     "alone (per frame, over a\nsliding window, and over all frames), and "
     "writes into ./rcm_demo/ (or --out):\n"
     "  n_per_frame.png   n per frame with its 1-sigma band, against the "
@@ -267,7 +267,9 @@ int RunDemo() {
       SlidingWindowRefractiveIndexEstimator::Create(rig, RefinementOptions(),
                                                     SlidingWindowOptions());
   CHECK(window.ok()) << window.status().message();
-  SiftMatcherOptions matcher;
+  StatusOr<StereoFrontEnd> front_end =
+      StereoFrontEnd::Create(rig, StereoFrontEndOptions());
+  CHECK(front_end.ok()) << front_end.status().message();
   std::vector<FrameResult> results;
   std::vector<StereoCorrespondence> since_switch;  // matches of this medium
   int first_frame_of_medium = 0;
@@ -287,13 +289,22 @@ int RunDemo() {
     }
     render_seconds += SecondsSince(tick);
     tick = Clock::now();
-    StatusOr<std::vector<StereoCorrespondence>> matches = MatchStereoPair(
-        frame.value().left, frame.value().right, matcher, i, frame.value().t);
-    if (!matches.ok()) {
+    // Guided by the window's estimate once there is one (the front end
+    // re-acquires with its prior range when the medium changes).
+    std::optional<RefractiveIndexInterval> guide;
+    if (const auto current = window.value().Current(); current.ok()) {
+      guide = RefractiveIndexInterval::Around(current->n, current->sigma_n,
+                                              6.0, 0.01);
+    }
+    StatusOr<StereoMatches> matched = front_end->Match(
+        frame.value().left, frame.value().right, i, frame.value().t, guide);
+    if (!matched.ok()) {
       PrintError(command, "frame " + std::to_string(i) + ": " +
-                              matches.status().message());
+                              matched.status().message());
       return kExitFailure;
     }
+    const std::optional<std::vector<StereoCorrespondence>> matches =
+        std::move(matched->matches);
     match_seconds += SecondsSince(tick);
     tick = Clock::now();
     const SlidingWindowRefractiveIndexEstimator::WindowUpdate update =
@@ -571,7 +582,7 @@ int RunDemo() {
             << "  " << json_path << "     the numbers; per frame in "
             << csv_path << "\n"
             << "done in " << FormatFixed(seconds, 1) << " s (render "
-            << FormatFixed(render_seconds, 1) << " s, SIFT "
+            << FormatFixed(render_seconds, 1) << " s, matching "
             << FormatFixed(match_seconds, 1) << " s, estimation "
             << FormatFixed(estimate_seconds, 1) << " s)" << std::endl;
   return kExitOk;
