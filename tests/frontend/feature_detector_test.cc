@@ -10,8 +10,8 @@
 namespace rcm {
 namespace {
 
-// Random blobs of random gray levels on gray, slightly blurred (as in
-// sift_matcher_test.cc): corners and blobs for every detector.
+// Random blobs of random gray levels on gray, slightly blurred: corners
+// and blobs for every detector.
 cv::Mat Blobs(int width, int height, int count, uint64_t seed) {
   cv::RNG rng(seed);
   cv::Mat image(height, width, CV_8UC1, cv::Scalar(128));

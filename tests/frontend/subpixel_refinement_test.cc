@@ -12,8 +12,8 @@
 namespace rcm {
 namespace {
 
-// Random blobs of random gray levels on gray, slightly blurred (as in
-// sift_matcher_test.cc): texture everywhere, none alike. Drawn `scale`
+// Random blobs of random gray levels on gray, slightly blurred: texture
+// everywhere, none alike. Drawn `scale`
 // times larger (blob sizes, positions and blur scaled with it).
 cv::Mat Blobs(int width, int height, int count, uint64_t seed, int scale = 1) {
   cv::RNG rng(seed);
