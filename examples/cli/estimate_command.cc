@@ -96,8 +96,9 @@ namespace rcm::cli {
 namespace {
 
 constexpr char kUsage[] =
-    "rcm estimate: the refractive index n of the medium from stereo\n"
-    "correspondences of a rig calibrated in air.\n\n"
+    "rcm estimate: the refractive index n of the medium from the stereo\n"
+    "images (folders or a ROS1 bag) or correspondences of a rig calibrated\n"
+    "in air.\n\n"
     "usage: rcm estimate --calib RIG.yaml --left DIR --right DIR [--out DIR]\n"
     "       rcm estimate --calib RIG.yaml --bag BAG --left-topic T0 "
     "--right-topic T1\n"
@@ -652,7 +653,7 @@ int RunEstimate();
 
 extern const Subcommand kEstimateCommand = {
     "estimate",
-    "refractive index n from stereo correspondences",
+    "refractive index n from stereo images or correspondences",
     kUsage,
     {__FILE__, kRigFlagsSource, kImageInputFlagsSource},
     RunEstimate};
