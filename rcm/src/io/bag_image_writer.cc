@@ -80,6 +80,21 @@ struct BagImageWriter::Impl {
     return Status::Ok();
   }
 
+  // The checks every message passes before it is encoded: a writable bag,
+  // a topic, a stamp ROS can hold, an image. Returns the stamp.
+  StatusOr<ros::Time> CheckMessage(const std::string& topic, double stamp_s,
+                                   const cv::Mat& image) const {
+    RCM_RETURN_IF_ERROR(CheckWritable());
+    if (topic.empty()) return Status::Error(path + ": an image needs a topic");
+    const StatusOr<ros::Time> time = ToRosTime(stamp_s);
+    if (!time.ok()) return time.status().WithContext(path + ": " + topic);
+    if (image.empty()) {
+      return Status::Error(path + ": " + topic +
+                           ": cannot write an empty image");
+    }
+    return *time;
+  }
+
   template <typename Message>
   Status Write(const std::string& topic, const ros::Time& time,
                const Message& message) {
@@ -139,14 +154,9 @@ Status BagImageWriter::WriteImage(const std::string& topic, double stamp_s,
                                   const std::string& encoding,
                                   const std::string& frame_id) {
   CHECK(impl_ != nullptr) << "BagImageWriter used after a move";
-  RCM_RETURN_IF_ERROR(impl_->CheckWritable());
   const std::string& path = impl_->path;
-  if (topic.empty()) return Status::Error(path + ": an image needs a topic");
-  const StatusOr<ros::Time> time = ToRosTime(stamp_s);
-  if (!time.ok()) return time.status().WithContext(path + ": " + topic);
-  if (image.empty()) {
-    return Status::Error(path + ": " + topic + ": cannot write an empty image");
-  }
+  const StatusOr<ros::Time> time = impl_->CheckMessage(topic, stamp_s, image);
+  RCM_RETURN_IF_ERROR(time.status());
   int type;
   if (encoding == "mono8") {
     type = CV_8UC1;
@@ -187,14 +197,9 @@ Status BagImageWriter::WriteCompressed(const std::string& topic,
                                        const std::string& format,
                                        const std::string& frame_id) {
   CHECK(impl_ != nullptr) << "BagImageWriter used after a move";
-  RCM_RETURN_IF_ERROR(impl_->CheckWritable());
   const std::string& path = impl_->path;
-  if (topic.empty()) return Status::Error(path + ": an image needs a topic");
-  const StatusOr<ros::Time> time = ToRosTime(stamp_s);
-  if (!time.ok()) return time.status().WithContext(path + ": " + topic);
-  if (image.empty()) {
-    return Status::Error(path + ": " + topic + ": cannot write an empty image");
-  }
+  const StatusOr<ros::Time> time = impl_->CheckMessage(topic, stamp_s, image);
+  RCM_RETURN_IF_ERROR(time.status());
   std::string extension;
   std::vector<int> parameters;
   if (format == "png") {

@@ -30,7 +30,9 @@ Status WritePng(const cv::Mat& image, const std::string& path) {
   return WriteFileAtomically(path, std::string(encoded.begin(), encoded.end()));
 }
 
-StatusOr<cv::Mat> ReadImage(const std::string& path, bool grayscale) {
+namespace {
+
+StatusOr<cv::Mat> DecodeFile(const std::string& path, int flags) {
   StatusOr<std::string> contents = ReadFileToString(path);
   if (!contents.ok()) return contents.status();
   const std::string& bytes = *contents;
@@ -39,8 +41,7 @@ StatusOr<cv::Mat> ReadImage(const std::string& path, bool grayscale) {
     try {
       const cv::Mat buffer(1, static_cast<int>(bytes.size()), CV_8UC1,
                            const_cast<char*>(bytes.data()));
-      image = cv::imdecode(buffer,
-                           grayscale ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR);
+      image = cv::imdecode(buffer, flags);
     } catch (const cv::Exception&) {
       image = cv::Mat();
     }
@@ -51,6 +52,17 @@ StatusOr<cv::Mat> ReadImage(const std::string& path, bool grayscale) {
         ": not an image OpenCV can decode (corrupt or unsupported format)");
   }
   return image;
+}
+
+}  // namespace
+
+StatusOr<cv::Mat> ReadImage(const std::string& path, bool grayscale) {
+  return DecodeFile(path,
+                    grayscale ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR);
+}
+
+StatusOr<cv::Mat> ReadImageAsStored(const std::string& path) {
+  return DecodeFile(path, cv::IMREAD_UNCHANGED);
 }
 
 }  // namespace rcm

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "rcm/io/atomic_file.h"
+#include "rcm/io/image_file.h"
 #include "rcm/io/number_format.h"
 #include "rcm/util/message_text.h"
 
@@ -492,24 +493,9 @@ std::string DepthText(int depth) {
 
 // Decodes one file as stored: 8-bit gray or BGR (BGRA loses alpha).
 StatusOr<cv::Mat> DecodeImage(const std::string& path) {
-  StatusOr<std::string> contents = ReadFileToString(path);
-  if (!contents.ok()) return contents.status();
-  const std::string& bytes = *contents;
-  cv::Mat image;
-  if (!bytes.empty()) {
-    try {
-      const cv::Mat buffer(1, static_cast<int>(bytes.size()), CV_8UC1,
-                           const_cast<char*>(bytes.data()));
-      image = cv::imdecode(buffer, cv::IMREAD_UNCHANGED);
-    } catch (const cv::Exception&) {
-      image = cv::Mat();
-    }
-  }
-  if (image.empty()) {
-    return Status::Error(
-        path +
-        ": not an image OpenCV can decode (corrupt or unsupported format)");
-  }
+  StatusOr<cv::Mat> decoded = ReadImageAsStored(path);
+  if (!decoded.ok()) return decoded.status();
+  const cv::Mat& image = *decoded;
   if (image.depth() != CV_8U) {
     return Status::Error(path + ": " + DepthText(image.depth()) +
                          " image, expected 8-bit");

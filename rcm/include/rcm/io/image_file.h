@@ -24,6 +24,10 @@ Status WritePng(const cv::Mat& image, const std::string& path);
 // image OpenCV can decode (corrupt or unsupported format)".
 StatusOr<cv::Mat> ReadImage(const std::string& path, bool grayscale);
 
+// The same, with the depth and channels as stored (cv::IMREAD_UNCHANGED):
+// a 16-bit PNG stays 16-bit, an RGBA one BGRA. Same errors.
+StatusOr<cv::Mat> ReadImageAsStored(const std::string& path);
+
 }  // namespace rcm
 
 #endif  // RCM_IO_IMAGE_FILE_H_
