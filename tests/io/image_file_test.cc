@@ -80,6 +80,32 @@ TEST(ImageFile, WriteRejectsImagesPngCannotHold) {
   EXPECT_FALSE(std::filesystem::exists(path));
 }
 
+TEST(ImageFile, ReadAsStoredKeepsDepthAndChannels) {
+  // ReadImage converts to 8-bit gray or BGR; ReadImageAsStored does not.
+  cv::Mat deep(6, 8, CV_16UC1);
+  cv::randu(deep, 0, 65535);
+  const std::string deep_path = test::TempFilePath("deep.png");
+  ASSERT_TRUE(WritePng(deep, deep_path).ok());
+  const StatusOr<cv::Mat> stored = ReadImageAsStored(deep_path);
+  ASSERT_TRUE(stored.ok()) << stored.status().message();
+  EXPECT_EQ(stored->type(), CV_16UC1);
+  EXPECT_EQ(cv::norm(*stored, deep, cv::NORM_INF), 0.0);
+  EXPECT_EQ(ReadImage(deep_path, true)->type(), CV_8UC1);
+
+  cv::Mat bgra(6, 8, CV_8UC4);
+  cv::randu(bgra, 0, 255);
+  const std::string bgra_path = test::TempFilePath("bgra.png");
+  ASSERT_TRUE(WritePng(bgra, bgra_path).ok());
+  EXPECT_EQ(ReadImageAsStored(bgra_path)->type(), CV_8UC4);
+  EXPECT_EQ(ReadImage(bgra_path, false)->type(), CV_8UC3);
+
+  const std::string text = test::WriteTempFile("text.png", "not an image\n");
+  EXPECT_EQ(ReadImageAsStored(text).status().message(),
+            text +
+                ": not an image OpenCV can decode (corrupt or unsupported "
+                "format)");
+}
+
 TEST(ImageFile, ReadMissingFile) {
   const std::string path = test::TempFilePath("missing.png");
   const StatusOr<cv::Mat> read = ReadImage(path, true);
