@@ -303,19 +303,18 @@ int RunDemo() {
                               matched.status().message());
       return kExitFailure;
     }
-    const std::optional<std::vector<StereoCorrespondence>> matches =
-        std::move(matched->matches);
+    const std::vector<StereoCorrespondence>& matches = matched->matches;
     match_seconds += SecondsSince(tick);
     tick = Clock::now();
     const SlidingWindowRefractiveIndexEstimator::WindowUpdate update =
-        window.value().AddFrame(i, matches.value());
+        window.value().AddFrame(i, matches);
     estimate_seconds += SecondsSince(tick);
 
     FrameResult result;
     result.frame = i;
     result.t = frame.value().t;
     result.n_true = frame.value().n;
-    result.matches = static_cast<int64_t>(matches.value().size());
+    result.matches = static_cast<int64_t>(matches.size());
     if (update.frame_estimate.ok()) {
       result.n_frame = update.frame_estimate.value().n;
       result.sigma_frame = update.frame_estimate.value().sigma_n;
@@ -338,12 +337,12 @@ int RunDemo() {
                          }),
           since_switch.end());
     }
-    since_switch.insert(since_switch.end(), matches.value().begin(),
-                        matches.value().end());
+    since_switch.insert(since_switch.end(), matches.begin(),
+                        matches.end());
     if (i == 0) {
       first_left = frame.value().left;
       first_right = frame.value().right;
-      first_matches = matches.value();
+      first_matches = matches;
     }
     results.push_back(result);
     std::cerr << "rcm demo: [" << (i + 1) << "/" << num_frames << "] "

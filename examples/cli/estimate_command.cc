@@ -199,7 +199,6 @@ struct Report {
 struct ImageRun {
   std::string source;  // the source's Describe()
   std::vector<Frame> frames;
-  std::vector<StereoCorrespondence> matches;  // all frames, in order
   std::vector<FrameRow> own_rows;             // each pair's own estimate
   FrontEndTimings stage_ms;                   // sums over the pairs
   double read_ms = 0.0;                       // decoding, summed
@@ -280,9 +279,8 @@ StatusOr<ImageRun> RunFrontEnd(const StereoRig& rig,
       run.picture_frame = pair->frame;
       run.picture_matches = matched->matches;
     }
-    run.frames.push_back({pair->frame, pair->timestamp, matched->matches});
-    run.matches.insert(run.matches.end(), matched->matches.begin(),
-                       matched->matches.end());
+    run.frames.push_back(
+        {pair->frame, pair->timestamp, std::move(matched->matches)});
     progress.Update(i + 1, status);
   }
   run.seconds = Milliseconds(start) / 1000.0;
@@ -759,8 +757,11 @@ int RunEstimate() {
       return kExitFailure;
     }
     run = std::move(*pass);
-    matches = run->matches;
-    frames = run->frames;
+    frames = std::move(run->frames);
+    for (const Frame& frame : frames) {
+      matches.insert(matches.end(), frame.matches.begin(),
+                     frame.matches.end());
+    }
   } else {
     StatusOr<std::vector<StereoCorrespondence>> read =
         ReadCorrespondenceCsv(FLAGS_matches);
@@ -816,15 +817,15 @@ int RunEstimate() {
       {"rotation_deg", Degrees(deviation.rotation)},
       {"baseline_off_axis_deg", Degrees(deviation.baseline_off_axis)}};
   if (run) {
-    const double pairs = std::max<double>(1.0, run->frames.size());
+    const double pairs = std::max<double>(1.0, frames.size());
     json["images"] = {
         {"source", run->source},
-        {"pairs", run->frames.size()},
+        {"pairs", frames.size()},
         {"features", FLAGS_features},
         {"clahe", FLAGS_clahe},
         {"matches_per_pair", matches.size() / pairs},
         {"reacquired_pairs", run->reacquired},
-        {"pairs_per_second", run->frames.size() / std::max(run->seconds, 1e-9)},
+        {"pairs_per_second", frames.size() / std::max(run->seconds, 1e-9)},
         {"ms_per_pair",
          {{"decode", run->read_ms / pairs},
           {"preprocess", run->stage_ms.preprocess_ms / pairs},
@@ -895,12 +896,12 @@ int RunEstimate() {
        << FormatFixed(rig->Baseline(), 4) << " m, "
        << FormatFixed(deviation_deg, 3) << " deg from rectified\n";
   if (run) {
-    const double pairs = std::max<double>(1.0, run->frames.size());
+    const double pairs = std::max<double>(1.0, frames.size());
     text << "  images     " << run->source << "\n"
          << "  front end  " << FLAGS_features << (FLAGS_clahe ? " + CLAHE" : "")
          << ": " << FormatFixed(matches.size() / pairs, 0)
          << " matches per pair, "
-         << FormatFixed(run->frames.size() / std::max(run->seconds, 1e-9), 1)
+         << FormatFixed(frames.size() / std::max(run->seconds, 1e-9), 1)
          << " pairs/s (ms per pair: decode "
          << FormatFixed(run->read_ms / pairs, 1) << ", detect "
          << FormatFixed(run->stage_ms.detect_ms / pairs, 1) << ", match "

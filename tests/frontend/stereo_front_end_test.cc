@@ -259,10 +259,10 @@ TEST(StereoFrontEnd, ReacquiresWhenTheMediumChanges) {
   // With re-acquisition off the air frame stays in the water band with
   // fewer matches.
   options.reacquire_fraction = 0.0;
-  StereoFrontEnd stubborn = StereoFrontEnd::Create(rig, options).value();
-  ASSERT_TRUE(stubborn.Match(frames.water[0].left, frames.water[0].right).ok());
+  StereoFrontEnd without_reacquisition = StereoFrontEnd::Create(rig, options).value();
+  ASSERT_TRUE(without_reacquisition.Match(frames.water[0].left, frames.water[0].right).ok());
   const StereoMatches stuck =
-      stubborn.Match(frames.air.left, frames.air.right, 2, frames.air.t, water)
+      without_reacquisition.Match(frames.air.left, frames.air.right, 2, frames.air.t, water)
           .value();
   EXPECT_FALSE(stuck.reacquired);
   EXPECT_EQ(stuck.band.min, water.min);

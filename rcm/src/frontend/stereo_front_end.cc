@@ -36,9 +36,10 @@ ImageFeatures DetectImage(const cv::Mat& image, const ClaheOptions& clahe,
   return out;
 }
 
-// Stage 3 and the band keys for one interval.
+// Stage 3 in the band of one interval, with what verification reuses.
 struct BandMatches {
-  RefractiveIndexInterval interval;
+  LocusBand band;
+  std::vector<LocusKey> left_keys;
   std::vector<KeypointMatch> matches;
 };
 
@@ -110,44 +111,38 @@ StatusOr<StereoMatches> StereoFrontEnd::Match(
   // Stage 3 in a band; the band's keys are cheap (one undistortion per
   // keypoint) next to detection.
   const Clock::time_point match_start = Clock::now();
-  const auto match_in = [&](const RefractiveIndexInterval& interval,
-                            LocusBand* band_out) -> StatusOr<BandMatches> {
+  const auto match_in =
+      [&](const RefractiveIndexInterval& interval) -> StatusOr<BandMatches> {
     StatusOr<LocusBand> band = LocusBand::Create(rig_, interval, options_.band);
     RCM_RETURN_IF_ERROR(band.status());
-    const std::vector<LocusKey> left_keys =
+    std::vector<LocusKey> left_keys =
         band->LeftKeys(sides[0].features.keypoints);
     const std::vector<LocusKey> right_keys =
         band->RightKeys(sides[1].features.keypoints);
-    BandMatches out{interval,
-                    MatchInLocusBand(sides[0].features, left_keys,
-                                     sides[1].features, right_keys, *band,
-                                     options_.matching)};
-    *band_out = std::move(*band);
-    return out;
+    std::vector<KeypointMatch> matches =
+        MatchInLocusBand(sides[0].features, left_keys, sides[1].features,
+                         right_keys, *band, options_.matching);
+    return BandMatches{std::move(*band), std::move(left_keys),
+                       std::move(matches)};
   };
-  const RefractiveIndexInterval first_interval =
-      guide ? *guide : options_.search_range;
-  StatusOr<LocusBand> band =
-      LocusBand::Create(rig_, first_interval, options_.band);
-  RCM_RETURN_IF_ERROR(band.status());
-  StatusOr<BandMatches> matched = match_in(first_interval, &*band);
+  StatusOr<BandMatches> matched =
+      match_in(guide ? *guide : options_.search_range);
   RCM_RETURN_IF_ERROR(matched.status());
   if (!guide) {
     prior_band_matches_ = static_cast<int>(matched->matches.size());
   } else if (prior_band_matches_ > 0 &&
              matched->matches.size() <
                  options_.reacquire_fraction * prior_band_matches_) {
-    LocusBand prior_band = *band;
-    StatusOr<BandMatches> prior = match_in(options_.search_range, &prior_band);
+    StatusOr<BandMatches> prior = match_in(options_.search_range);
     RCM_RETURN_IF_ERROR(prior.status());
     if (prior->matches.size() > matched->matches.size()) {
       prior_band_matches_ = static_cast<int>(prior->matches.size());
       matched = std::move(prior);
-      *band = std::move(prior_band);
       result.reacquired = true;
     }
   }
-  result.band = matched->interval;
+  const LocusBand& band = matched->band;
+  result.band = band.interval();
   result.descriptor_matches = static_cast<int>(matched->matches.size());
   result.timings.match_ms = MillisecondsSince(match_start);
 
@@ -174,8 +169,10 @@ StatusOr<StereoMatches> StereoFrontEnd::Match(
         Eigen::Vector2d(left_points[i].x, left_points[i].y);
     correspondence.right_pixel =
         Eigen::Vector2d(right_points[i].x, right_points[i].y);
-    if (!band->Contains(band->LeftKey(correspondence.left_pixel),
-                        band->RightKey(correspondence.right_pixel))) {
+    // The left pixel is the keypoint's: its key is the one matched with.
+    const LocusKey& left_key =
+        matched->left_keys[matched->matches[i].left];
+    if (!band.Contains(left_key, band.RightKey(correspondence.right_pixel))) {
       continue;
     }
     result.matches.push_back(correspondence);

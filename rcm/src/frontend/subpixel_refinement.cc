@@ -103,7 +103,9 @@ bool RefineOne(const LeftImage& left_image, const cv::Mat& right,
   }
   double template_mean = 0.0;
   double template_deviation = 0.0;
-  MeanAndDeviation(buffers->patch, &template_mean, &template_deviation);
+  if (options.normalize_exposure) {
+    MeanAndDeviation(buffers->patch, &template_mean, &template_deviation);
+  }
   // Texture: the weaker eigenvalue of the translation block (Shi-Tomasi),
   // per pixel of the window.
   const Eigen::Matrix2d translation_block =
@@ -137,21 +139,23 @@ bool RefineOne(const LeftImage& left_image, const cv::Mat& right,
             static_cast<float>(warp(1, 0) * u + warp(1, 1) * v + warp(1, 2)));
       }
     }
-    double mean = 0.0;
-    double deviation = 0.0;
+    // Exposure: error = gain * warped + offset - template, the identity
+    // unless normalize_exposure matches mean and contrast.
     double gain = 1.0;
+    double offset = 0.0;
     if (options.normalize_exposure) {
+      double mean = 0.0;
+      double deviation = 0.0;
       MeanAndDeviation(buffers->warped, &mean, &deviation);
       if (!(deviation > 0.0)) return false;
       gain = template_deviation / deviation;
-    } else {
-      mean = template_mean;
+      offset = template_mean - gain * mean;
     }
     Vector6 gradient = Vector6::Zero();
     for (int v = -half, k = 0; v <= half; ++v) {
       for (int u = -half; u <= half; ++u, ++k) {
-        const double error = (buffers->warped[k] - mean) * gain +
-                             template_mean - buffers->patch[k];
+        const double error =
+            gain * buffers->warped[k] + offset - buffers->patch[k];
         const double ex = buffers->dx[k] * error;
         const double ey = buffers->dy[k] * error;
         gradient[0] += ex;
