@@ -15,6 +15,8 @@ packages=(
   libyaml-cpp-dev      # Kalibr camchain / ROS camera_info YAML
   nlohmann-json3-dev   # --json output
   libopencv-dev        # images: PNG/JPEG I/O, remap, drawing plots, SIFT
+  libopencv-contrib-dev  # aruco: AprilTag 36h11 and ChArUco targets
+  opencv-doc           # the real stereo chessboard images a calibration test uses
   libgtest-dev libgmock-dev  # tests
   libbenchmark-dev     # benchmarks
   librosbag-storage-dev libsensor-msgs-dev  # ROS1 bags: rcm estimate/undistort --bag
