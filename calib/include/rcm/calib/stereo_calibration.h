@@ -12,9 +12,11 @@
 // with pi the lens projection of lens_models.h. The cost is
 // sum rho(|e|^2) with Huber's rho at `huber_px`, followed by rounds that
 // drop corners whose residual exceeds `outlier_sigmas` robust standard
-// deviations (1.4826 MAD of |e|, floored at `min_outlier_threshold_px`)
-// and re-solve. The last solve is plain least squares over the inliers,
-// so that the covariance below is that of the least-squares estimate.
+// deviations and re-solve. The robust sigma is median|e| / sqrt(2 ln 2):
+// |e| of a 2-D residual with N(0, sigma^2) components is Rayleigh
+// distributed, with median sigma sqrt(2 ln 2). The threshold is floored at
+// `min_outlier_threshold_px`. The last solve is plain least squares over the
+// inliers, so that the covariance below is that of the least-squares estimate.
 //
 // Initialization (OpenCV closed forms): per camera, cv::calibrateCamera
 // (Zhang's homography method + LM) with k3 fixed to 0 for radtan; for
@@ -82,6 +84,8 @@ struct StereoCalibrationOptions {
 
 // One camera's calibration and its uncertainty.
 struct CameraCalibration {
+  explicit CameraCalibration(const Camera& camera) : camera(camera) {}
+
   Camera camera;
   // Covariance of camera.params() ([fx, fy, cx, cy, d0..d3]; the first
   // camera.num_params() rows/cols are used) and their standard deviations.
@@ -100,6 +104,9 @@ struct CornerResidual {
 };
 
 struct StereoCalibration {
+  StereoCalibration(const Camera& cam0, const Camera& cam1)
+      : cam0(cam0), cam1(cam1) {}
+
   CameraCalibration cam0;
   CameraCalibration cam1;
   Rigid3d cam1_from_cam0;

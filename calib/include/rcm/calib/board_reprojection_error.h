@@ -1,0 +1,124 @@
+// Reprojection errors of planar-target corners, the residuals of the
+// stereo bundle adjustment (stereo_calibration.h). Written as Ceres'
+// examples/snavely_reprojection_error.h: const measurement members, a
+// templated operator(), a static Create().
+//
+// Parameter blocks (raw arrays):
+//   lens            [fx, fy, cx, cy, d0, d1, d2, d3]   (lens_models.h order,
+//                                                      LensModel::kNumParams)
+//   cam0_from_target [w0, w1, w2, t0, t1, t2]          rotation vector
+//                                                      (angle-axis, rad) and
+//                                                      translation (m)
+//   cam1_from_cam0   [w0, w1, w2, t0, t1, t2]          the same convention
+//
+// Residuals (pixels), for a corner X (target frame, z = 0) seen at u:
+//   cam0:  e = pi(lens, R(w_v) X + t_v) - u
+//   cam1:  e = pi(lens, R(w_10) (R(w_v) X + t_v) + t_10) - u
+// with pi(lens, P) = LensModel::ImgFromCam(lens, P_x / P_z, P_y / P_z).
+// A point at or behind the camera plane (P_z <= 1e-9 m) makes the residual
+// undefined: operator() returns false and Ceres rejects the step.
+#ifndef RCM_CALIB_BOARD_REPROJECTION_ERROR_H_
+#define RCM_CALIB_BOARD_REPROJECTION_ERROR_H_
+
+#include <ceres/autodiff_cost_function.h>
+#include <ceres/rotation.h>
+
+#include <Eigen/Core>
+
+namespace rcm::calib {
+
+// Depth [m] below which a point counts as behind the camera.
+inline constexpr double kMinBoardPointDepth = 1e-9;
+
+namespace board_internal {
+
+// pi(lens, P) for a point in the camera frame; false behind the camera.
+template <typename LensModel, typename T>
+bool ProjectCameraPoint(const T* lens, const T point[3], T* residuals,
+                        const Eigen::Vector2d& pixel) {
+  if (!(point[2] > T(kMinBoardPointDepth))) return false;
+  const T x = point[0] / point[2];
+  const T y = point[1] / point[2];
+  T u;
+  T v;
+  LensModel::ImgFromCam(lens, x, y, &u, &v);
+  residuals[0] = u - T(pixel.x());
+  residuals[1] = v - T(pixel.y());
+  return true;
+}
+
+// R(w) X + t for a pose block [w, t].
+template <typename T>
+void TransformPoint(const T* pose, const T point[3], T out[3]) {
+  ceres::AngleAxisRotatePoint(pose, point, out);
+  out[0] += pose[3];
+  out[1] += pose[4];
+  out[2] += pose[5];
+}
+
+}  // namespace board_internal
+
+// A corner seen by cam0: blocks (lens, cam0_from_target).
+template <typename LensModel>
+struct Cam0BoardReprojectionError {
+  Cam0BoardReprojectionError(const Eigen::Vector3d& point_in_target,
+                             const Eigen::Vector2d& pixel)
+      : point_in_target(point_in_target), pixel(pixel) {}
+
+  template <typename T>
+  bool operator()(const T* lens, const T* cam0_from_target,
+                  T* residuals) const {
+    const T point[3] = {T(point_in_target.x()), T(point_in_target.y()),
+                        T(point_in_target.z())};
+    T point_in_cam0[3];
+    board_internal::TransformPoint(cam0_from_target, point, point_in_cam0);
+    return board_internal::ProjectCameraPoint<LensModel>(lens, point_in_cam0,
+                                                         residuals, pixel);
+  }
+
+  static ceres::CostFunction* Create(const Eigen::Vector3d& point_in_target,
+                                     const Eigen::Vector2d& pixel) {
+    return new ceres::AutoDiffCostFunction<Cam0BoardReprojectionError, 2,
+                                           LensModel::kNumParams, 6>(
+        new Cam0BoardReprojectionError(point_in_target, pixel));
+  }
+
+  const Eigen::Vector3d point_in_target;
+  const Eigen::Vector2d pixel;
+};
+
+// A corner seen by cam1: blocks (lens, cam0_from_target, cam1_from_cam0).
+template <typename LensModel>
+struct Cam1BoardReprojectionError {
+  Cam1BoardReprojectionError(const Eigen::Vector3d& point_in_target,
+                             const Eigen::Vector2d& pixel)
+      : point_in_target(point_in_target), pixel(pixel) {}
+
+  template <typename T>
+  bool operator()(const T* lens, const T* cam0_from_target,
+                  const T* cam1_from_cam0, T* residuals) const {
+    const T point[3] = {T(point_in_target.x()), T(point_in_target.y()),
+                        T(point_in_target.z())};
+    T point_in_cam0[3];
+    board_internal::TransformPoint(cam0_from_target, point, point_in_cam0);
+    T point_in_cam1[3];
+    board_internal::TransformPoint(cam1_from_cam0, point_in_cam0,
+                                   point_in_cam1);
+    return board_internal::ProjectCameraPoint<LensModel>(lens, point_in_cam1,
+                                                         residuals, pixel);
+  }
+
+  static ceres::CostFunction* Create(const Eigen::Vector3d& point_in_target,
+                                     const Eigen::Vector2d& pixel) {
+    return new ceres::AutoDiffCostFunction<Cam1BoardReprojectionError, 2,
+                                           LensModel::kNumParams, 6, 6>(
+        new Cam1BoardReprojectionError(point_in_target, pixel));
+  }
+
+  const Eigen::Vector3d point_in_target;
+  const Eigen::Vector2d pixel;
+};
+
+}  // namespace rcm::calib
+
+#endif  // RCM_CALIB_BOARD_REPROJECTION_ERROR_H_

@@ -1,0 +1,69 @@
+// Closed-form starting points for the stereo bundle adjustment
+// (stereo_calibration.h), from OpenCV's calibration routines.
+//
+// Intrinsics (InitializeCamera), per camera from its target views:
+//   1. OpenCV's closed form, cv::initCameraMatrix2D: Zhang's method (the
+//      first step of cv::calibrateCamera), focal lengths from the
+//      homographies' vanishing points with the principal point at the
+//      image center, no distortion;
+//   2. target poses from those intrinsics (InitializeTargetPose);
+//   3. a single-camera bundle adjustment (Ceres, Huber loss at 1 px) of the
+//      camera's lens parameters and its poses, from zero distortion.
+// Step 3 is what cv::calibrateCamera / cv::fisheye::calibrate do after
+// step 1, for our lens models and with a sparse solver: OpenCV's dense LM
+// costs ~175 ms (calibrateCamera) and ~250 ms (fisheye::calibrate) on 18
+// views of 54 corners, step 3 a few ms.
+//
+// Target poses (InitializeTargetPose): the corners are undistorted with the
+// camera's own model (Camera::NormalizedFromImage), then cv::solvePnP on
+// the normalized points (K = I) with IPPE, the planar-target solution,
+// refined by LM. This works the same for every lens model.
+//
+// Extrinsics (MedianRigid): from the relative poses of the stereo views,
+// the rotation that is the medoid under the angle metric and the
+// component-wise median of the translations. Robust to a few bad views.
+#ifndef RCM_CALIB_CALIBRATION_INITIALIZATION_H_
+#define RCM_CALIB_CALIBRATION_INITIALIZATION_H_
+
+#include <Eigen/Core>
+#include <optional>
+#include <vector>
+
+#include "rcm/calib/target_observation.h"
+#include "rcm/camera/camera.h"
+#include "rcm/geometry/rigid3d.h"
+#include "rcm/util/status.h"
+
+namespace rcm::calib {
+
+// The lens of one camera from the target's views in its images
+// (observations of one camera; at least 3, each with >= 4 corners).
+// `target_points` is TargetPoints(target). Fails when the closed form
+// fails (e.g. every view nearly fronto-parallel) or fewer than 3 views can
+// be posed.
+StatusOr<Camera> InitializeCamera(
+    LensModelId model, int width, int height,
+    const std::vector<Eigen::Vector3d>& target_points,
+    const std::vector<const TargetObservation*>& observations);
+
+// camera_from_target of one view; nullopt when fewer than 4 corners
+// undistort, PnP fails, or a corner ends up behind the camera.
+std::optional<Rigid3d> InitializeTargetPose(
+    const Camera& camera, const std::vector<Eigen::Vector3d>& target_points,
+    const TargetObservation& observation);
+
+// The robust center of transforms (non-empty): medoid rotation, median
+// translation.
+Rigid3d MedianRigid(const std::vector<Rigid3d>& transforms);
+
+// sqrt(mean |pi(camera, camera_from_target X) - u|^2) over the corners of
+// the observations (nullptr poses are skipped); infinity when a corner
+// does not project.
+double ReprojectionRms(
+    const Camera& camera, const std::vector<Eigen::Vector3d>& target_points,
+    const std::vector<const TargetObservation*>& observations,
+    const std::vector<std::optional<Rigid3d>>& poses);
+
+}  // namespace rcm::calib
+
+#endif  // RCM_CALIB_CALIBRATION_INITIALIZATION_H_

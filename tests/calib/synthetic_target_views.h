@@ -1,0 +1,114 @@
+// Synthetic stereo views of a calibration target for the calibration
+// tests: board poses that cover the image of cam0 at several tilts and
+// depths, and the exact (or noisy) corner pixels in both cameras.
+#ifndef RCM_TESTS_CALIB_SYNTHETIC_TARGET_VIEWS_H_
+#define RCM_TESTS_CALIB_SYNTHETIC_TARGET_VIEWS_H_
+
+#include <Eigen/Geometry>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "rcm/calib/calibration_target.h"
+#include "rcm/calib/target_observation.h"
+#include "rcm/geometry/stereo_rig.h"
+
+namespace rcm::calib::test {
+
+// `count` board poses (cam0_from_target), deterministic in `seed`: the
+// board's center is placed on the rays of a 3x3 grid of image points of
+// the left camera (cycling, jittered) at depths [min_depth, max_depth],
+// tilted by up to `max_tilt_deg` about x and y and rolled by up to 30
+// degrees.
+inline std::vector<Rigid3d> BoardPoses(const Camera& camera,
+                                       const CalibrationTarget& target,
+                                       int count, unsigned seed,
+                                       double min_depth = 0.45,
+                                       double max_depth = 0.9,
+                                       double max_tilt_deg = 35.0) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const std::vector<Eigen::Vector3d> points = TargetPoints(target);
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : points) center += p;
+  center /= static_cast<double>(points.size());
+  std::vector<Rigid3d> poses;
+  for (int i = 0; i < count; ++i) {
+    const int cell = i % 9;
+    const double fx = 0.5 + 0.3 * (cell % 3 - 1) + 0.04 * unit(rng);
+    const double fy = 0.5 + 0.3 * (cell / 3 - 1) + 0.04 * unit(rng);
+    const Eigen::Vector2d pixel(fx * camera.width(), fy * camera.height());
+    const Eigen::Vector2d normalized =
+        camera.NormalizedFromImage(pixel).value();
+    const double depth =
+        min_depth + (max_depth - min_depth) * 0.5 * (1.0 + unit(rng));
+    const double deg = M_PI / 180.0;
+    Rigid3d pose;
+    pose.rotation =
+        (Eigen::AngleAxisd(30.0 * deg * unit(rng), Eigen::Vector3d::UnitZ()) *
+         Eigen::AngleAxisd(max_tilt_deg * deg * unit(rng),
+                           Eigen::Vector3d::UnitY()) *
+         Eigen::AngleAxisd(max_tilt_deg * deg * unit(rng),
+                           Eigen::Vector3d::UnitX()))
+            .toRotationMatrix();
+    pose.translation =
+        depth * Eigen::Vector3d(normalized.x(), normalized.y(), 1.0) -
+        pose.rotation * center;
+    poses.push_back(pose);
+  }
+  return poses;
+}
+
+// The corners of the target that `camera` sees in the image at
+// camera_from_target, with Gaussian pixel noise of `noise_px` per axis.
+// nullopt when fewer than `min_corners` are in the image.
+inline std::optional<TargetObservation> ObserveTarget(
+    const Camera& camera, const Rigid3d& camera_from_target,
+    const std::vector<Eigen::Vector3d>& points, double noise_px,
+    std::mt19937* rng, int min_corners = 6) {
+  std::normal_distribution<double> noise(0.0, 1.0);
+  TargetObservation observation;
+  observation.detector = "synthetic";
+  for (int id = 0; id < static_cast<int>(points.size()); ++id) {
+    const Eigen::Vector3d p = camera_from_target * points[id];
+    if (!(p.z() > 0.05)) continue;
+    const std::optional<Eigen::Vector2d> pixel =
+        camera.ProjectNormalized(p.head<2>() / p.z());
+    if (!pixel || !camera.InImage(*pixel)) continue;
+    Eigen::Vector2d measured = *pixel;
+    if (noise_px > 0.0) {
+      measured += noise_px * Eigen::Vector2d(noise(*rng), noise(*rng));
+    }
+    observation.point_ids.push_back(id);
+    observation.pixels.push_back(measured);
+  }
+  if (observation.size() < min_corners) return std::nullopt;
+  return observation;
+}
+
+// Stereo views of `rig` (left = cam0) at the given target poses.
+inline std::vector<StereoView> ObserveStereo(
+    const StereoRig& rig, const CalibrationTarget& target,
+    const std::vector<Rigid3d>& cam0_from_target, double noise_px,
+    unsigned seed) {
+  std::mt19937 rng(seed);
+  const std::vector<Eigen::Vector3d> points = TargetPoints(target);
+  std::vector<StereoView> views;
+  for (size_t v = 0; v < cam0_from_target.size(); ++v) {
+    StereoView view;
+    view.left_name = "left" + std::to_string(v) + ".png";
+    view.right_name = "right" + std::to_string(v) + ".png";
+    view.left =
+        ObserveTarget(rig.left(), cam0_from_target[v], points, noise_px, &rng);
+    view.right =
+        ObserveTarget(rig.right(), rig.right_from_left() * cam0_from_target[v],
+                      points, noise_px, &rng);
+    views.push_back(std::move(view));
+  }
+  return views;
+}
+
+}  // namespace rcm::calib::test
+
+#endif  // RCM_TESTS_CALIB_SYNTHETIC_TARGET_VIEWS_H_
