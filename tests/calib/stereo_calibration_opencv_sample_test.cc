@@ -1,0 +1,200 @@
+// The stereo chessboard images that Debian's opencv-doc package ships
+// (left01.jpg ... right14.jpg, 13 pairs, 640x480, 9x6 inner corners):
+// real images, calibrated by rcm and by cv::stereoCalibrate on the same
+// corners. scripts/setup.sh installs opencv-doc.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
+
+#include "rcm/calib/calibration_target.h"
+#include "rcm/calib/cross_validation.h"
+#include "rcm/calib/stereo_calibration.h"
+#include "rcm/calib/target_detector.h"
+
+namespace rcm::calib {
+namespace {
+
+constexpr char kDataDir[] = "/usr/share/doc/opencv-doc/examples/data/";
+// The sample's numbering skips 10.
+constexpr int kPairNumbers[] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 11, 12, 13, 14};
+
+CalibrationTarget SampleBoard() {
+  // The square size of the printed board is not published; 25 mm scales
+  // the translations only, never the RMS or the intrinsics.
+  return MakeCheckerboardTarget(9, 6, 0.025).value();
+}
+
+// The 13 pairs' detections, read once for all tests of this file.
+const std::vector<StereoView>& SampleViews() {
+  static const std::vector<StereoView>* views = [] {
+    auto* out = new std::vector<StereoView>;
+    for (int number : kPairNumbers) {
+      char suffix[16];
+      std::snprintf(suffix, sizeof(suffix), "%02d.jpg", number);
+      const std::string left = std::string(kDataDir) + "left" + suffix;
+      const std::string right = std::string(kDataDir) + "right" + suffix;
+      const cv::Mat left_image = cv::imread(left, cv::IMREAD_GRAYSCALE);
+      const cv::Mat right_image = cv::imread(right, cv::IMREAD_GRAYSCALE);
+      if (left_image.empty() || right_image.empty()) {
+        ADD_FAILURE() << "cannot read " << left << " / " << right
+                      << ": install opencv-doc (scripts/setup.sh)";
+        continue;
+      }
+      StereoView view =
+          DetectTargetPair(left_image, right_image, SampleBoard());
+      view.left_name = left;
+      view.right_name = right;
+      out->push_back(std::move(view));
+    }
+    return out;
+  }();
+  return *views;
+}
+
+constexpr ImageSize kSize{640, 480};
+
+// cv::stereoCalibrate on the corners of the stereo views, the same
+// 4-coefficient model (k3 fixed to 0), each camera started from
+// cv::calibrateCamera: OpenCV's own best effort.
+double OpenCvStereoRms(const std::vector<StereoView>& views) {
+  const std::vector<Eigen::Vector3d> points = TargetPoints(SampleBoard());
+  std::vector<std::vector<cv::Point3f>> object;
+  std::vector<std::vector<cv::Point2f>> image[2];
+  for (const StereoView& view : views) {
+    if (!view.stereo() || view.left->size() != view.right->size()) continue;
+    object.emplace_back();
+    image[0].emplace_back();
+    image[1].emplace_back();
+    for (int k = 0; k < view.left->size(); ++k) {
+      // The chessboard detector reports every corner, in id order.
+      EXPECT_EQ(view.left->point_ids[k], view.right->point_ids[k]);
+      const Eigen::Vector3d& x = points[view.left->point_ids[k]];
+      object.back().emplace_back(x.x(), x.y(), x.z());
+      image[0].back().emplace_back(view.left->pixels[k].x(),
+                                   view.left->pixels[k].y());
+      image[1].back().emplace_back(view.right->pixels[k].x(),
+                                   view.right->pixels[k].y());
+    }
+  }
+  const cv::Size size(kSize.width, kSize.height);
+  cv::Mat k[2];
+  cv::Mat d[2];
+  for (int c = 0; c < 2; ++c) {
+    std::vector<cv::Mat> rvecs;
+    std::vector<cv::Mat> tvecs;
+    cv::calibrateCamera(object, image[c], size, k[c], d[c], rvecs, tvecs,
+                        cv::CALIB_FIX_K3);
+  }
+  cv::Mat r;
+  cv::Mat t;
+  cv::Mat e;
+  cv::Mat f;
+  return cv::stereoCalibrate(
+      object, image[0], image[1], k[0], d[0], k[1], d[1], size, r, t, e, f,
+      cv::CALIB_USE_INTRINSIC_GUESS | cv::CALIB_FIX_K3,
+      cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 200,
+                       1e-12));
+}
+
+TEST(OpenCvSampleStereo, EveryPairIsDetectedConsistently) {
+  const std::vector<StereoView>& views = SampleViews();
+  ASSERT_EQ(views.size(), 13u);
+  for (const StereoView& view : views) {
+    ASSERT_TRUE(view.stereo()) << view.left_name << ": " << view.note;
+    EXPECT_EQ(view.left->size(), 54);
+    EXPECT_EQ(view.right->size(), 54);
+  }
+}
+
+TEST(OpenCvSampleStereo, RmsNoWorseThanStereoCalibrate) {
+  const std::vector<StereoView>& views = SampleViews();
+  const StatusOr<StereoCalibration> calibration =
+      CalibrateStereo(SampleBoard(), views, kSize, kSize);
+  ASSERT_TRUE(calibration.ok()) << calibration.status().message();
+  const double opencv_rms = OpenCvStereoRms(views);
+  std::printf(
+      "rcm rms %.6f px over %d corners (%d outliers, inlier rms %.6f), "
+      "cv::stereoCalibrate rms %.6f px\n",
+      calibration->rms_px, calibration->num_inliers + calibration->num_outliers,
+      calibration->num_outliers, calibration->inlier_rms_px, opencv_rms);
+  std::printf("cam0 f %.3f %.3f c %.3f %.3f (sigma %.3f %.3f %.3f %.3f)\n",
+              calibration->cam0.camera.fx(), calibration->cam0.camera.fy(),
+              calibration->cam0.camera.cx(), calibration->cam0.camera.cy(),
+              calibration->cam0.sigma[0], calibration->cam0.sigma[1],
+              calibration->cam0.sigma[2], calibration->cam0.sigma[3]);
+  // No corner of these images is a gross outlier, so both minimize the
+  // same sum of squares over the same corners; rcm may only lose by the
+  // last digits of convergence (1e-6 px).
+  EXPECT_EQ(calibration->num_outliers, 0);
+  EXPECT_LE(calibration->rms_px, opencv_rms + 1e-6);
+}
+
+TEST(OpenCvSampleStereo, LeaveOneOutIsStable) {
+  // Leave-one-pair-out cross-validation: 13 calibrations of 12 pairs.
+  // Stable means every leave-one-out estimate is within 0.5 % of the focal
+  // length and 2 px of the principal point of each other, and the
+  // baseline within 0.5 %: a view more or less must not change the
+  // calibration by more than a user can tolerate.
+  constexpr double kMaxFocalRange = 0.005;
+  constexpr double kMaxPrincipalPointRangePx = 2.0;
+  constexpr double kMaxBaselineRange = 0.005;
+  const std::vector<StereoView>& views = SampleViews();
+  const StereoCalibrationOptions options;
+  const StereoCalibration full =
+      CalibrateStereo(SampleBoard(), views, kSize, kSize, options).value();
+  CrossValidationOptions cross_validation_options;
+  cross_validation_options.folds = 13;
+  const CrossValidation cross_validation =
+      CrossValidateStereo(SampleBoard(), views, kSize, kSize, full, options,
+                          cross_validation_options)
+          .value();
+  EXPECT_EQ(cross_validation.folds, 13);
+  EXPECT_EQ(cross_validation.failed_folds, 0);
+  ASSERT_EQ(cross_validation.parameters.size(), 9u);
+  for (const ParameterSpread& p : cross_validation.parameters) {
+    std::printf(
+        "%-9s %.5g  leave-one-out range %.4g  jackknife sigma %.4g  "
+        "covariance sigma %.4g\n",
+        p.name.c_str(), p.full, p.max - p.min, p.jackknife_sigma,
+        p.reported_sigma);
+    EXPECT_LE(p.min, p.full) << p.name;
+    EXPECT_GE(p.max, p.full) << p.name;
+    const bool focal =
+        p.name.back() == 'x' && p.name.find(" f") != std::string::npos;
+    const bool focal_y = p.name.find(" fy") != std::string::npos;
+    if (p.name == "baseline") {
+      EXPECT_LT(p.max - p.min, kMaxBaselineRange * p.full);
+    } else if (focal || focal_y) {
+      EXPECT_LT(p.max - p.min, kMaxFocalRange * p.full) << p.name;
+    } else {
+      EXPECT_LT(p.max - p.min, kMaxPrincipalPointRangePx) << p.name;
+    }
+  }
+}
+
+TEST(CrossValidation, NeedsTwoFolds) {
+  const std::vector<StereoView>& views = SampleViews();
+  const StereoCalibration full =
+      CalibrateStereo(SampleBoard(), views, kSize, kSize).value();
+  CrossValidationOptions options;
+  options.folds = 1;
+  EXPECT_EQ(
+      CrossValidateStereo(SampleBoard(), views, kSize, kSize, full, {}, options)
+          .status()
+          .message(),
+      "cross-validation needs at least 2 folds");
+  // Three views split three ways leave two per fold: every fold fails.
+  options.folds = 3;
+  const std::vector<StereoView> three(views.begin(), views.begin() + 3);
+  EXPECT_FALSE(
+      CrossValidateStereo(SampleBoard(), three, kSize, kSize, full, {}, options)
+          .ok());
+}
+
+}  // namespace
+}  // namespace rcm::calib

@@ -1,0 +1,93 @@
+#include "rcm/calib/cross_validation.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace rcm::calib {
+namespace {
+
+// The quantities of a calibration, in ParameterSpread order.
+std::vector<double> Quantities(const StereoCalibration& c) {
+  return {c.cam0.camera.fx(), c.cam0.camera.fy(), c.cam0.camera.cx(),
+          c.cam0.camera.cy(), c.cam1.camera.fx(), c.cam1.camera.fy(),
+          c.cam1.camera.cx(), c.cam1.camera.cy(), c.baseline};
+}
+
+}  // namespace
+
+Status CrossValidationOptions::Check() const {
+  if (folds < 2)
+    return Status::Error("cross-validation needs at least 2 folds");
+  return Status::Ok();
+}
+
+StatusOr<CrossValidation> CrossValidateStereo(
+    const CalibrationTarget& target, const std::vector<StereoView>& views,
+    const ImageSize& cam0_size, const ImageSize& cam1_size,
+    const StereoCalibration& full,
+    const StereoCalibrationOptions& calibration_options,
+    const CrossValidationOptions& options,
+    const std::function<void(int, int)>& progress) {
+  if (Status status = options.Check(); !status.ok()) return status;
+  const int num_views = static_cast<int>(views.size());
+  const int groups = std::min(options.folds, num_views);
+  if (groups < 2) {
+    return Status::Error("cross-validation needs at least 2 views");
+  }
+  StereoCalibrationOptions fold_options = calibration_options;
+  fold_options.compute_covariance = false;
+  std::vector<std::vector<double>> estimates;
+  CrossValidation result;
+  result.folds = groups;
+  for (int k = 0; k < groups; ++k) {
+    std::vector<StereoView> subset;
+    for (int v = 0; v < num_views; ++v) {
+      if (v % groups != k) subset.push_back(views[v]);
+    }
+    const StatusOr<StereoCalibration> calibration =
+        CalibrateStereo(target, subset, cam0_size, cam1_size, fold_options);
+    if (calibration.ok()) {
+      estimates.push_back(Quantities(*calibration));
+    } else {
+      ++result.failed_folds;
+    }
+    if (progress) progress(k + 1, groups);
+  }
+  const int g = static_cast<int>(estimates.size());
+  if (g < 2) {
+    return Status::Error("cross-validation: only " + std::to_string(g) +
+                         " of " + std::to_string(groups) +
+                         " leave-out calibrations succeeded");
+  }
+  const char* names[9] = {"cam0 fx", "cam0 fy", "cam0 cx", "cam0 cy", "cam1 fx",
+                          "cam1 fy", "cam1 cx", "cam1 cy", "baseline"};
+  const double reported[9] = {
+      full.cam0.sigma[0], full.cam0.sigma[1], full.cam0.sigma[2],
+      full.cam0.sigma[3], full.cam1.sigma[0], full.cam1.sigma[1],
+      full.cam1.sigma[2], full.cam1.sigma[3], full.baseline_sigma};
+  const std::vector<double> full_values = Quantities(full);
+  for (int q = 0; q < 9; ++q) {
+    ParameterSpread spread;
+    spread.name = names[q];
+    spread.unit = q == 8 ? "m" : "px";
+    spread.full = full_values[q];
+    spread.reported_sigma = reported[q];
+    double mean = 0.0;
+    spread.min = spread.max = estimates[0][q];
+    for (const std::vector<double>& e : estimates) {
+      mean += e[q];
+      spread.min = std::min(spread.min, e[q]);
+      spread.max = std::max(spread.max, e[q]);
+    }
+    mean /= g;
+    double sum = 0.0;
+    for (const std::vector<double>& e : estimates) {
+      sum += (e[q] - mean) * (e[q] - mean);
+    }
+    spread.jackknife_sigma = std::sqrt((g - 1.0) / g * sum);
+    result.parameters.push_back(spread);
+  }
+  return result;
+}
+
+}  // namespace rcm::calib
