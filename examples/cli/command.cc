@@ -14,7 +14,8 @@ DEFINE_bool(json, false, "print one JSON object on stdout instead of text");
 DEFINE_string(out, "",
               "output folder (rcm simulate: required; rcm demo: default "
               "./rcm_demo; rcm estimate: optional, for the pictures and "
-              "files of the run)");
+              "files of the run; rcm calibrate: the camchain file to write, "
+              "or a folder)");
 
 namespace rcm::cli {
 namespace {

@@ -10,6 +10,7 @@
 #include "command.h"
 
 namespace rcm::cli {
+extern const Subcommand kCalibrateCommand;
 extern const Subcommand kDemoCommand;
 extern const Subcommand kEstimateCommand;
 extern const Subcommand kSimulateCommand;
@@ -19,7 +20,8 @@ namespace {
 
 using rcm::cli::Subcommand;
 
-const Subcommand* const kSubcommands[] = {&rcm::cli::kDemoCommand,
+const Subcommand* const kSubcommands[] = {&rcm::cli::kCalibrateCommand,
+                                          &rcm::cli::kDemoCommand,
                                           &rcm::cli::kEstimateCommand,
                                           &rcm::cli::kSimulateCommand};
 
