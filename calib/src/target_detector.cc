@@ -1,0 +1,546 @@
+#include "rcm/calib/target_detector.h"
+
+#include <glog/logging.h>
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <opencv2/aruco.hpp>
+#include <opencv2/aruco/charuco.hpp>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+namespace rcm::calib {
+namespace {
+
+// Images smaller than this along a side hold no target worth detecting.
+constexpr int kMinImageSide = 16;
+// Kalibr's tags: a 2-bit black border around the 6 x 6 data bits.
+constexpr int kAprilTagBorderBits = 2;
+// ArUco's adaptive threshold offsets tried in turn for Kalibr's tags: a
+// corner square joined to a tag at one threshold is apart at another (on
+// renders, one pass finds ~85% of the tags, these two all).
+constexpr double kAprilThresholdConstants[] = {7.0, 14.0};
+constexpr double kAprilMinMarkerDistanceRate = 0.001;
+constexpr double kAprilIgnoredMargin = 0.3;
+constexpr int kAprilTagBits = 10;
+// Half window of the tag corners' cornerSubPix as a fraction of the
+// X-junction's reach: on renders 0.55-0.7 converge (measured), smaller
+// windows miss contour corners that start 2-3 px off, larger ones reach
+// the data bits.
+constexpr double kAprilHalfWindowFraction = 0.6;
+// The classic detector's corner refinement: half window [px] and stop
+// criteria (as OpenCV's calibration sample).
+constexpr int kClassicHalfWindow = 5;
+// cornerSubPix on a ChArUco corner: the chessboard X-junction reaches
+// (square - marker) / 2 from the corner (to the markers); the half window
+// is this fraction of it in pixels, clamped to [2, 10].
+constexpr double kCharucoHalfWindowFraction = 0.6;
+
+using Corners = std::vector<cv::Point2f>;
+
+// `image` as 8-bit gray, or nullopt for an empty, tiny or non-8-bit image.
+std::optional<cv::Mat> ToGray(const cv::Mat& image) {
+  if (image.empty() || image.dims != 2 || image.depth() != CV_8U ||
+      image.cols < kMinImageSide || image.rows < kMinImageSide) {
+    return std::nullopt;
+  }
+  switch (image.channels()) {
+    case 1:
+      return image;
+    case 3: {
+      cv::Mat gray;
+      cv::cvtColor(image, gray, cv::COLOR_BGR2GRAY);
+      return gray;
+    }
+    case 4: {
+      cv::Mat gray;
+      cv::cvtColor(image, gray, cv::COLOR_BGRA2GRAY);
+      return gray;
+    }
+    default:
+      return std::nullopt;
+  }
+}
+
+// ---------------------------------------------------------------------------
+// Checkerboard.
+
+enum class ChessDetector { kSb, kClassic };
+
+const char* DetectorName(ChessDetector detector) {
+  return detector == ChessDetector::kSb ? "chessboard-sb"
+                                        : "chessboard-classic";
+}
+
+// The detector's corners (row-major over patternSize (cols, rows)).
+std::optional<Corners> FindChessboard(const cv::Mat& gray,
+                                      const CalibrationTarget& target,
+                                      ChessDetector detector) {
+  const cv::Size pattern(target.cols, target.rows);
+  Corners corners;
+  try {
+    if (detector == ChessDetector::kSb) {
+      if (!cv::findChessboardCornersSB(
+              gray, pattern, corners,
+              cv::CALIB_CB_EXHAUSTIVE | cv::CALIB_CB_ACCURACY)) {
+        return std::nullopt;
+      }
+    } else {
+      if (!cv::findChessboardCorners(
+              gray, pattern, corners,
+              cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE)) {
+        return std::nullopt;
+      }
+      cv::cornerSubPix(
+          gray, corners, cv::Size(kClassicHalfWindow, kClassicHalfWindow),
+          cv::Size(-1, -1),
+          cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 30,
+                           0.01));
+    }
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  if (static_cast<int>(corners.size()) != target.cols * target.rows) {
+    return std::nullopt;
+  }
+  return corners;
+}
+
+// A relabelling of a cols x rows grid: label k takes the corner at
+// source[k].
+using GridOrder = std::vector<int>;
+
+// The relabellings of the grid that keep its shape: the rotations (by 180
+// degrees; by 90 too when square) and, when `mirrors`, the reflections.
+std::vector<GridOrder> GridOrders(int cols, int rows, bool mirrors) {
+  // Each maps the new label (r, c) to the old (r', c').
+  using Map = std::pair<int, int> (*)(int r, int c, int cols, int rows);
+  std::vector<Map> maps = {
+      [](int r, int c, int, int) { return std::make_pair(r, c); },
+      [](int r, int c, int cols, int rows) {
+        return std::make_pair(rows - 1 - r, cols - 1 - c);
+      }};
+  if (cols == rows) {
+    maps.push_back([](int r, int c, int cols, int) {
+      return std::make_pair(c, cols - 1 - r);
+    });
+    maps.push_back([](int r, int c, int cols, int) {
+      return std::make_pair(cols - 1 - c, r);
+    });
+  }
+  if (mirrors) {
+    maps.push_back([](int r, int c, int cols, int) {
+      return std::make_pair(r, cols - 1 - c);
+    });
+    maps.push_back([](int r, int c, int, int rows) {
+      return std::make_pair(rows - 1 - r, c);
+    });
+    if (cols == rows) {
+      maps.push_back(
+          [](int r, int c, int, int) { return std::make_pair(c, r); });
+      maps.push_back([](int r, int c, int cols, int) {
+        return std::make_pair(cols - 1 - c, cols - 1 - r);
+      });
+    }
+  }
+  std::vector<GridOrder> orders;
+  for (const Map map : maps) {
+    GridOrder order(static_cast<size_t>(cols) * rows);
+    for (int r = 0; r < rows; ++r) {
+      for (int c = 0; c < cols; ++c) {
+        const auto [old_r, old_c] = map(r, c, cols, rows);
+        order[r * cols + c] = old_r * cols + old_c;
+      }
+    }
+    orders.push_back(std::move(order));
+  }
+  return orders;
+}
+
+Corners Reorder(const Corners& corners, const GridOrder& order) {
+  Corners out(order.size());
+  for (size_t k = 0; k < order.size(); ++k) out[k] = corners[order[k]];
+  return out;
+}
+
+// The rotation of the grid whose corner 0 has the smallest x + y.
+Corners Canonical(const Corners& corners, const CalibrationTarget& target) {
+  const std::vector<GridOrder> orders =
+      GridOrders(target.cols, target.rows, /*mirrors=*/false);
+  const GridOrder* best = nullptr;
+  float best_sum = std::numeric_limits<float>::infinity();
+  for (const GridOrder& order : orders) {
+    const cv::Point2f& first = corners[order[0]];
+    if (first.x + first.y < best_sum) {
+      best_sum = first.x + first.y;
+      best = &order;
+    }
+  }
+  return Reorder(corners, *best);
+}
+
+TargetObservation ChessboardObservation(const Corners& corners,
+                                        ChessDetector detector) {
+  TargetObservation observation;
+  observation.detector = DetectorName(detector);
+  for (size_t k = 0; k < corners.size(); ++k) {
+    observation.point_ids.push_back(static_cast<int>(k));
+    observation.pixels.emplace_back(corners[k].x, corners[k].y);
+  }
+  return observation;
+}
+
+// The points centred on their centroid and scaled to unit RMS radius.
+std::vector<Eigen::Vector2d> NormalizedLayout(const Corners& corners) {
+  Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+  for (const cv::Point2f& p : corners) centroid += Eigen::Vector2d(p.x, p.y);
+  centroid /= static_cast<double>(corners.size());
+  std::vector<Eigen::Vector2d> layout;
+  double sum_squares = 0.0;
+  for (const cv::Point2f& p : corners) {
+    layout.push_back(Eigen::Vector2d(p.x, p.y) - centroid);
+    sum_squares += layout.back().squaredNorm();
+  }
+  const double rms = std::sqrt(sum_squares / corners.size());
+  if (rms > 0.0) {
+    for (Eigen::Vector2d& point : layout) point /= rms;
+  }
+  return layout;
+}
+
+double Mismatch(const std::vector<Eigen::Vector2d>& a,
+                const std::vector<Eigen::Vector2d>& b) {
+  double sum = 0.0;
+  for (size_t k = 0; k < a.size(); ++k) sum += (a[k] - b[k]).squaredNorm();
+  return sum / static_cast<double>(a.size());
+}
+
+// ---------------------------------------------------------------------------
+// ArUco based targets.
+
+// cornerSubPix on the four corners of a Kalibr tag, each an X-junction of
+// the tag's 2-bit border and a corner square, reaching min(2 bits, gap)
+// from the corner; the window must stay inside it.
+void RefineTagCorners(const cv::Mat& gray, const CalibrationTarget& target,
+                      Corners* corners) {
+  // Twice: the contour's corners can be a few pixels inside the tag, which
+  // makes it look smaller than it is; the second pass sizes its window from
+  // the first pass's corners.
+  for (int pass = 0; pass < 2; ++pass) {
+    double edge = 0.0;  // mean edge [px]
+    for (int k = 0; k < 4; ++k) {
+      edge += 0.25 * cv::norm((*corners)[k] - (*corners)[(k + 1) % 4]);
+    }
+    const double junction =
+        std::min(static_cast<double>(kAprilTagBorderBits) / kAprilTagBits,
+                 target.tag_spacing) *
+        edge;
+    const int half_window = std::clamp(
+        static_cast<int>(std::lround(kAprilHalfWindowFraction * junction)), 2,
+        10);
+    cv::cornerSubPix(
+        gray, *corners, cv::Size(half_window, half_window), cv::Size(-1, -1),
+        cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 40,
+                         0.01));
+  }
+}
+
+std::optional<TargetObservation> DetectAprilGrid(
+    const cv::Mat& gray, const CalibrationTarget& target,
+    const TargetDetectorOptions& options) {
+  const cv::Ptr<cv::aruco::Dictionary> dictionary =
+      cv::aruco::getPredefinedDictionary(cv::aruco::DICT_APRILTAG_36h11);
+  const int num_tags = target.cols * target.rows;
+  TargetObservation observation;
+  observation.detector = "aprilgrid";
+  std::vector<bool> seen(num_tags, false);
+  for (const double threshold_constant : kAprilThresholdConstants) {
+    const cv::Ptr<cv::aruco::DetectorParameters> parameters =
+        cv::aruco::DetectorParameters::create();
+    parameters->markerBorderBits = kAprilTagBorderBits;
+    parameters->adaptiveThreshConstant = threshold_constant;
+    // Keep a tag's inner and outer contours both as candidates: the outer
+    // one may be spoilt by a corner square joined to it.
+    parameters->minMarkerDistanceRate = kAprilMinMarkerDistanceRate;
+    parameters->perspectiveRemoveIgnoredMarginPerCell = kAprilIgnoredMargin;
+    // Refined below, per tag.
+    parameters->cornerRefinementMethod = cv::aruco::CORNER_REFINE_NONE;
+    std::vector<Corners> markers;
+    std::vector<int> ids;
+    cv::aruco::detectMarkers(gray, dictionary, markers, ids, parameters);
+    for (size_t m = 0; m < ids.size(); ++m) {
+      const int id = ids[m];
+      if (id < 0 || id >= num_tags || seen[id]) continue;
+      seen[id] = true;
+      RefineTagCorners(gray, target, &markers[m]);
+      for (int k = 0; k < 4; ++k) {
+        observation.point_ids.push_back(4 * id + (k ^ 1));
+        observation.pixels.emplace_back(markers[m][k].x, markers[m][k].y);
+      }
+    }
+  }
+  if (observation.size() < 4 * options.min_aprilgrid_tags) return std::nullopt;
+  return observation;
+}
+
+std::optional<TargetObservation> DetectCharuco(
+    const cv::Mat& gray, const CalibrationTarget& target,
+    const TargetDetectorOptions& options) {
+  const cv::Ptr<cv::aruco::Dictionary> dictionary =
+      cv::aruco::getPredefinedDictionary(
+          FindArucoDictionary(target.dictionary)->opencv_id);
+  const cv::Ptr<cv::aruco::CharucoBoard> board =
+      cv::aruco::CharucoBoard::create(
+          target.cols, target.rows, static_cast<float>(target.square_size),
+          static_cast<float>(target.marker_size), dictionary);
+  std::vector<Corners> markers;
+  std::vector<int> ids;
+  cv::aruco::detectMarkers(gray, dictionary, markers, ids,
+                           cv::aruco::DetectorParameters::create());
+  // Markers of the dictionary that are not on the board.
+  const int num_markers = NumCharucoMarkers(target);
+  std::vector<Corners> board_markers;
+  std::vector<int> board_ids;
+  for (size_t m = 0; m < ids.size(); ++m) {
+    if (ids[m] < 0 || ids[m] >= num_markers) continue;
+    board_markers.push_back(markers[m]);
+    board_ids.push_back(ids[m]);
+  }
+  if (board_ids.empty()) return std::nullopt;
+  Corners corners;
+  std::vector<int> corner_ids;
+  cv::aruco::interpolateCornersCharuco(board_markers, board_ids, gray, board,
+                                       corners, corner_ids);
+  if (static_cast<int>(corner_ids.size()) < options.min_charuco_corners) {
+    return std::nullopt;
+  }
+  // OpenCV 4.6 leaves the interpolated corners ~0.5 px off on renders (its
+  // refinement window is sized from the marker corners); refine them again
+  // on their X-junctions, the window sized from the markers' edges.
+  std::vector<double> edges;
+  for (const Corners& marker : board_markers) {
+    for (int k = 0; k < 4; ++k) {
+      edges.push_back(cv::norm(marker[k] - marker[(k + 1) % 4]));
+    }
+  }
+  std::nth_element(edges.begin(), edges.begin() + edges.size() / 2,
+                   edges.end());
+  const double square_px =
+      edges[edges.size() / 2] * target.square_size / target.marker_size;
+  const double junction_px = 0.5 * (target.square_size - target.marker_size) /
+                             target.square_size * square_px;
+  const int half_window = std::clamp(
+      static_cast<int>(kCharucoHalfWindowFraction * junction_px), 2, 10);
+  cv::cornerSubPix(
+      gray, corners, cv::Size(half_window, half_window), cv::Size(-1, -1),
+      cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 40,
+                       0.001));
+  TargetObservation observation;
+  observation.detector = "charuco";
+  for (size_t k = 0; k < corner_ids.size(); ++k) {
+    observation.point_ids.push_back(corner_ids[k]);
+    observation.pixels.emplace_back(corners[k].x, corners[k].y);
+  }
+  return observation;
+}
+
+// DetectTarget without the argument checks, for a gray image.
+std::optional<TargetObservation> DetectInGray(
+    const cv::Mat& gray, const CalibrationTarget& target,
+    const TargetDetectorOptions& options) {
+  try {
+    switch (target.type) {
+      case TargetType::kCheckerboard: {
+        for (const ChessDetector detector :
+             {ChessDetector::kSb, ChessDetector::kClassic}) {
+          if (detector == ChessDetector::kClassic &&
+              !options.chessboard_fallback) {
+            break;
+          }
+          const std::optional<Corners> corners =
+              FindChessboard(gray, target, detector);
+          if (corners) {
+            return ChessboardObservation(Canonical(*corners, target), detector);
+          }
+        }
+        return std::nullopt;
+      }
+      case TargetType::kAprilGrid:
+        return DetectAprilGrid(gray, target, options);
+      case TargetType::kCharuco:
+        return DetectCharuco(gray, target, options);
+    }
+  } catch (const std::exception&) {
+    // cv::Exception from OpenCV on an input it does not handle.
+  }
+  return std::nullopt;
+}
+
+// Runs first() and second(), at once when num_threads >= 2.
+template <typename First, typename Second>
+void RunBoth(int num_threads, const First& first, const Second& second) {
+  if (num_threads < 2) {
+    first();
+    second();
+    return;
+  }
+  std::thread thread(second);
+  first();
+  thread.join();
+}
+
+// The pair's checkerboards; see the header.
+void DetectChessboardPair(const std::optional<cv::Mat>& left,
+                          const std::optional<cv::Mat>& right,
+                          const CalibrationTarget& target,
+                          const TargetDetectorOptions& options,
+                          StereoView* view) {
+  std::optional<Corners> corners[2];
+  const std::optional<cv::Mat>* images[2] = {&left, &right};
+  const auto run = [&](ChessDetector detector, std::optional<Corners>* out) {
+    RunBoth(
+        options.num_threads,
+        [&] {
+          if (*images[0])
+            out[0] = FindChessboard(**images[0], target, detector);
+        },
+        [&] {
+          if (*images[1])
+            out[1] = FindChessboard(**images[1], target, detector);
+        });
+  };
+  run(ChessDetector::kSb, corners);
+  ChessDetector detector = ChessDetector::kSb;
+  const auto count = [](const std::optional<Corners>* pair) {
+    return static_cast<int>(pair[0].has_value()) +
+           static_cast<int>(pair[1].has_value());
+  };
+  if (count(corners) < 2 && options.chessboard_fallback) {
+    std::optional<Corners> classic[2];
+    run(ChessDetector::kClassic, classic);
+    if (count(classic) > count(corners)) {
+      corners[0] = std::move(classic[0]);
+      corners[1] = std::move(classic[1]);
+      detector = ChessDetector::kClassic;
+    }
+  }
+  if (corners[0]) {
+    corners[0] = Canonical(*corners[0], target);
+    view->left = ChessboardObservation(*corners[0], detector);
+  }
+  if (!corners[1]) return;
+  if (!corners[0]) {
+    view->right =
+        ChessboardObservation(Canonical(*corners[1], target), detector);
+    return;
+  }
+  // The right ordering whose layout best matches the left's.
+  const std::vector<Eigen::Vector2d> left_layout =
+      NormalizedLayout(*corners[0]);
+  double best = std::numeric_limits<double>::infinity();
+  double second = std::numeric_limits<double>::infinity();
+  Corners best_corners;
+  for (const GridOrder& order :
+       GridOrders(target.cols, target.rows, /*mirrors=*/true)) {
+    Corners candidate = Reorder(*corners[1], order);
+    const double mismatch = Mismatch(left_layout, NormalizedLayout(candidate));
+    if (mismatch < best) {
+      second = best;
+      best = mismatch;
+      best_corners = std::move(candidate);
+    } else if (mismatch < second) {
+      second = mismatch;
+    }
+  }
+  if (best > options.chessboard_pair_max_mismatch ||
+      best >= options.chessboard_pair_max_ratio * second) {
+    std::ostringstream note;
+    note.precision(3);
+    note << "right chessboard order ambiguous (layout mismatch " << best
+         << ", next " << second << "); right view dropped";
+    view->note = note.str();
+    return;
+  }
+  view->right = ChessboardObservation(best_corners, detector);
+}
+
+}  // namespace
+
+Status TargetDetectorOptions::Check() const {
+  std::ostringstream message;
+  if (min_charuco_corners < 4) {
+    message << "min_charuco_corners = " << min_charuco_corners
+            << " must be >= 4";
+  } else if (min_aprilgrid_tags < 1) {
+    message << "min_aprilgrid_tags = " << min_aprilgrid_tags << " must be >= 1";
+  } else if (!(chessboard_pair_max_ratio > 0.0 &&
+               chessboard_pair_max_ratio < 1.0)) {
+    message << "chessboard_pair_max_ratio = " << chessboard_pair_max_ratio
+            << " must be in (0, 1)";
+  } else if (!(chessboard_pair_max_mismatch > 0.0 &&
+               std::isfinite(chessboard_pair_max_mismatch))) {
+    message << "chessboard_pair_max_mismatch = " << chessboard_pair_max_mismatch
+            << " must be positive and finite";
+  } else if (num_threads < 1) {
+    message << "num_threads = " << num_threads << " must be >= 1";
+  } else {
+    return Status::Ok();
+  }
+  return Status::Error(message.str());
+}
+
+std::optional<TargetObservation> DetectTarget(
+    const cv::Mat& image, const CalibrationTarget& target,
+    const TargetDetectorOptions& options) {
+  const Status valid = options.Check();
+  CHECK(valid.ok()) << "TargetDetectorOptions: " << valid.message();
+  NumTargetPoints(target);  // CHECKs that the target is valid
+  const std::optional<cv::Mat> gray = ToGray(image);
+  if (!gray) return std::nullopt;
+  return DetectInGray(*gray, target, options);
+}
+
+StereoView DetectTargetPair(const cv::Mat& left, const cv::Mat& right,
+                            const CalibrationTarget& target,
+                            const TargetDetectorOptions& options) {
+  const Status valid = options.Check();
+  CHECK(valid.ok()) << "TargetDetectorOptions: " << valid.message();
+  NumTargetPoints(target);  // CHECKs that the target is valid
+  StereoView view;
+  const std::optional<cv::Mat> left_gray = ToGray(left);
+  const std::optional<cv::Mat> right_gray = ToGray(right);
+  if (target.type == TargetType::kCheckerboard) {
+    DetectChessboardPair(left_gray, right_gray, target, options, &view);
+  } else {
+    RunBoth(
+        options.num_threads,
+        [&] {
+          if (left_gray) view.left = DetectInGray(*left_gray, target, options);
+        },
+        [&] {
+          if (right_gray) {
+            view.right = DetectInGray(*right_gray, target, options);
+          }
+        });
+  }
+  if (view.note.empty()) {
+    if (!view.left && !view.right) {
+      view.note = "board found in neither image";
+    } else if (!view.right) {
+      view.note = "board found in the left image only";
+    } else if (!view.left) {
+      view.note = "board found in the right image only";
+    }
+  }
+  return view;
+}
+
+}  // namespace rcm::calib

@@ -1,0 +1,225 @@
+#include "rcm/calib/target_renderer.h"
+
+#include <glog/logging.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+#include <utility>
+
+#include "rcm/util/parallel_for.h"
+#include "rcm/util/splitmix64.h"
+
+namespace rcm::calib {
+namespace {
+
+constexpr int kMaxSupersampling = 16;
+// Rows per thread below which ParallelFor stays on one thread.
+constexpr int64_t kMinRowsPerThread = 8;
+// Threads Create undistorts the pixel corners with.
+constexpr int kCreateThreads = 2;
+
+// A standard normal draw from one 64-bit hash (Box-Muller on its halves).
+double GaussianFromHash(uint64_t hash) {
+  const double u1 = (static_cast<double>(hash >> 32) + 0.5) * 0x1.0p-32;
+  const double u2 = static_cast<double>(hash & 0xFFFFFFFFull) * 0x1.0p-32;
+  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
+}
+
+}  // namespace
+
+Status TargetRenderOptions::Check() const {
+  std::ostringstream message;
+  if (supersampling < 1 || supersampling > kMaxSupersampling) {
+    message << "supersampling = " << supersampling << " must be in [1, "
+            << kMaxSupersampling << "]";
+  } else if (!(std::isfinite(blur_sigma_px) && blur_sigma_px >= 0.0)) {
+    message << "blur_sigma_px = " << blur_sigma_px
+            << " must be finite and >= 0";
+  } else if (!(std::isfinite(noise_sigma) && noise_sigma >= 0.0)) {
+    message << "noise_sigma = " << noise_sigma << " must be finite and >= 0";
+  } else if (background < 0 || background > 255) {
+    message << "background = " << background << " must be in [0, 255]";
+  } else if (num_threads < 1) {
+    message << "num_threads = " << num_threads << " must be >= 1";
+  } else {
+    return Status::Ok();
+  }
+  return Status::Error(message.str());
+}
+
+StatusOr<TargetRenderer> TargetRenderer::Create(const Camera& camera,
+                                                TargetImage target_image) {
+  const cv::Mat& texture = target_image.image;
+  if (texture.empty() || texture.type() != CV_8UC1) {
+    return Status::Error("target image must be a non-empty 8-bit gray image");
+  }
+  const Eigen::Matrix2d linear = target_image.target_from_texture.leftCols<2>();
+  const double det = linear.determinant();
+  if (!target_image.target_from_texture.allFinite() || !(std::abs(det) > 0)) {
+    return Status::Error("target_from_texture is not invertible");
+  }
+  TargetRenderer renderer(camera, std::move(target_image));
+  const int columns = camera.width() + 1;
+  const int rows = camera.height() + 1;
+  constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
+  renderer.corner_rays_.assign(static_cast<size_t>(columns) * rows,
+                               Eigen::Vector3f::Constant(kNan));
+  std::vector<Eigen::Vector3f>& rays = renderer.corner_rays_;
+  ParallelFor(
+      rows, kCreateThreads, kMinRowsPerThread, [&](int64_t begin, int64_t end) {
+        for (int64_t y = begin; y < end; ++y) {
+          for (int x = 0; x < columns; ++x) {
+            const std::optional<Eigen::Vector2d> normalized =
+                camera.NormalizedFromImage(Eigen::Vector2d(x - 0.5, y - 0.5));
+            if (!normalized || !normalized->allFinite()) continue;
+            rays[y * columns + x] =
+                normalized->homogeneous().normalized().cast<float>();
+          }
+        }
+      });
+  const bool any_valid =
+      std::any_of(rays.begin(), rays.end(),
+                  [](const Eigen::Vector3f& ray) { return ray.allFinite(); });
+  if (!any_valid) {
+    return Status::Error("the camera's lens cannot undistort any pixel");
+  }
+  return renderer;
+}
+
+cv::Mat TargetRenderer::Render(const Rigid3d& cam_from_target,
+                               const TargetRenderOptions& options) const {
+  const Status valid = options.Check();
+  CHECK(valid.ok()) << "TargetRenderOptions: " << valid.message();
+  const int width = camera_.width();
+  const int height = camera_.height();
+  const int columns = width + 1;
+  const int s = options.supersampling;
+  const float background = static_cast<float>(options.background);
+  cv::Mat mean(height, width, CV_32FC1, cv::Scalar(background));
+
+  // texture_from_camera_ray: [u w, v w, w] = T [r1 r2 t]^-1 d.
+  Eigen::Matrix3d plane;
+  plane << cam_from_target.rotation.col(0), cam_from_target.rotation.col(1),
+      cam_from_target.translation;
+  const double plane_det = plane.determinant();
+  if (std::isfinite(plane_det) && std::abs(plane_det) > 1e-12) {
+    const Eigen::Matrix2d linear =
+        target_image_.target_from_texture.leftCols<2>();
+    const Eigen::Matrix2d linear_inverse = linear.inverse();
+    Eigen::Matrix3d texture_from_target = Eigen::Matrix3d::Identity();
+    texture_from_target.topLeftCorner<2, 2>() = linear_inverse;
+    texture_from_target.topRightCorner<2, 1>() =
+        -linear_inverse * target_image_.target_from_texture.col(2);
+    const Eigen::Matrix3d texture_from_ray =
+        texture_from_target * plane.inverse();
+
+    // Homogeneous texture points of the pixel corners (NaN where invalid).
+    std::vector<Eigen::Vector3d> corners(corner_rays_.size());
+    ParallelFor(static_cast<int64_t>(height) + 1, options.num_threads,
+                kMinRowsPerThread, [&](int64_t begin, int64_t end) {
+                  for (int64_t k = begin * columns; k < end * columns; ++k) {
+                    corners[k] =
+                        texture_from_ray * corner_rays_[k].cast<double>();
+                  }
+                });
+
+    const cv::Mat& texture = target_image_.image;
+    const int texture_cols = texture.cols;
+    const int texture_rows = texture.rows;
+    const int background_level = options.background;
+    std::vector<double> fractions(s);
+    for (int i = 0; i < s; ++i) fractions[i] = (i + 0.5) / s;
+    const float inverse_count = 1.0f / static_cast<float>(s * s);
+    ParallelFor(height, options.num_threads, kMinRowsPerThread,
+                [&](int64_t begin, int64_t end) {
+                  for (int64_t y = begin; y < end; ++y) {
+                    float* out = mean.ptr<float>(static_cast<int>(y));
+                    const Eigen::Vector3d* top = &corners[y * columns];
+                    const Eigen::Vector3d* bottom = top + columns;
+                    for (int x = 0; x < width; ++x) {
+                      const Eigen::Vector3d& c00 = top[x];
+                      const Eigen::Vector3d& c10 = top[x + 1];
+                      const Eigen::Vector3d& c01 = bottom[x];
+                      const Eigen::Vector3d& c11 = bottom[x + 1];
+                      if (!(c00.allFinite() && c10.allFinite() &&
+                            c01.allFinite() && c11.allFinite())) {
+                        continue;  // stays background
+                      }
+                      int sum = 0;
+                      for (int j = 0; j < s; ++j) {
+                        const double fy = fractions[j];
+                        const Eigen::Vector3d left = c00 + fy * (c01 - c00);
+                        const Eigen::Vector3d step =
+                            c10 + fy * (c11 - c10) - left;
+                        for (int i = 0; i < s; ++i) {
+                          const Eigen::Vector3d h = left + fractions[i] * step;
+                          if (!(h.z() > 0.0)) {
+                            sum += background_level;
+                            continue;
+                          }
+                          const double inverse_w = 1.0 / h.z();
+                          const double u = std::floor(h.x() * inverse_w + 0.5);
+                          const double v = std::floor(h.y() * inverse_w + 0.5);
+                          if (u >= 0.0 && v >= 0.0 && u < texture_cols &&
+                              v < texture_rows) {
+                            sum += texture.ptr<uint8_t>(
+                                static_cast<int>(v))[static_cast<int>(u)];
+                          } else {
+                            sum += background_level;
+                          }
+                        }
+                      }
+                      out[x] = static_cast<float>(sum) * inverse_count;
+                    }
+                  }
+                });
+  }
+
+  if (options.blur_sigma_px > 0.0) {
+    cv::GaussianBlur(mean, mean, cv::Size(0, 0), options.blur_sigma_px,
+                     options.blur_sigma_px, cv::BORDER_REPLICATE);
+  }
+  cv::Mat image(height, width, CV_8UC1);
+  const uint64_t noise_key = SplitMix64(options.seed);
+  ParallelFor(
+      height, options.num_threads, kMinRowsPerThread,
+      [&](int64_t begin, int64_t end) {
+        for (int64_t y = begin; y < end; ++y) {
+          const float* in = mean.ptr<float>(static_cast<int>(y));
+          uint8_t* out = image.ptr<uint8_t>(static_cast<int>(y));
+          for (int x = 0; x < width; ++x) {
+            double value = in[x];
+            if (options.noise_sigma > 0.0) {
+              const uint64_t pixel = static_cast<uint64_t>(y) * width + x;
+              value += options.noise_sigma *
+                       GaussianFromHash(SplitMix64(noise_key + pixel));
+            }
+            out[x] =
+                static_cast<uint8_t>(std::clamp(std::lround(value), 0L, 255L));
+          }
+        }
+      });
+  return image;
+}
+
+std::vector<std::optional<Eigen::Vector2d>> ProjectTargetPoints(
+    const Camera& camera, const Rigid3d& cam_from_target,
+    const CalibrationTarget& target) {
+  std::vector<std::optional<Eigen::Vector2d>> pixels;
+  for (const Eigen::Vector3d& point : TargetPoints(target)) {
+    const Eigen::Vector3d in_camera = cam_from_target * point;
+    std::optional<Eigen::Vector2d> pixel;
+    if (in_camera.z() > 0.0) {
+      pixel = camera.ProjectNormalized(in_camera.hnormalized());
+      if (pixel && !camera.InImage(*pixel)) pixel.reset();
+    }
+    pixels.push_back(pixel);
+  }
+  return pixels;
+}
+
+}  // namespace rcm::calib

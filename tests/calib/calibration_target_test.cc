@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <opencv2/aruco/charuco.hpp>
 #include <string>
 #include <vector>
 
@@ -224,13 +225,13 @@ TEST(CalibrationTarget, ErrorMissingKey) {
 TEST(CalibrationTarget, ErrorMissingTargetType) {
   EXPECT_EQ(ErrorOf("targetCols: 6\ntargetRows: 7\n"),
             "t.yaml: missing key 'target_type' (supported: checkerboard, "
-            "aprilgrid)");
+            "aprilgrid, charuco)");
 }
 
 TEST(CalibrationTarget, ErrorUnknownType) {
-  EXPECT_EQ(ErrorOf("\ntarget_type: 'charuco'\n"),
-            "t.yaml:2: unknown target_type 'charuco' (supported: "
-            "checkerboard, aprilgrid)");
+  EXPECT_EQ(ErrorOf("\ntarget_type: 'circlegrid'\n"),
+            "t.yaml:2: unknown target_type 'circlegrid' (supported: "
+            "checkerboard, aprilgrid, charuco)");
 }
 
 TEST(CalibrationTarget, ErrorZeroTagCount) {
@@ -320,7 +321,7 @@ TEST(CalibrationTarget, ErrorEmptyFile) {
 TEST(CalibrationTarget, ErrorTargetTypeWithoutValue) {
   EXPECT_EQ(ErrorOf("target_type:\ntagCols: 6\n"),
             "t.yaml:1: target_type: expected a name, got nothing (supported: "
-            "checkerboard, aprilgrid)");
+            "checkerboard, aprilgrid, charuco)");
 }
 
 TEST(CalibrationTarget, ErrorDuplicateKey) {
@@ -334,7 +335,181 @@ TEST(CalibrationTarget, ErrorDuplicateKey) {
 TEST(CalibrationTarget, ErrorStaysOnOneLine) {
   EXPECT_EQ(ErrorOf("target_type: \"april\\ngrid\"\n"),
             "t.yaml:1: unknown target_type 'april\\x0agrid' (supported: "
-            "checkerboard, aprilgrid)");
+            "checkerboard, aprilgrid, charuco)");
+}
+
+constexpr char kCharuco[] =
+    "target_type: 'charuco'\n"
+    "squaresX: 5\n"
+    "squaresY: 7\n"
+    "squareSize: 0.04\n"
+    "markerSize: 0.03\n"
+    "dictionary: 'DICT_4X4_50'\n";
+
+TEST(CalibrationTarget, ParsesCharuco) {
+  const StatusOr<CalibrationTarget> target =
+      ParseCalibrationTarget(kCharuco, "t.yaml");
+  ASSERT_TRUE(target.ok()) << target.status().message();
+  EXPECT_EQ(target->type, TargetType::kCharuco);
+  EXPECT_EQ(target->cols, 5);
+  EXPECT_EQ(target->rows, 7);
+  EXPECT_EQ(target->square_size, 0.04);
+  EXPECT_EQ(target->marker_size, 0.03);
+  EXPECT_EQ(target->dictionary, "DICT_4X4_50");
+  EXPECT_EQ(target->tag_size, 0.0);
+  EXPECT_EQ(target->col_spacing, 0.0);
+  EXPECT_EQ(NumTargetPoints(*target), 4 * 6);
+  EXPECT_EQ(NumCharucoMarkers(*target), 17);
+}
+
+TEST(CalibrationTarget, CharucoDefaultDictionary) {
+  const CalibrationTarget target = ParseOrDie(
+      "target_type: charuco\nsquaresX: 3\nsquaresY: 2\nsquareSize: 0.1\n"
+      "markerSize: 0.07\n");
+  EXPECT_EQ(target.dictionary, "DICT_6X6_250");
+}
+
+TEST(CalibrationTarget, CharucoPointsAreOpenCvsChessboardCorners) {
+  const CalibrationTarget target = ParseOrDie(kCharuco);
+  const std::vector<Eigen::Vector3d> points = TargetPoints(target);
+  const cv::Ptr<cv::aruco::CharucoBoard> board =
+      cv::aruco::CharucoBoard::create(
+          5, 7, 0.04f, 0.03f,
+          cv::aruco::getPredefinedDictionary(cv::aruco::DICT_4X4_50));
+  ASSERT_EQ(points.size(), board->chessboardCorners.size());
+  for (size_t k = 0; k < points.size(); ++k) {
+    // OpenCV keeps float coordinates.
+    constexpr double kToleranceFloat = 1e-7;
+    EXPECT_NEAR(points[k].x(), board->chessboardCorners[k].x, kToleranceFloat);
+    EXPECT_NEAR(points[k].y(), board->chessboardCorners[k].y, kToleranceFloat);
+    EXPECT_EQ(points[k].z(), 0.0);
+  }
+  // Corner (r, c) is id r * (squaresX - 1) + c at ((c + 1) s, (r + 1) s).
+  ExpectPointNear(points[0], {0.04, 0.04, 0.0});
+  ExpectPointNear(points[1], {0.08, 0.04, 0.0});
+  ExpectPointNear(points[4], {0.04, 0.08, 0.0});
+}
+
+TEST(CalibrationTarget, ErrorCharucoMarkerNotSmallerThanSquare) {
+  EXPECT_EQ(ErrorOf("target_type: 'charuco'\nsquaresX: 5\nsquaresY: 7\n"
+                    "squareSize: 0.04\nmarkerSize: 0.04\n"),
+            "t.yaml:5: markerSize: must be smaller than squareSize (0.04 >= "
+            "0.04)");
+}
+
+TEST(CalibrationTarget, ErrorCharucoOneSquare) {
+  EXPECT_EQ(ErrorOf("target_type: 'charuco'\nsquaresX: 1\nsquaresY: 7\n"
+                    "squareSize: 0.04\nmarkerSize: 0.03\n"),
+            "t.yaml:2: squaresX: must be between 2 and 1000 squares, got 1");
+}
+
+TEST(CalibrationTarget, ErrorCharucoMissingKey) {
+  EXPECT_EQ(ErrorOf("target_type: 'charuco'\nsquaresX: 5\nsquaresY: 7\n"
+                    "squareSize: 0.04\n"),
+            "t.yaml: missing key 'markerSize' (a charuco board needs "
+            "squaresX, squaresY, squareSize, markerSize)");
+}
+
+TEST(CalibrationTarget, ErrorCharucoUnknownDictionary) {
+  EXPECT_EQ(ErrorOf("target_type: 'charuco'\nsquaresX: 5\nsquaresY: 7\n"
+                    "squareSize: 0.04\nmarkerSize: 0.03\n"
+                    "dictionary: DICT_4X4_51\n"),
+            "t.yaml:6: dictionary: unknown dictionary 'DICT_4X4_51' "
+            "(OpenCV's predefined names, e.g. DICT_4X4_50, DICT_6X6_250, "
+            "DICT_APRILTAG_36h11)");
+}
+
+TEST(CalibrationTarget, ErrorCharucoDictionaryTooSmall) {
+  EXPECT_EQ(ErrorOf("target_type: 'charuco'\nsquaresX: 11\nsquaresY: 10\n"
+                    "squareSize: 0.04\nmarkerSize: 0.03\n"
+                    "dictionary: DICT_4X4_50\n"),
+            "t.yaml:6: dictionary: dictionary DICT_4X4_50 has 50 markers, a "
+            "11x10 board needs 55");
+}
+
+TEST(CalibrationTarget, ErrorCharucoDefaultDictionaryTooSmall) {
+  EXPECT_EQ(ErrorOf("target_type: 'charuco'\nsquaresX: 30\n"
+                    "squaresY: 20\nsquareSize: 0.04\nmarkerSize: 0.03\n"),
+            "t.yaml:3: squaresY: dictionary DICT_6X6_250 has 250 markers, a "
+            "30x20 board needs 300 (default dictionary; name a larger one)");
+}
+
+TEST(CalibrationTarget, ErrorCharucoDictionaryIsAList) {
+  EXPECT_EQ(ErrorOf("target_type: 'charuco'\nsquaresX: 5\nsquaresY: 7\n"
+                    "squareSize: 0.04\nmarkerSize: 0.03\n"
+                    "dictionary: [a]\n"),
+            "t.yaml:6: dictionary: expected a name, got a list");
+}
+
+TEST(CalibrationTarget, MakeTargetsLikeTheReader) {
+  const CalibrationTarget checkerboard =
+      MakeCheckerboardTarget(9, 6, 0.025).value();
+  EXPECT_EQ(checkerboard.type, TargetType::kCheckerboard);
+  EXPECT_EQ(checkerboard.col_spacing, 0.025);
+  EXPECT_EQ(checkerboard.row_spacing, 0.025);
+  const CalibrationTarget aprilgrid =
+      MakeAprilGridTarget(6, 6, 0.088, 0.3).value();
+  EXPECT_EQ(aprilgrid.type, TargetType::kAprilGrid);
+  EXPECT_EQ(NumTargetPoints(aprilgrid), 144);
+  const CalibrationTarget charuco =
+      MakeCharucoTarget(5, 7, 0.04, 0.03, "DICT_4X4_50").value();
+  EXPECT_EQ(charuco.dictionary, "DICT_4X4_50");
+  EXPECT_EQ(NumTargetPoints(charuco), 24);
+}
+
+TEST(CalibrationTarget, MakeTargetErrors) {
+  EXPECT_EQ(MakeCheckerboardTarget(9, 1, 0.025).status().message(),
+            "checkerboard: rows must be between 2 and 1000 inner corners, "
+            "got 1");
+  EXPECT_EQ(MakeCheckerboardTarget(9, 6, -1.0).status().message(),
+            "checkerboard: square size must be positive and finite, got -1");
+  EXPECT_EQ(MakeAprilGridTarget(0, 6, 0.088, 0.3).status().message(),
+            "aprilgrid: cols must be between 1 and 1000 tags, got 0");
+  EXPECT_EQ(MakeAprilGridTarget(6, 6, 0.088, 0.0).status().message(),
+            "aprilgrid: tag spacing must be positive and finite, got 0");
+  EXPECT_EQ(
+      MakeCharucoTarget(5, 7, 0.04, 0.05, "DICT_4X4_50").status().message(),
+      "charuco: marker size must be smaller than the square size (0.05 >= "
+      "0.04)");
+  EXPECT_EQ(MakeCharucoTarget(5, 7, 0.04, 0.03, "4x4").status().message(),
+            "charuco: unknown dictionary '4x4' (OpenCV's predefined names, "
+            "e.g. DICT_4X4_50, DICT_6X6_250, DICT_APRILTAG_36h11)");
+  EXPECT_EQ(
+      MakeCharucoTarget(11, 10, 0.04, 0.03, "DICT_4X4_50").status().message(),
+      "charuco: dictionary DICT_4X4_50 has 50 markers, a 11x10 board needs "
+      "55");
+}
+
+TEST(CalibrationTarget, DescribeTarget) {
+  EXPECT_EQ(DescribeTarget(MakeCheckerboardTarget(9, 6, 0.025).value()),
+            "checkerboard 9x6 inner corners, 25 mm squares");
+  EXPECT_EQ(DescribeTarget(ParseOrDie(kKalibrCheckerboard)),
+            "checkerboard 6x7 inner corners, 50 x 60 mm squares");
+  EXPECT_EQ(DescribeTarget(ParseOrDie(kKalibrAprilGrid)),
+            "aprilgrid 6x4 tags, 88 mm tags, spacing 0.3");
+  EXPECT_EQ(DescribeTarget(
+                MakeCharucoTarget(5, 7, 0.04, 0.0305, "DICT_6X6_250").value()),
+            "charuco 5x7 squares, 40 mm squares, 30.5 mm markers, "
+            "DICT_6X6_250");
+}
+
+TEST(CalibrationTarget, FindArucoDictionary) {
+  ASSERT_TRUE(FindArucoDictionary("DICT_APRILTAG_36h11").has_value());
+  EXPECT_EQ(FindArucoDictionary("DICT_APRILTAG_36h11")->num_markers, 587);
+  EXPECT_EQ(FindArucoDictionary("DICT_6X6_250")->opencv_id,
+            cv::aruco::DICT_6X6_250);
+  EXPECT_FALSE(FindArucoDictionary("dict_6x6_250").has_value());
+  // The sizes are OpenCV's.
+  for (const char* name :
+       {"DICT_4X4_50", "DICT_5X5_1000", "DICT_7X7_250", "DICT_ARUCO_ORIGINAL",
+        "DICT_APRILTAG_16h5", "DICT_APRILTAG_36h10"}) {
+    const std::optional<ArucoDictionaryInfo> info = FindArucoDictionary(name);
+    ASSERT_TRUE(info.has_value()) << name;
+    EXPECT_EQ(
+        info->num_markers,
+        cv::aruco::getPredefinedDictionary(info->opencv_id)->bytesList.rows)
+        << name;
+  }
 }
 
 TEST(CalibrationTarget, ErrorRootIsNotAMap) {
