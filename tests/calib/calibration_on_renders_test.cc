@@ -17,7 +17,7 @@
 namespace rcm::calib {
 namespace {
 
-constexpr double kMaxFocalError = 1e-3;   // relative
+constexpr double kMaxFocalError = 1e-3;  // relative
 constexpr double kMaxPrincipalPointErrorPx = 0.5;
 constexpr double kMaxBaselineError = 1e-3;  // relative
 
@@ -36,8 +36,8 @@ StereoCalibration CalibrateOnRenders(const StereoRig& rig,
   TargetRenderOptions render;
   render.noise_sigma = 2.0;
   render.blur_sigma_px = 0.5;
-  const std::vector<Rigid3d> poses = test::BoardPoses(
-      rig.left(), target, num_poses, seed, 0.5, 0.9, 30.0);
+  const std::vector<Rigid3d> poses =
+      test::BoardPoses(rig.left(), target, num_poses, seed, 0.5, 0.9, 30.0);
   std::vector<StereoView> views;
   int stereo = 0;
   for (size_t v = 0; v < poses.size(); ++v) {
@@ -69,10 +69,9 @@ void ExpectAccurate(const StereoCalibration& calibration,
   for (int c = 0; c < 2; ++c) {
     const Camera& e = *estimates[c];
     const Camera& t = *truths[c];
-    std::printf(
-        "cam%d: fx %+.2e fy %+.2e (relative), cx %+.3f cy %+.3f px\n", c,
-        e.fx() / t.fx() - 1.0, e.fy() / t.fy() - 1.0, e.cx() - t.cx(),
-        e.cy() - t.cy());
+    std::printf("cam%d: fx %+.2e fy %+.2e (relative), cx %+.3f cy %+.3f px\n",
+                c, e.fx() / t.fx() - 1.0, e.fy() / t.fy() - 1.0,
+                e.cx() - t.cx(), e.cy() - t.cy());
     EXPECT_LT(std::abs(e.fx() / t.fx() - 1.0), kMaxFocalError) << "cam" << c;
     EXPECT_LT(std::abs(e.fy() / t.fy() - 1.0), kMaxFocalError) << "cam" << c;
     EXPECT_LT(std::abs(e.cx() - t.cx()), kMaxPrincipalPointErrorPx)
