@@ -118,8 +118,8 @@ TEST(OpenCvSampleStereo, RmsNoWorseThanStereoCalibrate) {
   ASSERT_TRUE(calibration.ok()) << calibration.status().message();
   const double opencv_rms = OpenCvStereoRms(views);
   std::printf(
-      "rcm rms %.6f px over %d corners (%d outliers, inlier rms %.6f), "
-      "cv::stereoCalibrate rms %.6f px\n",
+      "rcm rms %.8f px over %d corners (%d outliers, inlier rms %.8f), "
+      "cv::stereoCalibrate rms %.8f px\n",
       calibration->rms_px, calibration->num_inliers + calibration->num_outliers,
       calibration->num_outliers, calibration->inlier_rms_px, opencv_rms);
   std::printf("cam0 f %.3f %.3f c %.3f %.3f (sigma %.3f %.3f %.3f %.3f)\n",

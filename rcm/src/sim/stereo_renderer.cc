@@ -19,13 +19,6 @@ constexpr int kFloatsPerSample = 7;
 // Rows per thread below which ParallelFor stays on one thread.
 constexpr int64_t kMinRowsPerThread = 8;
 
-// A standard normal draw from one 64-bit hash (Box-Muller on its halves).
-double GaussianFromHash(uint64_t hash) {
-  const double u1 = (static_cast<double>(hash >> 32) + 0.5) * 0x1.0p-32;
-  const double u2 = static_cast<double>(hash & 0xFFFFFFFFull) * 0x1.0p-32;
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
-}
-
 // A sample whose ray could be traced (a unit direction, not zero).
 bool ValidSample(const float* sample) {
   return sample[3] * sample[3] + sample[4] * sample[4] + sample[5] * sample[5] >

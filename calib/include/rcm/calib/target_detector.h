@@ -1,8 +1,9 @@
 // Finding a calibration target's corners in an image (OpenCV), with point
 // ids as TargetPoints (calibration_target.h) numbers them.
 //
-// - checkerboard: cv::findChessboardCornersSB (CALIB_CB_EXHAUSTIVE |
-//   CALIB_CB_ACCURACY) with patternSize (cols, rows): detector
+// - checkerboard: cv::findChessboardCornersSB with patternSize (cols,
+//   rows), flags EXHAUSTIVE | ACCURACY, then ACCURACY alone, then
+//   NORMALIZE_IMAGE | EXHAUSTIVE | ACCURACY until one finds it: detector
 //   "chessboard-sb". Should it fail and chessboard_fallback is set, the
 //   classic cv::findChessboardCorners (adaptive threshold, normalized
 //   image) refined by cv::cornerSubPix: "chessboard-classic". The corners

@@ -5,6 +5,7 @@
 #ifndef RCM_UTIL_SPLITMIX64_H_
 #define RCM_UTIL_SPLITMIX64_H_
 
+#include <cmath>
 #include <cstdint>
 
 namespace rcm {
@@ -16,6 +17,15 @@ constexpr uint64_t SplitMix64(uint64_t x) {
   x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
   x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
   return x ^ (x >> 31);
+}
+
+// A standard normal draw from one 64-bit hash (e.g. SplitMix64 of a seed
+// and a pixel index): Box-Muller on its two 32-bit halves, so that a noise
+// image depends on the seed and the pixel only, not on thread scheduling.
+inline double GaussianFromHash(uint64_t hash) {
+  const double u1 = (static_cast<double>(hash >> 32) + 0.5) * 0x1.0p-32;
+  const double u2 = static_cast<double>(hash & 0xFFFFFFFFull) * 0x1.0p-32;
+  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
 }
 
 }  // namespace rcm
