@@ -236,7 +236,9 @@ TEST(StereoCalibration, RejectsGrossOutliers) {
   const StereoCalibration calibration = Calibrate(truth, views).value();
   EXPECT_EQ(calibration.num_outliers, num_moved);
   for (const CornerResidual& corner : calibration.corners) {
-    if (!corner.inlier) EXPECT_GT(corner.residual.norm(), 5.0);
+    if (!corner.inlier) {
+      EXPECT_GT(corner.residual.norm(), 5.0);
+    }
   }
   EXPECT_NEAR(calibration.pixel_sigma, kNoisePx, 0.1 * kNoisePx);
   EXPECT_LT(std::abs(calibration.cam0.camera.fx() - truth.rig.left().fx()),
