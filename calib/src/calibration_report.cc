@@ -15,6 +15,7 @@
 #include "rcm/io/atomic_file.h"
 #include "rcm/io/image_file.h"
 #include "rcm/io/number_format.h"
+#include "rcm/viz/color_map.h"
 #include "rcm/viz/line_plot.h"
 
 namespace rcm::calib {
@@ -428,18 +429,9 @@ void DrawGridAndFrame(const PanelLayout& layout, int cols, int rows,
       true, kFrame, 1.0);
 }
 
-// The viridis color of t in [0, 1].
+// The viridis color of t in [0, 1] (that of 0 when t is not finite).
 cv::Scalar Viridis(double t) {
-  static const cv::Mat lut = [] {
-    cv::Mat ramp(1, 256, CV_8UC1);
-    for (int i = 0; i < 256; ++i) ramp.at<unsigned char>(0, i) = i;
-    cv::Mat colors;
-    cv::applyColorMap(ramp, colors, cv::COLORMAP_VIRIDIS);
-    return colors;
-  }();
-  const int index = static_cast<int>(
-      std::lround(std::clamp(Finite(t) ? t : 0.0, 0.0, 1.0) * 255));
-  const cv::Vec3b c = lut.at<cv::Vec3b>(0, index);
+  const cv::Vec3b c = ColorMapColor(cv::COLORMAP_VIRIDIS, t);
   return cv::Scalar(c[0], c[1], c[2]);
 }
 

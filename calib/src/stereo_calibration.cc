@@ -368,18 +368,13 @@ StatusOr<StereoCalibration> CalibrateStereo(
   const int num_lens_params = cameras[0]->num_params();
   const int num_parameters = 2 * num_lens_params + 6 + 6 * num_views_used;
 
-  auto rms_over = [&](bool inliers_only) {
-    double sum = 0.0;
-    int count = 0;
-    for (const Corner& corner : corners) {
-      if (inliers_only && !corner.inlier) continue;
-      sum += Residual(options.model, corner, target_points, parameters)
-                 .squaredNorm();
-      ++count;
-    }
-    return count == 0 ? 0.0 : std::sqrt(sum / count);
-  };
-  result.initial_rms_px = rms_over(false);
+  double initial_sum = 0.0;
+  for (const Corner& corner : corners) {
+    initial_sum += Residual(options.model, corner, target_points, parameters)
+                       .squaredNorm();
+  }
+  result.initial_rms_px =
+      corners.empty() ? 0.0 : std::sqrt(initial_sum / corners.size());
 
   // Robust solves with outlier rejection, then least squares on the inliers.
   for (int round = 0; round < options.max_outlier_rounds; ++round) {
@@ -443,6 +438,8 @@ StatusOr<StereoCalibration> CalibrateStereo(
           RigidFromPose(parameters.cam0_from_target[v].data());
     }
   }
+  // Each corner's final residual, evaluated once.
+  double sum = 0.0;
   double inlier_sum = 0.0;
   for (const Corner& corner : corners) {
     CornerResidual out;
@@ -452,6 +449,7 @@ StatusOr<StereoCalibration> CalibrateStereo(
     out.pixel = corner.pixel;
     out.residual = Residual(options.model, corner, target_points, parameters);
     out.inlier = corner.inlier;
+    sum += out.residual.squaredNorm();
     if (corner.inlier) {
       ++result.num_inliers;
       inlier_sum += out.residual.squaredNorm();
@@ -460,8 +458,10 @@ StatusOr<StereoCalibration> CalibrateStereo(
     }
     result.corners.push_back(out);
   }
-  result.rms_px = rms_over(false);
-  result.inlier_rms_px = rms_over(true);
+  result.rms_px = corners.empty() ? 0.0 : std::sqrt(sum / corners.size());
+  result.inlier_rms_px = result.num_inliers == 0
+                             ? 0.0
+                             : std::sqrt(inlier_sum / result.num_inliers);
   result.num_views_used = num_views_used;
   for (int v = 0; v < num_views; ++v) {
     if (view_used[v] && used[v][0] != nullptr && used[v][1] != nullptr) {

@@ -87,10 +87,6 @@ constexpr char kUsage[] =
     "36h11),\n"
     "charuco (OpenCV's).";
 
-nlohmann::json JsonNumber(double value) {
-  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json();
-}
-
 StatusOr<CalibrationTarget> TargetFromFlags() {
   if (!FLAGS_target.empty()) {
     if (!FLAGS_board.empty()) {

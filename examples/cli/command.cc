@@ -3,6 +3,7 @@
 #include <gflags/gflags.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <iostream>
 #include <string>
@@ -113,6 +114,14 @@ void PrintError(const Subcommand& subcommand, const std::string& message) {
 void PrintWarning(const Subcommand& subcommand, const std::string& message) {
   std::cerr << "rcm " << subcommand.name << ": warning: " << message
             << std::endl;
+}
+
+nlohmann::json JsonNumber(double value) {
+  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json();
+}
+
+nlohmann::json JsonNumber(const std::optional<double>& value) {
+  return value ? JsonNumber(*value) : nlohmann::json();
 }
 
 }  // namespace rcm::cli

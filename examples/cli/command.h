@@ -5,6 +5,8 @@
 
 #include <gflags/gflags.h>
 
+#include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,13 +29,18 @@ struct Subcommand {
   // flag files (rig_flags.cc, simulation_flags.cc). The flags of
   // command.cc (--json) belong to every subcommand.
   std::vector<const char*> flag_sources;
-  int (*run)();         // runs after the flags are parsed
+  int (*run)();  // runs after the flags are parsed
 };
 
 // Parses the flags of `subcommand` from argv (argv[0] = "rcm NAME"),
 // handles --help, and rejects flags that belong to other subcommands.
 // Returns the exit code to stop with, or -1 to go on and run it.
 int ParseSubcommandFlags(const Subcommand& subcommand, int* argc, char*** argv);
+
+// A JSON number, or null when `value` is not finite (or absent): JSON has
+// no NaN or infinity.
+nlohmann::json JsonNumber(double value);
+nlohmann::json JsonNumber(const std::optional<double>& value);
 
 // Writes "rcm NAME: error: MESSAGE" as one line on stderr.
 void PrintError(const Subcommand& subcommand, const std::string& message);

@@ -126,14 +126,6 @@ constexpr double kRectifiedToleranceDeg = 0.05;
 
 double Degrees(double radians) { return radians * 180.0 / M_PI; }
 
-// JSON number, or null when not finite.
-nlohmann::json JsonNumber(double value) {
-  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json();
-}
-nlohmann::json JsonNumber(const std::optional<double>& value) {
-  return value ? JsonNumber(*value) : nlohmann::json();
-}
-
 // One frame of the input: consecutive correspondences with equal `frame`.
 struct Frame {
   int64_t frame = 0;

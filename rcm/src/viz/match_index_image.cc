@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "rcm/io/number_format.h"
+#include "rcm/viz/color_map.h"
 
 namespace rcm {
 namespace {
@@ -20,17 +21,7 @@ const cv::Scalar kInk(30, 30, 30);
 const cv::Scalar kPaper(255, 255, 255);
 
 // The turbo color of t in [0, 1].
-cv::Vec3b Turbo(double t) {
-  static const cv::Mat lut = [] {
-    cv::Mat ramp(1, 256, CV_8UC1);
-    for (int i = 0; i < 256; ++i) ramp.at<unsigned char>(0, i) = i;
-    cv::Mat colors;
-    cv::applyColorMap(ramp, colors, cv::COLORMAP_TURBO);
-    return colors;
-  }();
-  const int index = static_cast<int>(std::lround(std::clamp(t, 0.0, 1.0) * 255));
-  return lut.at<cv::Vec3b>(0, index);
-}
+cv::Vec3b Turbo(double t) { return ColorMapColor(cv::COLORMAP_TURBO, t); }
 
 }  // namespace
 
