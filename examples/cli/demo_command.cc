@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "command.h"
+#include "index_flag.h"
 #include "rcm/camera/refractive_camera.h"
 #include "rcm/camera/virtual_pinhole_remap.h"
 #include "rcm/estimation/batch_refinement.h"
@@ -66,7 +67,7 @@ extern const Subcommand kDemoCommand = {
     "demo",
     "simulate a dive, estimate n from the images, plot it (no input needed)",
     kUsage,
-    {__FILE__, kSimulationFlagsSource},
+    {__FILE__, kSimulationFlagsSource, kIndexFlagSource},
     RunDemo};
 
 namespace {

@@ -11,19 +11,23 @@
 
 namespace rcm::cli {
 extern const Subcommand kCalibrateCommand;
+extern const Subcommand kCompareCommand;
 extern const Subcommand kDemoCommand;
 extern const Subcommand kEstimateCommand;
+extern const Subcommand kExportCommand;
 extern const Subcommand kSimulateCommand;
+extern const Subcommand kUndistortCommand;
 }  // namespace rcm::cli
 
 namespace {
 
 using rcm::cli::Subcommand;
 
-const Subcommand* const kSubcommands[] = {&rcm::cli::kCalibrateCommand,
-                                          &rcm::cli::kDemoCommand,
-                                          &rcm::cli::kEstimateCommand,
-                                          &rcm::cli::kSimulateCommand};
+const Subcommand* const kSubcommands[] = {
+    &rcm::cli::kCalibrateCommand, &rcm::cli::kCompareCommand,
+    &rcm::cli::kDemoCommand,      &rcm::cli::kEstimateCommand,
+    &rcm::cli::kExportCommand,    &rcm::cli::kSimulateCommand,
+    &rcm::cli::kUndistortCommand};
 
 void PrintUsage(std::ostream& out) {
   out << "rcm: the refractive index of the water from a stereo camera "

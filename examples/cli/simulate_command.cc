@@ -9,6 +9,7 @@
 #include <string>
 
 #include "command.h"
+#include "index_flag.h"
 #include "progress.h"
 #include "rcm/io/atomic_file.h"
 #include "rcm/io/number_format.h"
@@ -69,7 +70,7 @@ extern const Subcommand kSimulateCommand = {
     "simulate",
     "synthetic stereo sequence through exact flat ports, with ground truth",
     kUsage,
-    {__FILE__, kSimulationFlagsSource, kRigFlagsSource},
+    {__FILE__, kSimulationFlagsSource, kIndexFlagSource, kRigFlagsSource},
     RunSimulate};
 
 namespace {

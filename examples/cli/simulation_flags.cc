@@ -3,11 +3,11 @@
 #include <cmath>
 #include <sstream>
 
+#include "index_flag.h"
 #include "rcm/io/stereo_rig_file.h"
 #include "rcm/sim/media_schedule.h"
 #include "rcm/sim/reference_rigs.h"
 
-DEFINE_double(n, 1.333, "refractive index of the water, in [1, 2]");
 DEFINE_string(media, "",
               "media per frame, MEDIUM:FRAMES,... with MEDIUM air, water (= "
               "--n) or an index, e.g. water:30,air:30,water:30 (default: "
@@ -53,11 +53,8 @@ StatusOr<Simulation> SimulationFromFlags(const std::string& calib,
                          ": expected alphasense or alphasense-unrectified");
   }
 
-  if (!std::isfinite(FLAGS_n) || FLAGS_n < 1.0 || FLAGS_n > 2.0) {
-    std::ostringstream message;
-    message << "--n " << FLAGS_n << " is outside [1, 2]";
-    return Status::Error(message.str());
-  }
+  StatusOr<double> n = RefractiveIndexFromFlag(/*required=*/false);
+  if (!n.ok()) return n.status();
   StatusOr<MediaSchedule> media =
       FLAGS_media.empty() ? MediaSchedule::Constant(FLAGS_n, FLAGS_frames)
                           : MediaSchedule::Parse(FLAGS_media, FLAGS_n);

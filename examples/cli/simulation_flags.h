@@ -12,7 +12,6 @@
 #include "rcm/sim/sequence_simulator.h"
 #include "rcm/util/status.h"
 
-DECLARE_double(n);
 DECLARE_string(media);
 DECLARE_int32(frames);
 DECLARE_string(rig);

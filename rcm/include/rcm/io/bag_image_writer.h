@@ -17,6 +17,7 @@
 #include <opencv2/core.hpp>
 #include <string>
 
+#include "rcm/io/camera_info.h"
 #include "rcm/util/status.h"
 
 namespace rcm {
@@ -53,6 +54,14 @@ class BagImageWriter {
   Status WriteCompressed(const std::string& topic, double stamp_s,
                          const cv::Mat& image, const std::string& format,
                          const std::string& frame_id);
+
+  // Writes `info` as a sensor_msgs/CameraInfo on `topic` (stamp and
+  // frame_id as WriteImage): width, height, distortion_model and D as
+  // FormatCameraInfo (camera_info.h) writes them, K, R, P row-major,
+  // binning 0 and an empty ROI. Errors: as WriteImage's stamp and topic
+  // errors, a failed write.
+  Status WriteCameraInfo(const std::string& topic, double stamp_s,
+                         const CameraInfo& info, const std::string& frame_id);
 
   // Finishes the bag (writes its index) and renames it to its path. Once
   // a write failed, Close() fails too and removes the temporary file, so a

@@ -64,6 +64,26 @@ StatusOr<CameraInfo> ParseCameraInfo(const std::string& text,
                                      const std::string& source_name);
 StatusOr<CameraInfo> ReadCameraInfo(const std::string& path);
 
+// The camera_info of a camera used on its own, unrectified: R = I and
+// P = [K | 0].
+CameraInfo CameraInfoFromCamera(const std::string& camera_name,
+                                const Camera& camera);
+
+// The text camera_calibration_parsers writes (keys in its order:
+// image_width, image_height, camera_name, camera_matrix, distortion_model,
+// distortion_coefficients, rectification_matrix, projection_matrix, each
+// matrix with rows, cols and a flow list `data`), numbers in their
+// shortest round-trip form (number_format.h), so that ParseCameraInfo
+// reads back exactly the numbers written. Distortion models written:
+//   radtan       -> plumb_bob [k1, k2, p1, p2, 0];
+//   equidistant  -> equidistant [k1, k2, k3, k4];
+//   pinhole      -> plumb_bob [0, 0, 0, 0, 0], what ROS tools expect of an
+//                   undistorted camera (it reads back as radtan with zero
+//                   coefficients: the same projection).
+std::string FormatCameraInfo(const CameraInfo& info);
+// Writes atomically (WriteFileAtomically): on failure `path` is untouched.
+Status WriteCameraInfo(const std::string& path, const CameraInfo& info);
+
 // The stereo rig described by the camera_info files of the left and right
 // cameras of a pair calibrated by ROS (stereo_calibrate / stereoRectify).
 //
