@@ -428,6 +428,19 @@ std::optional<int> CamchainCameraIndex(std::string_view name) {
   return index;
 }
 
+StatusOr<int> FindCamchainCamera(const Camchain& camchain,
+                                 std::string_view name) {
+  const int num_cameras = static_cast<int>(camchain.cameras.size());
+  const std::optional<int> index = CamchainCameraIndex(name);
+  if (index.has_value() && *index < num_cameras) return *index;
+  std::string known;
+  for (int k = 0; k < num_cameras; ++k) {
+    known += (k == 0 ? "cam" : ", cam") + std::to_string(k);
+  }
+  return Status::Error("unknown camera '" + std::string(name) +
+                       "' (the camchain has " + known + ")");
+}
+
 StatusOr<Camchain> ParseCamchain(const std::string& text,
                                  const std::string& source_name) {
   const YamlReader reader(source_name);

@@ -1,53 +1,26 @@
 #include "rcm/io/stereo_rig_file.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <optional>
 #include <utility>
 
 #include "rcm/io/atomic_file.h"
 #include "rcm/io/camchain.h"
+#include "rcm/io/camera_file.h"
 #include "rcm/io/camera_info.h"
-#include "rcm/io/yaml_fields.h"
 
 namespace rcm {
 namespace {
 
-enum class RigFileFormat { kCamchain, kCameraInfo };
-
-// Recognises the format of a rig file from its top-level keys. Empty files
-// and YAML syntax errors are handed to the camchain parser, whose error
-// message describes the problem.
-StatusOr<RigFileFormat> DetectFormat(const std::string& path,
-                                     const std::string& text) {
-  const StatusOr<YAML::Node> root = YamlReader(path).Load(text);
-  if (!root.ok() || root->IsNull()) return RigFileFormat::kCamchain;
-  bool has_cam0 = false;
-  bool has_camera_matrix = false;
-  if (root->IsMap()) {
-    for (auto it = root->begin(); it != root->end(); ++it) {
-      if (!it->first.IsScalar()) continue;
-      has_cam0 = has_cam0 || it->first.Scalar() == "cam0";
-      has_camera_matrix =
-          has_camera_matrix || it->first.Scalar() == "camera_matrix";
-    }
-  }
-  if (has_cam0) return RigFileFormat::kCamchain;
-  if (has_camera_matrix) return RigFileFormat::kCameraInfo;
-  return Status::Error(path +
-                       ": neither a Kalibr camchain (no 'cam0') nor a ROS "
-                       "camera_info (no 'camera_matrix')");
-}
-
 // Reads a file and recognises its format.
 struct RigFile {
   std::string text;
-  RigFileFormat format;
+  CalibrationFileFormat format;
 };
 StatusOr<RigFile> ReadRigFile(const std::string& path) {
   StatusOr<std::string> text = ReadFileToString(path);
   if (!text.ok()) return text.status();
-  const StatusOr<RigFileFormat> format = DetectFormat(path, *text);
+  const StatusOr<CalibrationFileFormat> format =
+      DetectCalibrationFileFormat(path, *text);
   if (!format.ok()) return format.status();
   return RigFile{std::move(text).value(), *format};
 }
@@ -58,19 +31,11 @@ StatusOr<StereoRig> ReadCamchainRig(const std::string& path,
                                     const std::string& right) {
   const StatusOr<Camchain> camchain = ParseCamchain(text, path);
   if (!camchain.ok()) return camchain.status();
-  const int num_cameras = static_cast<int>(camchain->cameras.size());
   int indices[2];
   const std::string* names[2] = {&left, &right};
   for (int i = 0; i < 2; ++i) {
-    const std::optional<int> index = CamchainCameraIndex(*names[i]);
-    if (!index.has_value() || *index >= num_cameras) {
-      std::string known;
-      for (int k = 0; k < num_cameras; ++k) {
-        known += (k == 0 ? "cam" : ", cam") + std::to_string(k);
-      }
-      return Status::Error(path + ": unknown camera '" + *names[i] +
-                           "' (the camchain has " + known + ")");
-    }
+    const StatusOr<int> index = FindCamchainCamera(*camchain, *names[i]);
+    if (!index.ok()) return index.status().WithContext(path);
     indices[i] = *index;
   }
   const StatusOr<StereoRig> rig =
@@ -86,7 +51,7 @@ StatusOr<StereoRig> ReadCameraInfoPair(const std::string& left_path,
   for (int i = 0; i < 2; ++i) {
     const StatusOr<RigFile> file = ReadRigFile(paths[i]);
     if (!file.ok()) return file.status();
-    if (file->format != RigFileFormat::kCameraInfo) {
+    if (file->format != CalibrationFileFormat::kCameraInfo) {
       return Status::Error(paths[i] +
                            ": is a Kalibr camchain, expected a ROS "
                            "camera_info (give a camchain alone, not in a "
@@ -130,7 +95,7 @@ StatusOr<StereoRig> ReadStereoRig(const std::string& spec,
 
   const StatusOr<RigFile> file = ReadRigFile(spec);
   if (!file.ok()) return file.status();
-  if (file->format == RigFileFormat::kCameraInfo) {
+  if (file->format == CalibrationFileFormat::kCameraInfo) {
     return Status::Error(spec +
                          ": is a ROS camera_info, which describes one camera; "
                          "give the left and right files as "

@@ -75,6 +75,11 @@ struct Camchain {
 // leading zero that fits an int); nullopt for any other name.
 std::optional<int> CamchainCameraIndex(std::string_view name);
 
+// The index of camera `name` in `camchain`. Error (without a source
+// prefix): "unknown camera 'cam2' (the camchain has cam0, cam1)".
+StatusOr<int> FindCamchainCamera(const Camchain& camchain,
+                                 std::string_view name);
+
 // Parses camchain text. `source_name` (usually the path) prefixes every
 // error message.
 StatusOr<Camchain> ParseCamchain(const std::string& text,
