@@ -4,17 +4,23 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "support/camera_info_text.h"
 #include "support/reader_inputs.h"
 #include "support/temp_file.h"
+#include "support/test_rigs.h"
 
 namespace rcm {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 using ::testing::StartsWith;
 
 // A camera_info as camera_calibration_parsers writes it (the ROS stereo
@@ -409,6 +415,204 @@ TEST(CameraInfo, ReadRejectsMissingFile) {
   ASSERT_FALSE(info.ok());
   EXPECT_EQ(info.status().message(),
             path + ": cannot open: No such file or directory");
+}
+
+// --- Writing
+// ---------------------------------------------------------------------
+
+// EuRoC's cam0, with a coefficient that prints in scientific notation.
+Camera EurocCamera() {
+  return Camera::Create(LensModelId::kRadTan, 752, 480,
+                        {458.654, 457.296, 367.215, 248.375},
+                        {-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05})
+      .value();
+}
+
+// Formats `info` and parses the text back; a parse error fails the test.
+CameraInfo FormatAndParse(const CameraInfo& info) {
+  const std::string text = FormatCameraInfo(info);
+  StatusOr<CameraInfo> parsed = ParseCameraInfo(text, "written.yaml");
+  EXPECT_TRUE(parsed.ok()) << parsed.status().message() << "\n" << text;
+  return parsed.ok() ? std::move(parsed).value() : info;
+}
+
+// The names in this directory of files starting with `prefix`.
+std::vector<std::string> FilesStartingWith(const std::string& directory,
+                                           const std::string& prefix) {
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(directory)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(prefix, 0) == 0) names.push_back(name);
+  }
+  return names;
+}
+
+TEST(CameraInfo, FromCameraIsUnrectified) {
+  const CameraInfo info = CameraInfoFromCamera("cam0", EurocCamera());
+  EXPECT_EQ(info.camera_name, "cam0");
+  EXPECT_EQ(info.camera, EurocCamera());
+  EXPECT_EQ(info.rectification, Eigen::Matrix3d::Identity());
+  Eigen::Matrix<double, 3, 4> expected;
+  expected << 458.654, 0.0, 367.215, 0.0, 0.0, 457.296, 248.375, 0.0, 0.0, 0.0,
+      1.0, 0.0;
+  EXPECT_EQ(info.projection, expected);
+}
+
+TEST(CameraInfo, FormatIsWhatCameraCalibrationParsersWrite) {
+  EXPECT_EQ(FormatCameraInfo(CameraInfoFromCamera("cam0", EurocCamera())),
+            "image_width: 752\n"
+            "image_height: 480\n"
+            "camera_name: cam0\n"
+            "camera_matrix:\n"
+            "  rows: 3\n"
+            "  cols: 3\n"
+            "  data: [458.654, 0.0, 367.215, 0.0, 457.296, 248.375, 0.0, 0.0, "
+            "1.0]\n"
+            "distortion_model: plumb_bob\n"
+            "distortion_coefficients:\n"
+            "  rows: 1\n"
+            "  cols: 5\n"
+            "  data: [-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05, "
+            "0.0]\n"
+            "rectification_matrix:\n"
+            "  rows: 3\n"
+            "  cols: 3\n"
+            "  data: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]\n"
+            "projection_matrix:\n"
+            "  rows: 3\n"
+            "  cols: 4\n"
+            "  data: [458.654, 0.0, 367.215, 0.0, 0.0, 457.296, 248.375, 0.0, "
+            "0.0, 0.0, 1.0, 0.0]\n");
+}
+
+TEST(CameraInfo, RoundTripsRadTanBitExactly) {
+  const CameraInfo info = CameraInfoFromCamera("cam0", EurocCamera());
+  const CameraInfo parsed = FormatAndParse(info);
+  EXPECT_EQ(parsed.camera_name, "cam0");
+  EXPECT_EQ(parsed.camera, info.camera);
+  EXPECT_EQ(parsed.rectification, info.rectification);
+  EXPECT_EQ(parsed.projection, info.projection);
+}
+
+TEST(CameraInfo, RoundTripsEquidistantBitExactly) {
+  for (const Camera& camera : {test::AlphasenseCam0(), test::AlphasenseCam1(),
+                               test::WideEquidistantCamera()}) {
+    ASSERT_EQ(camera.model(), LensModelId::kEquidistant);
+    const CameraInfo info = CameraInfoFromCamera("fisheye", camera);
+    EXPECT_THAT(FormatCameraInfo(info),
+                HasSubstr("\ndistortion_model: equidistant\n"
+                          "distortion_coefficients:\n  rows: 1\n  cols: 4\n"));
+    const CameraInfo parsed = FormatAndParse(info);
+    EXPECT_EQ(parsed.camera, camera);
+    EXPECT_EQ(parsed.projection, info.projection);
+  }
+}
+
+TEST(CameraInfo, PinholeReadsBackAsZeroRadTanWithTheSameProjection) {
+  const Camera pinhole = test::PinholeCamera();
+  const CameraInfo info = CameraInfoFromCamera("pinhole", pinhole);
+  EXPECT_THAT(FormatCameraInfo(info),
+              HasSubstr("distortion_model: plumb_bob\n"
+                        "distortion_coefficients:\n  rows: 1\n  cols: 5\n"
+                        "  data: [0.0, 0.0, 0.0, 0.0, 0.0]\n"));
+  const CameraInfo parsed = FormatAndParse(info);
+  EXPECT_EQ(parsed.camera.model(), LensModelId::kRadTan);
+  EXPECT_EQ(parsed.camera.Distortion(), std::vector<double>(4, 0.0));
+  EXPECT_EQ(parsed.camera.width(), pinhole.width());
+  EXPECT_EQ(parsed.camera.height(), pinhole.height());
+  EXPECT_EQ(parsed.projection, info.projection);
+  for (const Eigen::Vector2d& pixel : test::ImageGrid(pinhole, 80.0)) {
+    const std::optional<Eigen::Vector2d> expected =
+        pinhole.NormalizedFromImage(pixel);
+    const std::optional<Eigen::Vector2d> normalized =
+        parsed.camera.NormalizedFromImage(pixel);
+    ASSERT_TRUE(expected.has_value() && normalized.has_value());
+    EXPECT_LT((*normalized - *expected).norm(), 1e-12) << pixel.transpose();
+    EXPECT_LT((parsed.camera.ImageFromNormalized(*expected) - pixel).norm(),
+              1e-9)
+        << pixel.transpose();
+  }
+}
+
+TEST(CameraInfo, CameraNamesThatNeedQuotingRoundTrip) {
+  for (const std::string name : {"", "alphasense/left", "a: b", "#1", "null",
+                                 "~", "[x]", "it's \"q\""}) {
+    const CameraInfo parsed =
+        FormatAndParse(CameraInfoFromCamera(name, EurocCamera()));
+    EXPECT_EQ(parsed.camera_name, name);
+  }
+}
+
+TEST_F(CameraInfoStereo, WrittenFilesReproduceTheRig) {
+  const StatusOr<CameraInfo> left = ParseCameraInfo(left_text_, "left.yaml");
+  const StatusOr<CameraInfo> right = ParseCameraInfo(right_text_, "right.yaml");
+  ASSERT_TRUE(left.ok() && right.ok());
+  const std::string left_path = test::TempFilePath("left.yaml");
+  const std::string right_path = test::TempFilePath("right.yaml");
+  ASSERT_TRUE(WriteCameraInfo(left_path, *left).ok());
+  ASSERT_TRUE(WriteCameraInfo(right_path, *right).ok());
+  const StatusOr<CameraInfo> left_read = ReadCameraInfo(left_path);
+  const StatusOr<CameraInfo> right_read = ReadCameraInfo(right_path);
+  ASSERT_TRUE(left_read.ok()) << left_read.status().message();
+  ASSERT_TRUE(right_read.ok()) << right_read.status().message();
+  for (const auto& [read, original] :
+       {std::pair{&*left_read, &*left}, std::pair{&*right_read, &*right}}) {
+    EXPECT_EQ(read->camera_name, original->camera_name);
+    EXPECT_EQ(read->camera, original->camera);
+    EXPECT_EQ(read->rectification, original->rectification);
+    EXPECT_EQ(read->projection, original->projection);
+  }
+  const StatusOr<StereoRig> expected = StereoRigFromCameraInfo(*left, *right);
+  const StatusOr<StereoRig> rig =
+      StereoRigFromCameraInfo(*left_read, *right_read);
+  ASSERT_TRUE(expected.ok() && rig.ok());
+  EXPECT_EQ(rig->right_from_left().rotation,
+            expected->right_from_left().rotation);
+  EXPECT_EQ(rig->right_from_left().translation,
+            expected->right_from_left().translation);
+  EXPECT_LT((rig->right_from_left().translation - right_from_left_.translation)
+                .cwiseAbs()
+                .maxCoeff(),
+            1e-12);
+  EXPECT_EQ(rig->left(), expected->left());
+  EXPECT_EQ(rig->right(), expected->right());
+  std::remove(left_path.c_str());
+  std::remove(right_path.c_str());
+}
+
+TEST(CameraInfo, WriteReplacesAnExistingFile) {
+  const std::string path = test::WriteTempFile("cam.yaml", "old contents\n");
+  const CameraInfo info = CameraInfoFromCamera("cam0", EurocCamera());
+  ASSERT_TRUE(WriteCameraInfo(path, info).ok());
+  const StatusOr<CameraInfo> read = ReadCameraInfo(path);
+  ASSERT_TRUE(read.ok()) << read.status().message();
+  EXPECT_EQ(read->camera, info.camera);
+  std::remove(path.c_str());
+}
+
+TEST(CameraInfo, WriteToUnwritableDirectoryFailsAndLeavesNothing) {
+  const std::string directory = test::TempFilePath("no_such_dir");
+  const std::string path = directory + "/cam0.yaml";
+  const Status status =
+      WriteCameraInfo(path, CameraInfoFromCamera("cam0", EurocCamera()));
+  ASSERT_FALSE(status.ok());
+  EXPECT_EQ(status.message(),
+            path + ": cannot write: No such file or directory");
+  EXPECT_FALSE(std::filesystem::exists(directory));
+
+  // A directory that exists but cannot hold the file: the path names one.
+  const std::string taken = test::TempFilePath("taken");
+  std::filesystem::create_directory(taken);
+  const Status over_directory =
+      WriteCameraInfo(taken, CameraInfoFromCamera("cam0", EurocCamera()));
+  ASSERT_FALSE(over_directory.ok());
+  EXPECT_THAT(over_directory.message(), StartsWith(taken + ": "));
+  EXPECT_THAT(over_directory.message(), Not(HasSubstr("\n")));
+  EXPECT_TRUE(std::filesystem::is_directory(taken));
+  const std::string prefix = std::filesystem::path(taken).filename().string();
+  EXPECT_EQ(FilesStartingWith(::testing::TempDir(), prefix),
+            std::vector<std::string>{prefix});
+  std::filesystem::remove(taken);
 }
 
 }  // namespace

@@ -4,39 +4,19 @@
 #include <rosbag/view.h>
 #include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
-#include <sys/stat.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <cstring>
 #include <exception>
-#include <map>
 #include <numeric>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
-#include <set>
 #include <utility>
 #include <vector>
 
 #include "rcm/io/number_format.h"
-#include "rcm/util/message_text.h"
+#include "ros_image_message.h"
 
 namespace rcm {
 namespace {
-
-constexpr char kImageType[] = "sensor_msgs/Image";
-constexpr char kCompressedImageType[] = "sensor_msgs/CompressedImage";
-
-// An exception's text fit for a one-line message (rosbag's may hold line
-// breaks).
-std::string OneLine(const std::exception& error) {
-  std::string text = error.what();
-  for (char& c : text) {
-    if (c == '\n' || c == '\r' || c == '\t') c = ' ';
-  }
-  return text;
-}
 
 // A stamp as messages and pair names show it: seconds, 6 decimals.
 std::string FormatStamp(double stamp_s) { return FormatFixed(stamp_s, 6); }
@@ -61,90 +41,6 @@ std::string Ordinal(int n) {
     if (units == 3) suffix = "rd";
   }
   return std::to_string(n) + suffix;
-}
-
-// The 8-bit, 1- or 3-channel (BGR) image of a sensor_msgs/Image.
-StatusOr<cv::Mat> DecodeImage(const sensor_msgs::Image& message) {
-  const std::string& encoding = message.encoding;
-  int channels;
-  int conversion = -1;  // cv::COLOR_* to BGR, -1 for none
-  if (encoding == "mono8" || encoding == "8UC1") {
-    channels = 1;
-  } else if (encoding == "bgr8" || encoding == "8UC3") {
-    channels = 3;
-  } else if (encoding == "rgb8") {
-    channels = 3;
-    conversion = cv::COLOR_RGB2BGR;
-  } else if (encoding == "bgra8") {
-    channels = 4;
-    conversion = cv::COLOR_BGRA2BGR;
-  } else if (encoding == "rgba8") {
-    channels = 4;
-    conversion = cv::COLOR_RGBA2BGR;
-  } else {
-    return Status::Error(
-        "unsupported encoding " + QuoteForMessage(encoding) +
-        " (rcm reads mono8, 8UC1, bgr8, 8UC3, rgb8, bgra8 and rgba8)");
-  }
-  if (message.width == 0 || message.height == 0) {
-    return Status::Error("empty image (" + std::to_string(message.width) +
-                         "x" + std::to_string(message.height) + ")");
-  }
-  // uint64_t: width * channels cannot overflow; OpenCV's sizes are int.
-  const uint64_t row_bytes = uint64_t{message.width} * channels;
-  if (message.width > (1u << 30) || message.height > (1u << 30)) {
-    return Status::Error("image too large (" + std::to_string(message.width) +
-                         "x" + std::to_string(message.height) + ")");
-  }
-  if (message.step < row_bytes) {
-    return Status::Error("step " + std::to_string(message.step) +
-                         " is less than width * channels = " +
-                         std::to_string(row_bytes));
-  }
-  const uint64_t needed = uint64_t{message.step} * message.height;
-  if (message.data.size() < needed) {
-    return Status::Error("data holds " + std::to_string(message.data.size()) +
-                         " bytes, step * height needs " +
-                         std::to_string(needed));
-  }
-  // A view of the message's bytes that respects the row padding (step).
-  const cv::Mat pixels(static_cast<int>(message.height),
-                       static_cast<int>(message.width), CV_8UC(channels),
-                       const_cast<uint8_t*>(message.data.data()),
-                       message.step);
-  cv::Mat image;
-  if (conversion >= 0) {
-    cv::cvtColor(pixels, image, conversion);
-  } else {
-    image = pixels.clone();
-  }
-  return image;
-}
-
-// The 8-bit, 1- or 3-channel (BGR) image of a sensor_msgs/CompressedImage.
-StatusOr<cv::Mat> DecodeCompressedImage(
-    const sensor_msgs::CompressedImage& message) {
-  const std::string format = QuoteForMessage(message.format);
-  cv::Mat image;
-  try {
-    image = cv::imdecode(message.data, cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception&) {
-    image.release();
-  }
-  if (image.empty()) {
-    return Status::Error("compressed image (format " + format +
-                         ", " + std::to_string(message.data.size()) +
-                         " bytes) is corrupt or not a format OpenCV decodes");
-  }
-  if (image.depth() != CV_8U ||
-      (image.channels() != 1 && image.channels() != 3 &&
-       image.channels() != 4)) {
-    return Status::Error("compressed image (format " + format + ") is " +
-                         cv::typeToString(image.type()) +
-                         ", rcm reads 8-bit images with 1, 3 or 4 channels");
-  }
-  if (image.channels() == 4) cv::cvtColor(image, image, cv::COLOR_BGRA2BGR);
-  return image;
 }
 
 // The messages of one topic in the bag, with their header stamps.
@@ -292,7 +188,7 @@ class BagStereoSource final : public StereoImageSource {
 
  private:
   static std::string Name(const std::string& topic, double stamp_s) {
-    return topic + " @ " + FormatStamp(stamp_s);
+    return StampedName(topic, stamp_s);
   }
 
   StatusOr<cv::Mat> Decode(const rosbag::MessageInstance& message,
@@ -331,54 +227,6 @@ class BagStereoSource final : public StereoImageSource {
   size_t num_unpaired_;
 };
 
-// "/a [sensor_msgs/Image], /b [sensor_msgs/CompressedImage]" for the
-// topics of `types` (topic -> data types) that `keep` accepts.
-template <typename Keep>
-std::string ListTopics(const std::map<std::string, std::set<std::string>>& types,
-                       Keep keep) {
-  std::string list;
-  for (const auto& [topic, topic_types] : types) {
-    for (const std::string& type : topic_types) {
-      if (!keep(type)) continue;
-      if (!list.empty()) list += ", ";
-      list += topic + " [" + type + "]";
-    }
-  }
-  return list;
-}
-
-bool IsImageType(const std::string& type) {
-  return type == kImageType || type == kCompressedImageType;
-}
-
-// Errors for a topic that is missing from the bag or not an image topic.
-Status CheckTopic(const std::string& path, const std::string& topic,
-                  const std::map<std::string, std::set<std::string>>& types) {
-  const auto found = types.find(topic);
-  if (found == types.end()) {
-    const std::string images = ListTopics(types, IsImageType);
-    if (!images.empty()) {
-      return Status::Error(path + ": no topic " + topic +
-                           " (image topics in the bag: " + images + ")");
-    }
-    const std::string all =
-        ListTopics(types, [](const std::string&) { return true; });
-    return Status::Error(path + ": no topic " + topic +
-                         " (the bag has no image topics" +
-                         (all.empty() ? std::string(" and no messages")
-                                      : "; its topics: " + all) +
-                         ")");
-  }
-  for (const std::string& type : found->second) {
-    if (!IsImageType(type)) {
-      return Status::Error(path + ": topic " + topic + " has type " + type +
-                           ", expected " + kImageType + " or " +
-                           kCompressedImageType);
-    }
-  }
-  return Status::Ok();
-}
-
 }  // namespace
 
 Status BagStereoOptions::Check() const {
@@ -400,30 +248,16 @@ StatusOr<std::unique_ptr<StereoImageSource>> OpenBagStereoSource(
     const std::string& path, const BagStereoOptions& options) {
   RCM_RETURN_IF_ERROR(options.Check());
   // rosbag's own errors for these name no reason.
-  struct stat info;
-  if (stat(path.c_str(), &info) != 0) {
-    return Status::Error(path + ": cannot open: " + std::strerror(errno));
-  }
-  if (S_ISDIR(info.st_mode)) {
-    return Status::Error(path + ": is a directory, expected a file");
-  }
+  RCM_RETURN_IF_ERROR(CheckBagFileExists(path));
 
-  // rosbag reports a missing, truncated or foreign file by throwing
-  // (rosbag::BagException and its subclasses, or whatever a corrupt chunk
-  // makes its decompressors throw).
   auto bag = std::make_unique<rosbag::Bag>();
   TopicMessages left;
   TopicMessages right;
   try {
     bag->open(path, rosbag::bagmode::Read);
-    std::map<std::string, std::set<std::string>> types;
-    rosbag::View everything(*bag);
-    for (const rosbag::ConnectionInfo* connection :
-         everything.getConnections()) {
-      types[connection->topic].insert(connection->datatype);
-    }
-    RCM_RETURN_IF_ERROR(CheckTopic(path, options.left_topic, types));
-    RCM_RETURN_IF_ERROR(CheckTopic(path, options.right_topic, types));
+    const BagTopicTypes types = ReadTopicTypes(*bag);
+    RCM_RETURN_IF_ERROR(CheckImageTopic(path, options.left_topic, types));
+    RCM_RETURN_IF_ERROR(CheckImageTopic(path, options.right_topic, types));
 
     rosbag::View view(
         *bag, rosbag::TopicQuery(std::vector<std::string>{
@@ -438,16 +272,8 @@ StatusOr<std::unique_ptr<StereoImageSource>> OpenBagStereoSource(
       topic.messages.push_back(message);
       topic.stamps.push_back(*stamp);
     }
-  } catch (const rosbag::BagUnindexedException&) {
-    return Status::Error(path +
-                         ": not a readable ROS1 bag (unindexed, as a "
-                         "recording that was cut off leaves it; `rosbag "
-                         "reindex` repairs it)");
-  } catch (const std::exception& error) {
-    return Status::Error(path + ": not a readable ROS1 bag (" +
-                         OneLine(error) + ")");
   } catch (...) {
-    return Status::Error(path + ": not a readable ROS1 bag");
+    return UnreadableBagError(path);
   }
 
   for (const auto& [topic, messages] :

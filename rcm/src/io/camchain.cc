@@ -540,4 +540,29 @@ Camchain CamchainFromStereoRig(const StereoRig& rig) {
   return camchain;
 }
 
+Status CopyCamchainImuAndTopics(const Camchain& source, int left_index,
+                                int right_index, Camchain* pair) {
+  const int num_cameras = static_cast<int>(source.cameras.size());
+  if (left_index < 0 || left_index >= num_cameras || right_index < 0 ||
+      right_index >= num_cameras || left_index == right_index) {
+    return Status::Error("cameras cam" + std::to_string(left_index) +
+                         " and cam" + std::to_string(right_index) +
+                         " are not two cameras of the camchain");
+  }
+  if (pair->cameras.size() != 2) {
+    return Status::Error("the camchain to complete has " +
+                         std::to_string(pair->cameras.size()) +
+                         " cameras, expected 2");
+  }
+  const int indices[2] = {left_index, right_index};
+  for (int k = 0; k < 2; ++k) {
+    const CamchainCamera& from = source.cameras[indices[k]];
+    CamchainCamera& to = pair->cameras[k];
+    to.cam_from_imu = from.cam_from_imu;
+    to.timeshift_cam_imu = from.timeshift_cam_imu;
+    to.rostopic = from.rostopic;
+  }
+  return Status::Ok();
+}
+
 }  // namespace rcm

@@ -39,11 +39,6 @@ StatusOr<Camera> ReadCameraFile(const std::string& path,
   if (!format.ok()) return format.status();
 
   if (*format == CalibrationFileFormat::kCameraInfo) {
-    if (camera_name != "cam0") {
-      return Status::Error(path + ": is a ROS camera_info, which has one "
-                                  "camera; the camera name '" +
-                           camera_name + "' selects a camera of a camchain");
-    }
     const StatusOr<CameraInfo> info = ParseCameraInfo(*text, path);
     if (!info.ok()) return info.status();
     return info->camera;

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <optional>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -285,6 +286,35 @@ Status CheckProjection(const std::string& which,
                        rows + "]");
 }
 
+// ---------------------------------------------------------------------------
+// Writing: the layout of camera_calibration_parsers' writeCalibrationYml
+// (yaml-cpp's emitter: block maps, each matrix's data a flow list).
+
+// A string scalar as yaml-cpp's emitter writes it: plain when that reads
+// back as the same string, quoted otherwise.
+std::string YamlScalar(const std::string& text) {
+  YAML::Emitter emitter;
+  emitter << text;
+  return emitter.c_str();
+}
+
+// "key:\n  rows: R\n  cols: C\n  data: [...]\n" for a row-major matrix.
+std::string RosMatrixText(const std::string& key, int rows, int cols,
+                          const double* row_major) {
+  std::string text = key + ":\n  rows: " + std::to_string(rows) +
+                     "\n  cols: " + std::to_string(cols) + "\n  data: [";
+  for (int i = 0; i < rows * cols; ++i) {
+    text += (i == 0 ? "" : ", ") + FormatDouble(row_major[i]);
+  }
+  return text + "]\n";
+}
+
+// K of `camera`, row-major.
+std::array<double, 9> CameraMatrix(const Camera& camera) {
+  return {camera.fx(), 0.0, camera.cx(), 0.0, camera.fy(),
+          camera.cy(), 0.0, 0.0,         1.0};
+}
+
 }  // namespace
 
 StatusOr<CameraInfo> ParseCameraInfo(const std::string& text,
@@ -300,6 +330,55 @@ StatusOr<CameraInfo> ReadCameraInfo(const std::string& path) {
   const StatusOr<std::string> text = ReadFileToString(path);
   if (!text.ok()) return text.status();
   return ParseCameraInfo(*text, path);
+}
+
+CameraInfo CameraInfoFromCamera(const std::string& camera_name,
+                                const Camera& camera) {
+  Eigen::Matrix<double, 3, 4> projection = Eigen::Matrix<double, 3, 4>::Zero();
+  const std::array<double, 9> k = CameraMatrix(camera);
+  for (int i = 0; i < 9; ++i) projection(i / 3, i % 3) = k[i];
+  return CameraInfo{camera_name, camera, Eigen::Matrix3d::Identity(),
+                    projection};
+}
+
+RosDistortion RosDistortionOf(const Camera& camera) {
+  switch (camera.model()) {
+    case LensModelId::kRadTan: {
+      // ROS's plumb_bob has a k3; rcm's radtan model holds it at 0.
+      std::vector<double> coefficients = camera.Distortion();
+      coefficients.push_back(0.0);
+      return {"plumb_bob", coefficients};
+    }
+    case LensModelId::kEquidistant:
+      return {"equidistant", camera.Distortion()};
+    case LensModelId::kPinhole:
+      // ROS tools treat plumb_bob with zero coefficients as undistorted;
+      // some reject "none".
+      return {"plumb_bob", std::vector<double>(5, 0.0)};
+  }
+  LOG(FATAL) << "unhandled lens model";
+  return {};
+}
+
+std::string FormatCameraInfo(const CameraInfo& info) {
+  const Camera& camera = info.camera;
+  const RosDistortion distortion = RosDistortionOf(camera);
+  const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> r = info.rectification;
+  const Eigen::Matrix<double, 3, 4, Eigen::RowMajor> p = info.projection;
+  return "image_width: " + std::to_string(camera.width()) +
+         "\nimage_height: " + std::to_string(camera.height()) +
+         "\ncamera_name: " + YamlScalar(info.camera_name) + "\n" +
+         RosMatrixText("camera_matrix", 3, 3, CameraMatrix(camera).data()) +
+         "distortion_model: " + distortion.model + "\n" +
+         RosMatrixText("distortion_coefficients", 1,
+                       static_cast<int>(distortion.coefficients.size()),
+                       distortion.coefficients.data()) +
+         RosMatrixText("rectification_matrix", 3, 3, r.data()) +
+         RosMatrixText("projection_matrix", 3, 4, p.data());
+}
+
+Status WriteCameraInfo(const std::string& path, const CameraInfo& info) {
+  return WriteFileAtomically(path, FormatCameraInfo(info));
 }
 
 StatusOr<StereoRig> StereoRigFromCameraInfo(const CameraInfo& left,

@@ -105,6 +105,15 @@ StatusOr<StereoRig> StereoRigFromCamchain(const Camchain& camchain,
 // one with T_cn_cnm1 = right_from_left, each listing the other as overlap.
 Camchain CamchainFromStereoRig(const StereoRig& rig);
 
+// Copies what `source` says of its cameras cam<left_index> and
+// cam<right_index> beyond their intrinsics and extrinsics to cameras 0 and
+// 1 of `pair` (a CamchainFromStereoRig of a rig derived from them, e.g.
+// the water-side models): T_cam_imu, timeshift_cam_imu and rostopic, so
+// that a VIO keeps its IMU calibration. Errors: an index out of range,
+// equal indices, a `pair` without two cameras.
+Status CopyCamchainImuAndTopics(const Camchain& source, int left_index,
+                                int right_index, Camchain* pair);
+
 }  // namespace rcm
 
 #endif  // RCM_IO_CAMCHAIN_H_

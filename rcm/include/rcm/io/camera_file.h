@@ -23,10 +23,9 @@ StatusOr<CalibrationFileFormat> DetectCalibrationFileFormat(
     const std::string& path, const std::string& text);
 
 // Reads camera `camera_name` of a camchain, or the camera of a camera_info
-// (whose `camera_name` must then keep its default "cam0": a camera_info
-// has one camera). Errors: the file's own (missing, unreadable, malformed;
-// one line naming the file), an unknown camera name (listing the
-// camchain's cameras).
+// (which has one camera; `camera_name` is not used). Errors: the file's
+// own (missing, unreadable, malformed; one line naming the file), an
+// unknown camera name in a camchain (listing the camchain's cameras).
 StatusOr<Camera> ReadCameraFile(const std::string& path,
                                 const std::string& camera_name = "cam0");
 

@@ -40,6 +40,7 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <vector>
 
 #include "rcm/camera/camera.h"
 #include "rcm/geometry/stereo_rig.h"
@@ -68,6 +69,18 @@ StatusOr<CameraInfo> ReadCameraInfo(const std::string& path);
 // P = [K | 0].
 CameraInfo CameraInfoFromCamera(const std::string& camera_name,
                                 const Camera& camera);
+
+// The distortion_model and coefficients D that ROS tools expect of
+// `camera`, as FormatCameraInfo and camera_info messages write them:
+//   radtan       -> plumb_bob [k1, k2, p1, p2, 0] (ROS's k3 held at 0);
+//   equidistant  -> equidistant [k1, k2, k3, k4];
+//   pinhole      -> plumb_bob [0, 0, 0, 0, 0] (some ROS tools reject
+//                   "none"; zero coefficients read as undistorted).
+struct RosDistortion {
+  std::string model;
+  std::vector<double> coefficients;
+};
+RosDistortion RosDistortionOf(const Camera& camera);
 
 // The text camera_calibration_parsers writes (keys in its order:
 // image_width, image_height, camera_name, camera_matrix, distortion_model,
