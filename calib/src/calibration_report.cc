@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <limits>
 #include <opencv2/imgproc.hpp>
@@ -16,6 +15,7 @@
 #include "rcm/io/image_file.h"
 #include "rcm/io/number_format.h"
 #include "rcm/viz/color_map.h"
+#include "rcm/viz/figure.h"
 #include "rcm/viz/line_plot.h"
 
 namespace rcm::calib {
@@ -41,28 +41,6 @@ double Quantile(std::vector<double> values, double q) {
   const size_t above = std::min(below + 1, values.size() - 1);
   const double t = position - static_cast<double>(below);
   return values[below] + t * (values[above] - values[below]);
-}
-
-// 1-2-5 numbers m 10^k: the largest <= x, the smallest >= x, the nearest
-// in ratio (x > 0, finite).
-double NiceFloor(double x) {
-  const double power = std::pow(10.0, std::floor(std::log10(x)));
-  for (const double m : {5.0, 2.0, 1.0}) {
-    if (m * power <= x * (1.0 + 1e-12)) return m * power;
-  }
-  return power;
-}
-double NiceCeil(double x) {
-  const double power = std::pow(10.0, std::floor(std::log10(x)));
-  for (const double m : {1.0, 2.0, 5.0, 10.0}) {
-    if (m * power >= x * (1.0 - 1e-12)) return m * power;
-  }
-  return 10.0 * power;
-}
-double NiceNearest(double x) {
-  const double low = NiceFloor(x);
-  const double high = NiceCeil(x);
-  return x / low <= high / x ? low : high;
 }
 
 // A 1-2-5 number with as many decimals as it needs.
@@ -144,203 +122,7 @@ std::vector<double> Values(const cv::Mat& samples) {
 }
 
 // ---------------------------------------------------------------------------
-// Drawing, in the manner of rcm::LinePlot: at kSupersample times the output
-// size, averaged down with cv::INTER_AREA.
-
-constexpr int kSupersample = 3;
-constexpr int kShift = 4;  // fractional bits of cv drawing coordinates
-constexpr double kShiftScale = 1 << kShift;
-
-const cv::Scalar kWhite(255, 255, 255);
-const cv::Scalar kInk(34, 34, 34);
-const cv::Scalar kFrame(80, 80, 80);
-const cv::Scalar kPanel(246, 246, 246);
-const cv::Scalar kGridLine(215, 215, 215);
-const cv::Scalar kMuted(110, 110, 110);
-const cv::Scalar kNoData(200, 200, 200);
-
-struct Font {
-  int face;
-  double scale;  // at z = 1
-};
-const Font kTitleFont{cv::FONT_HERSHEY_DUPLEX, 0.62};
-const Font kTextFont{cv::FONT_HERSHEY_SIMPLEX, 0.50};
-const Font kSmallFont{cv::FONT_HERSHEY_SIMPLEX, 0.40};
-
-class Figure {
- public:
-  Figure(int width, int height, double z)
-      : width_(width),
-        height_(height),
-        z_(z),
-        canvas_(height * kSupersample, width * kSupersample, CV_8UC3, kWhite),
-        target_(canvas_) {}
-
-  double z() const { return z_; }
-
-  // Drawing (not Paste) goes into the output rectangle with edges x0, x1,
-  // y0, y1 (pixel i spans [i - 0.5, i + 0.5]) until Unclip.
-  void Clip(double x0, double y0, double x1, double y1) {
-    const cv::Rect rect(cv::Point(Edge(x0), Edge(y0)),
-                        cv::Point(Edge(x1), Edge(y1)));
-    const cv::Rect clip = rect & cv::Rect(0, 0, canvas_.cols, canvas_.rows);
-    target_ = canvas_(clip);
-    offset_ = clip.tl();
-  }
-  void Unclip() {
-    target_ = canvas_;
-    offset_ = cv::Point(0, 0);
-  }
-
-  // Output coordinates (pixel centers at integers) -> supersampled, fixed
-  // point, in the clip rectangle.
-  cv::Point At(const cv::Point2d& p) const {
-    return cv::Point(
-        static_cast<int>(
-            std::lround((p.x * kSupersample + 1.0 - offset_.x) * kShiftScale)),
-        static_cast<int>(
-            std::lround((p.y * kSupersample + 1.0 - offset_.y) * kShiftScale)));
-  }
-  static int Thickness(double width) {
-    return std::max(1, static_cast<int>(std::lround(width * kSupersample)));
-  }
-
-  void Line(const cv::Point2d& a, const cv::Point2d& b, const cv::Scalar& color,
-            double width) {
-    cv::line(target_, At(a), At(b), color, Thickness(width), cv::LINE_AA,
-             kShift);
-  }
-
-  void Polyline(const std::vector<cv::Point2d>& points, bool closed,
-                const cv::Scalar& color, double width) {
-    if (points.size() < 2) return;
-    std::vector<cv::Point> fixed;
-    fixed.reserve(points.size());
-    for (const cv::Point2d& point : points) fixed.push_back(At(point));
-    cv::polylines(target_, std::vector<std::vector<cv::Point>>{fixed}, closed,
-                  color, Thickness(width), cv::LINE_AA, kShift);
-  }
-
-  void Disc(const cv::Point2d& center, double radius, const cv::Scalar& color) {
-    cv::circle(
-        target_, At(center),
-        static_cast<int>(std::lround(radius * kSupersample * kShiftScale)),
-        color, cv::FILLED, cv::LINE_AA, kShift);
-  }
-
-  // A shaft from `from` to `to` with a head of two strokes at `to`.
-  void Arrow(const cv::Point2d& from, const cv::Point2d& to,
-             const cv::Scalar& color, double width) {
-    const cv::Point2d d = to - from;
-    const double length = std::hypot(d.x, d.y);
-    if (!(length > 0.0) || !Finite(length)) return;
-    Line(from, to, color, width);
-    const double head = std::min(0.4 * length, (2.5 + 1.5 * width) * z_);
-    const cv::Point2d back = -d * (head / length);
-    const double c = std::cos(0.45);
-    const double s = std::sin(0.45);
-    Line(to, to + cv::Point2d(c * back.x - s * back.y, s * back.x + c * back.y),
-         color, width);
-    Line(to,
-         to + cv::Point2d(c * back.x + s * back.y, -s * back.x + c * back.y),
-         color, width);
-  }
-
-  // Fills output pixels x0..x1-1, y0..y1-1 (integer edges of pixels).
-  void FillRect(int x0, int y0, int x1, int y1, const cv::Scalar& color) {
-    cv::rectangle(
-        target_,
-        cv::Rect(cv::Point(x0 * kSupersample, y0 * kSupersample) - offset_,
-                 cv::Point(x1 * kSupersample, y1 * kSupersample) - offset_),
-        color, cv::FILLED);
-  }
-  // The same with edges in continuous output coordinates (pixel i spans
-  // [i - 0.5, i + 0.5]).
-  void FillArea(double x0, double y0, double x1, double y1,
-                const cv::Scalar& color) {
-    cv::rectangle(target_,
-                  cv::Rect(cv::Point(Edge(x0), Edge(y0)) - offset_,
-                           cv::Point(Edge(x1), Edge(y1)) - offset_),
-                  color, cv::FILLED);
-  }
-
-  double FontScale(const Font& font) const {
-    return font.scale * z_ * kSupersample;
-  }
-  int FontThickness() const {
-    return static_cast<int>(std::lround(std::max(0.75, z_) * kSupersample));
-  }
-  // Width and cap height of a text in output pixels.
-  cv::Size2d Measure(const std::string& text, const Font& font,
-                     double shrink = 1.0) const {
-    int baseline = 0;
-    const cv::Size size = cv::getTextSize(
-        text, font.face, FontScale(font) * shrink, FontThickness(), &baseline);
-    return cv::Size2d(static_cast<double>(size.width) / kSupersample,
-                      static_cast<double>(size.height) / kSupersample);
-  }
-  // Text with the left end of its baseline at `origin`, shrunk to fit
-  // `max_width` output pixels; returns its width.
-  double Text(const std::string& text, const cv::Point2d& origin,
-              const Font& font, const cv::Scalar& color,
-              double max_width = std::numeric_limits<double>::infinity()) {
-    if (text.empty()) return 0.0;
-    double shrink = 1.0;
-    const double width = Measure(text, font).width;
-    if (width > max_width && max_width > 0.0) shrink = max_width / width;
-    cv::putText(
-        target_, text,
-        cv::Point(
-            static_cast<int>(std::lround(origin.x * kSupersample + 1.0)),
-            static_cast<int>(std::lround(origin.y * kSupersample + 1.0))) -
-            offset_,
-        font.face, FontScale(font) * shrink, color, FontThickness(),
-        cv::LINE_AA);
-    return width * shrink;
-  }
-  // Text centered on `center` over a filled box of `box` color.
-  void Label(const std::string& text, const cv::Point2d& center,
-             const Font& font, const cv::Scalar& color, const cv::Scalar& box) {
-    const cv::Size2d size = Measure(text, font);
-    const double pad = 2.0 * z_;
-    FillArea(center.x - 0.5 * size.width - pad,
-             center.y - 0.5 * size.height - pad,
-             center.x + 0.5 * size.width + pad,
-             center.y + 0.5 * size.height + pad, box);
-    Text(text,
-         cv::Point2d(center.x - 0.5 * size.width, center.y + 0.5 * size.height),
-         font, color);
-  }
-
-  // A 1x image with its top-left pixel at output pixel (x, y).
-  void Paste(const cv::Mat& image, int x, int y) {
-    cv::Mat big;
-    cv::resize(image, big, cv::Size(), kSupersample, kSupersample,
-               cv::INTER_NEAREST);
-    big.copyTo(canvas_(
-        cv::Rect(x * kSupersample, y * kSupersample, big.cols, big.rows)));
-  }
-
-  cv::Mat Finish() const {
-    cv::Mat output;
-    cv::resize(canvas_, output, cv::Size(width_, height_), 0, 0,
-               cv::INTER_AREA);
-    return output;
-  }
-
- private:
-  int width_;
-  int height_;
-  double z_;
-  cv::Mat canvas_;
-  cv::Mat target_;          // canvas_ or its clip rectangle
-  cv::Point offset_{0, 0};  // of target_ in canvas_
-
-  // The supersampled pixel edge of output coordinate x.
-  static int Edge(double x) {
-    return static_cast<int>(std::lround((x + 0.5) * kSupersample));
-  }
-};
+// Drawing, on an rcm::Figure (rcm/viz/figure.h).
 
 // An image-sized panel with a title strip above, a legend strip of
 // `legend_lines` lines below and `extra_right` z-scaled pixels on the right.
@@ -438,13 +220,6 @@ cv::Scalar Viridis(double t) {
 // Linear blend of two colors, t in [0, 1].
 cv::Scalar Mix(const cv::Scalar& a, const cv::Scalar& b, double t) {
   return a * (1.0 - t) + b * t;
-}
-
-// "%g": 0.05, 0.2, 50, 0.75.
-std::string FormatShort(double value) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "%g", value);
-  return buffer;
 }
 
 // The colour scale of the uncertainty map: logarithmic from `low` to
