@@ -14,6 +14,7 @@
 
 #include "command.h"
 #include "image_input_flags.h"
+#include "lens_model_flag.h"
 #include "progress.h"
 #include "rcm/calib/calibration_report.h"
 #include "rcm/calib/calibration_target.h"
@@ -43,8 +44,6 @@ DEFINE_double(tag_spacing, 0.3,
               "aprilgrid: gap between tags as a fraction of --tag-size");
 DEFINE_double(marker, 0.0, "charuco: marker edge in metres");
 DEFINE_string(dictionary, "DICT_6X6_250", "charuco: OpenCV aruco dictionary");
-DEFINE_string(model, "radtan",
-              "lens model of both cameras: radtan, equidistant, none");
 DEFINE_string(report, "",
               "folder of the report (pictures, per-view CSV, JSON); default: "
               "next to the camchain, <name>-report");
@@ -232,7 +231,7 @@ extern const Subcommand kCalibrateCommand = {
     "calibrate",
     "air stereo calibration from target images (folders or a ROS1 bag)",
     kUsage,
-    {__FILE__, kImageInputFlagsSource},
+    {__FILE__, kImageInputFlagsSource, kLensModelFlagSource},
     RunCalibrate};
 
 namespace {
@@ -252,10 +251,9 @@ int RunCalibrate() {
                "FILE with --left-topic/--right-topic");
     return kExitUsage;
   }
-  const std::optional<LensModelId> model = LensModelFromName(FLAGS_model);
-  if (!model) {
-    PrintError(command, "unknown --model '" + FLAGS_model +
-                            "' (available: radtan, equidistant, none)");
+  const StatusOr<LensModelId> model = LensModelFromFlag(LensModelId::kRadTan);
+  if (!model.ok()) {
+    PrintError(command, model.status().message());
     return kExitUsage;
   }
   calib::StereoCalibrationOptions options;

@@ -1,0 +1,25 @@
+#include "lens_model_flag.h"
+
+#include <optional>
+
+#include "rcm/camera/camera.h"
+
+DEFINE_string(model, "",
+              "lens model: radtan, equidistant or none (default: radtan for "
+              "calibrate, equidistant for export)");
+
+namespace rcm::cli {
+
+extern const char kLensModelFlagSource[] = __FILE__;
+
+StatusOr<LensModelId> LensModelFromFlag(LensModelId default_model) {
+  if (FLAGS_model.empty()) return default_model;
+  const std::optional<LensModelId> model = LensModelFromName(FLAGS_model);
+  if (!model.has_value()) {
+    return Status::Error("unknown --model '" + FLAGS_model +
+                         "' (available: radtan, equidistant, none)");
+  }
+  return *model;
+}
+
+}  // namespace rcm::cli
