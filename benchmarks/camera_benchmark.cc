@@ -3,11 +3,13 @@
 #include <benchmark/benchmark.h>
 
 #include <opencv2/core.hpp>
+#include <string>
 #include <vector>
 
 #include "rcm/camera/camera.h"
 #include "rcm/camera/refractive_camera.h"
 #include "rcm/camera/virtual_pinhole_remap.h"
+#include "rcm/camera/virtual_pinhole_rig.h"
 #include "rcm/sim/reference_rigs.h"
 
 namespace rcm {
@@ -128,6 +130,59 @@ void BM_NoBorderVirtualPinholeView(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_NoBorderVirtualPinholeView)->Unit(benchmark::kMillisecond);
+
+// The bisection for the view that keeps the whole field of view (n =
+// 1.333).
+void BM_FullFieldOfViewVirtualPinholeView(benchmark::State& state) {
+  const RefractiveCamera camera =
+      RefractiveCamera::Create(AlphasenseFrontCam0(), 1.333).value();
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(
+        ChooseVirtualPinholeView(camera, VirtualPinholeFit::kFullFieldOfView)
+            .value());
+  }
+}
+BENCHMARK(BM_FullFieldOfViewVirtualPinholeView)->Unit(benchmark::kMillisecond);
+
+// Everything `rcm undistort` does once per n: both cameras' views of the
+// 720x540 dataset rig (0.5 degrees from rectified) chosen by fit range(0)
+// (0 virtual-pinhole, 1 no-border, 2 full), rectified when range(1), and
+// both cameras' float and fixed-point maps built on two threads. n = 1.333.
+void BM_BuildVirtualPinholeRig(benchmark::State& state) {
+  const StereoRig rig = AlphasenseFrontUnrectifiedRig();
+  VirtualPinholeRigOptions options;
+  options.fit = static_cast<VirtualPinholeFit>(state.range(0));
+  options.rectify = state.range(1) != 0;
+  options.num_threads = 2;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(
+        VirtualPinholeRig::Create(rig, 1.333, options).value());
+  }
+  state.SetLabel(std::string(VirtualPinholeFitName(options.fit)) +
+                 (options.rectify ? ", rectified" : ""));
+}
+BENCHMARK(BM_BuildVirtualPinholeRig)
+    ->ArgsProduct({{0, 1, 2}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// Correcting one 720x540 stereo pair with a built rig (both images, the
+// fixed-point maps): the per-pair cost of `rcm undistort` before decoding
+// and encoding.
+void BM_CorrectStereoPair(benchmark::State& state) {
+  const VirtualPinholeRig rig =
+      VirtualPinholeRig::Create(AlphasenseFrontUnrectifiedRig(), 1.333).value();
+  cv::Mat left(540, 720, CV_8UC1);
+  cv::Mat right(540, 720, CV_8UC1);
+  cv::RNG rng(1);
+  rng.fill(left, cv::RNG::UNIFORM, 0, 256);
+  rng.fill(right, cv::RNG::UNIFORM, 0, 256);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(rig.left().Correct(left));
+    benchmark::DoNotOptimize(rig.right().Correct(right));
+  }
+}
+BENCHMARK(BM_CorrectStereoPair)->Unit(benchmark::kMicrosecond)->UseRealTime();
 
 // Remapping one 720x540 CV_8UC1 image (n = 1.333): range(0) = 1 with the
 // fixed-point maps, 0 with the float maps.

@@ -34,7 +34,8 @@ TEST(VirtualPinholeRemap, MapsAgreeWithTheCamera) {
   for (const auto& [camera, n] : cases) {
     const RefractiveCamera refractive = Refractive(camera, n);
     for (VirtualPinholeFit fit :
-         {VirtualPinholeFit::kVirtualPinhole, VirtualPinholeFit::kNoBorder}) {
+         {VirtualPinholeFit::kVirtualPinhole, VirtualPinholeFit::kNoBorder,
+          VirtualPinholeFit::kFullFieldOfView}) {
       const VirtualPinholeView view =
           ChooseVirtualPinholeView(refractive, fit).value();
       const RemapMaps maps =
@@ -137,6 +138,161 @@ TEST(VirtualPinholeRemap, NoBorderViewIsCoveredAndMaximal) {
                   max_y > camera.height() - 1.0);
     }
   }
+}
+
+// Output pixel of the ray of each raw border pixel (centers on the four
+// edges) that the lens unprojects, in `view`: K' R^T b, computed as
+// FitFocalScale does.
+std::vector<Eigen::Vector2d> BorderRaysInOutput(
+    const RefractiveCamera& camera, const VirtualPinholeView& view) {
+  const Camera& lens = camera.camera();
+  std::vector<Eigen::Vector2d> pixels;
+  const auto add = [&](int u, int v) {
+    const std::optional<Eigen::Vector3d> bearing =
+        camera.BearingInWaterFromImage(Eigen::Vector2d(u, v));
+    if (!bearing) return;
+    const Eigen::Vector3d in_view =
+        view.camera_from_view.transpose() * *bearing;
+    EXPECT_GT(in_view.z(), 0.0);
+    pixels.push_back((view.k * in_view).hnormalized());
+  };
+  for (int u = 0; u < lens.width(); ++u) {
+    add(u, 0);
+    add(u, lens.height() - 1);
+  }
+  for (int v = 0; v < lens.height(); ++v) {
+    add(0, v);
+    add(lens.width() - 1, v);
+  }
+  return pixels;
+}
+
+// Number of `pixels` outside [0, w - 1] x [0, h - 1] of `view`, with the
+// fits' slack.
+int CountOutside(const std::vector<Eigen::Vector2d>& pixels,
+                 const VirtualPinholeView& view) {
+  constexpr double kSlack = kVirtualPinholeFitSlackPx;
+  int outside = 0;
+  for (const Eigen::Vector2d& pixel : pixels) {
+    if (pixel.x() < -kSlack || pixel.x() > view.width - 1.0 + kSlack ||
+        pixel.y() < -kSlack || pixel.y() > view.height - 1.0 + kSlack) {
+      ++outside;
+    }
+  }
+  return outside;
+}
+
+// The bisection's relative tolerance on s: the found s holds, one larger
+// (narrower view) by this factor must not.
+constexpr double kScaleTolerance = 1e-6;
+
+TEST(VirtualPinholeRemap, FullFieldOfViewHoldsEveryBorderRayAndIsMaximal) {
+  for (const Camera& camera :
+       {test::AlphasenseCam0(), test::EurocRadtanCamera(),
+        test::PinholeCamera()}) {
+    for (double n : {1.0, 1.333}) {
+      const RefractiveCamera refractive = Refractive(camera, n);
+      const VirtualPinholeView view =
+          ChooseVirtualPinholeView(refractive,
+                                   VirtualPinholeFit::kFullFieldOfView)
+              .value();
+      const double scale = VirtualPinholeFocalScale(refractive, view);
+      SCOPED_TRACE(::testing::Message() << LensModelName(camera.model())
+                                        << " n = " << n << " scale " << scale);
+      EXPECT_EQ(view.width, camera.width());
+      EXPECT_EQ(view.height, camera.height());
+      EXPECT_DOUBLE_EQ(view.k(0, 2), camera.cx());
+      EXPECT_DOUBLE_EQ(view.k(1, 2), camera.cy());
+      const std::vector<Eigen::Vector2d> rays =
+          BorderRaysInOutput(refractive, view);
+      EXPECT_GT(rays.size(), 2u * (camera.width() + camera.height()) - 8u);
+      EXPECT_EQ(CountOutside(rays, view), 0);
+      VirtualPinholeView narrower = view;
+      narrower.k(0, 0) *= 1.0 + kScaleTolerance;
+      narrower.k(1, 1) *= 1.0 + kScaleTolerance;
+      EXPECT_GT(
+          CountOutside(BorderRaysInOutput(refractive, narrower), narrower), 0);
+      // The whole field of view is wider than the view without borders
+      // (equal for a pinhole in air: both are the camera itself).
+      const double no_border_scale = VirtualPinholeFocalScale(
+          refractive,
+          ChooseVirtualPinholeView(refractive, VirtualPinholeFit::kNoBorder)
+              .value());
+      if (camera.model() == LensModelId::kPinhole && n == 1.0) {
+        EXPECT_EQ(scale, 1.0);
+        EXPECT_EQ(no_border_scale, 1.0);
+      } else {
+        EXPECT_LT(scale, no_border_scale);
+      }
+    }
+  }
+}
+
+TEST(VirtualPinholeRemap, FitNamesRoundTrip) {
+  for (VirtualPinholeFit fit :
+       {VirtualPinholeFit::kVirtualPinhole, VirtualPinholeFit::kNoBorder,
+        VirtualPinholeFit::kFullFieldOfView}) {
+    EXPECT_EQ(VirtualPinholeFitFromName(VirtualPinholeFitName(fit)), fit);
+  }
+  EXPECT_EQ(std::string(VirtualPinholeFitName(VirtualPinholeFit::kNoBorder)),
+            "no-border");
+  EXPECT_FALSE(VirtualPinholeFitFromName("none").has_value());
+}
+
+TEST(VirtualPinholeRemap, RotatedNoBorderFitIsCoveredAndMaximal) {
+  // A view rotated 3 degrees: the bisection runs through the rotation, on
+  // the output border, exactly as the maps sample.
+  const RefractiveCamera camera = Refractive(test::AlphasenseCam0(), 1.333);
+  const Eigen::Matrix3d rotation =
+      Eigen::AngleAxisd(3.0 * M_PI / 180.0,
+                        Eigen::Vector3d(0.2, 1.0, -0.3).normalized())
+          .toRotationMatrix();
+  const ZoomedViewFamily family = VirtualPinholeFamily(camera);
+  const double scale = FitFocalScale({RotatedCamera{camera, rotation}}, family,
+                                     VirtualPinholeFit::kNoBorder)
+                           .value();
+  const RemapMaps maps =
+      BuildVirtualPinholeMaps(camera, family.At(scale, rotation)).value();
+  EXPECT_EQ(maps.num_invalid, 0);
+  // Rotated off the principal point, the view must zoom in further than
+  // the unrotated one.
+  const double unrotated = FitFocalScale({RotatedCamera{camera}}, family,
+                                         VirtualPinholeFit::kNoBorder)
+                               .value();
+  EXPECT_GT(scale, unrotated);
+  const RemapMaps wider =
+      BuildVirtualPinholeMaps(
+          camera, family.At(scale * (1.0 - 2.0 * kScaleTolerance), rotation))
+          .value();
+  double min_x, max_x, min_y, max_y;
+  cv::minMaxLoc(wider.map_x, &min_x, &max_x);
+  cv::minMaxLoc(wider.map_y, &min_y, &max_y);
+  EXPECT_TRUE(wider.num_invalid > 0 || min_x < 0.0 ||
+              max_x > camera.camera().width() - 1.0 || min_y < 0.0 ||
+              max_y > camera.camera().height() - 1.0);
+}
+
+TEST(VirtualPinholeRemap, ZoomedFamilyKeepsTheAnchor) {
+  // The anchor pixel sees the anchor direction at every scale.
+  ZoomedViewFamily family;
+  family.base_focal = Eigen::Vector2d(400.0, 410.0);
+  family.anchor_pixel = Eigen::Vector2d(319.5, 239.5);
+  family.anchor_direction = Eigen::Vector2d(0.05, -0.02);
+  family.width = 640;
+  family.height = 480;
+  for (double scale : {0.5, 1.0, 1.7}) {
+    const VirtualPinholeView view = family.At(scale);
+    EXPECT_TRUE(view.Check().ok());
+    EXPECT_DOUBLE_EQ(view.k(0, 0), 400.0 * scale);
+    EXPECT_DOUBLE_EQ(view.k(1, 1), 410.0 * scale);
+    const Eigen::Vector2d seen =
+        (view.k * Eigen::Vector3d(0.05, -0.02, 1.0)).hnormalized();
+    EXPECT_NEAR((seen - family.anchor_pixel).norm(), 0.0, 1e-12);
+  }
+  ZoomedViewFamily bad = family;
+  bad.base_focal.x() = 0.0;
+  EXPECT_FALSE(bad.Check().ok());
+  EXPECT_FALSE(FitFocalScale({}, family, VirtualPinholeFit::kNoBorder).ok());
 }
 
 TEST(VirtualPinholeRemap, FixedPointMapsAreOpenCvs) {

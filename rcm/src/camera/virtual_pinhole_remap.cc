@@ -2,12 +2,16 @@
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <opencv2/imgproc.hpp>
 #include <optional>
 #include <sstream>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "rcm/util/parallel_for.h"
@@ -23,79 +27,106 @@ Eigen::Matrix3d VirtualFromOutput(const RefractiveCamera& camera,
          view.k.inverse();
 }
 
-// The view K_n with both focal lengths scaled by `scale`.
-VirtualPinholeView ScaledView(const RefractiveCamera& camera, double scale) {
-  VirtualPinholeView view;
-  view.k = camera.VirtualPinholeMatrix();
-  view.k(0, 0) *= scale;
-  view.k(1, 1) *= scale;
-  view.width = camera.camera().width();
-  view.height = camera.camera().height();
-  return view;
-}
-
-// True when every border pixel of the scaled view samples the raw image
-// inside [0, w - 1] x [0, h - 1].
-bool BorderInsideRaw(const RefractiveCamera& camera, double scale) {
-  const Camera& lens = camera.camera();
-  const int width = lens.width();
-  const int height = lens.height();
-  const double cx = lens.cx();
-  const double cy = lens.cy();
-  auto inside = [&](int u, int v) {
-    // K_n K'^-1 p' = c + (p' - c) / scale.
-    const std::optional<Eigen::Vector2d> raw = camera.ImageFromVirtualPinhole(
-        Eigen::Vector2d(cx + (u - cx) / scale, cy + (v - cy) / scale));
-    return raw && raw->x() >= 0.0 && raw->x() <= width - 1.0 &&
-           raw->y() >= 0.0 && raw->y() <= height - 1.0;
-  };
+// Output pixel (u, v) of the border of a w x h image: calls
+// `visit(u, v, edge)` for every pixel center on the four edges, edge 0 top
+// (v = 0), 1 bottom, 2 left (u = 0), 3 right; corners on two edges. Stops
+// and returns false as soon as `visit` does.
+template <typename Visit>
+bool ForEachBorderPixel(int width, int height, Visit visit) {
   for (int u = 0; u < width; ++u) {
-    if (!inside(u, 0) || !inside(u, height - 1)) return false;
+    if (!visit(u, 0, 0) || !visit(u, height - 1, 1)) return false;
   }
-  for (int v = 1; v + 1 < height; ++v) {
-    if (!inside(0, v) || !inside(width - 1, v)) return false;
+  for (int v = 0; v < height; ++v) {
+    if (!visit(0, v, 2) || !visit(width - 1, v, 3)) return false;
   }
   return true;
 }
 
-StatusOr<double> NoBorderFocalScale(const RefractiveCamera& camera) {
+// Inside [0, width - 1] x [0, height - 1], up to kVirtualPinholeFitSlackPx.
+bool InsideCenters(const Eigen::Vector2d& pixel, int width, int height) {
+  constexpr double kSlack = kVirtualPinholeFitSlackPx;
+  return pixel.x() >= -kSlack && pixel.x() <= width - 1.0 + kSlack &&
+         pixel.y() >= -kSlack && pixel.y() <= height - 1.0 + kSlack;
+}
+
+// True when every border pixel of `view` samples the raw image of `camera`
+// inside [0, w - 1] x [0, h - 1], computed exactly as the maps are.
+bool OutputBorderInsideRaw(const RefractiveCamera& camera,
+                           const VirtualPinholeView& view) {
   const Camera& lens = camera.camera();
-  if (lens.cx() < 0.0 || lens.cx() > lens.width() - 1.0 || lens.cy() < 0.0 ||
-      lens.cy() > lens.height() - 1.0) {
-    return Status::Error(
-        "no virtual pinhole view without black borders: the principal point "
-        "lies outside the image");
-  }
-  constexpr double kMinScale = 1e-3;
-  constexpr double kMaxScale = 1e3;
-  // Bracket: `valid` has every border pixel inside, `invalid` not.
+  const Eigen::Matrix3d virtual_from_output = VirtualFromOutput(camera, view);
+  return ForEachBorderPixel(view.width, view.height, [&](int u, int v, int) {
+    const Eigen::Vector3d virtual_point =
+        virtual_from_output * Eigen::Vector3d(u, v, 1.0);
+    if (!(virtual_point.z() > 0.0)) return false;
+    const std::optional<Eigen::Vector2d> raw =
+        camera.ImageFromVirtualPinhole(virtual_point.hnormalized());
+    return raw && InsideCenters(*raw, lens.width(), lens.height());
+  });
+}
+
+// View-frame directions (not normalized, z > 0) of the rays of a camera's
+// raw border pixels that the lens can unproject; nullopt when one of them
+// points 90 degrees or more off the view axis (`behind` then names it).
+std::optional<std::vector<Eigen::Vector3d>> BorderRaysInView(
+    const RotatedCamera& rotated, Eigen::Vector2d* behind) {
+  const Camera& lens = rotated.camera.camera();
+  const Eigen::Matrix3d view_from_camera = rotated.camera_from_view.transpose();
+  std::vector<Eigen::Vector3d> rays;
+  rays.reserve(2 * (lens.width() + lens.height()));
+  const bool all_in_front =
+      ForEachBorderPixel(lens.width(), lens.height(), [&](int u, int v, int) {
+        const std::optional<Eigen::Vector3d> bearing =
+            rotated.camera.BearingInWaterFromImage(Eigen::Vector2d(u, v));
+        if (!bearing) return true;  // not unprojectable: not seen
+        const Eigen::Vector3d in_view = view_from_camera * *bearing;
+        if (!(in_view.z() > 0.0)) {
+          *behind = Eigen::Vector2d(u, v);
+          return false;
+        }
+        rays.push_back(in_view);
+        return true;
+      });
+  if (!all_in_front) return std::nullopt;
+  return rays;
+}
+
+constexpr double kMinScale = 1e-3;
+constexpr double kMaxScale = 1e3;
+constexpr double kScaleTolerance = 1e-6;
+
+enum class BisectionFailure { kHoldsEverywhere, kHoldsNowhere };
+
+// The boundary of a predicate `holds(s)` that is monotone in s: it holds
+// for s >= s* when `larger_holds`, else for s <= s*. Returns an s that
+// holds within a relative kScaleTolerance of s*, searching
+// [kMinScale, kMaxScale] from s = 1 by halving or doubling, then bisecting.
+template <typename Holds>
+std::variant<double, BisectionFailure> BisectScale(Holds holds,
+                                                   bool larger_holds) {
+  // From a valid scale toward the invalid side.
+  const double step = larger_holds ? 0.5 : 2.0;
+  const auto out_of_range = [](double s) {
+    return s < kMinScale || s > kMaxScale;
+  };
   double valid = 1.0;
   double invalid = 1.0;
-  if (BorderInsideRaw(camera, 1.0)) {
-    while (BorderInsideRaw(camera, invalid)) {
-      invalid *= 0.5;
-      if (invalid < kMinScale) {
-        // Not seen: far off axis every lens folds or refraction cuts off.
-        return Status::Error(
-            "no virtual pinhole view without black borders: the border stays "
-            "inside the image down to a focal 1/1000 of K_n");
-      }
+  if (holds(1.0)) {
+    while (holds(invalid)) {
+      invalid *= step;
+      if (out_of_range(invalid)) return BisectionFailure::kHoldsEverywhere;
     }
-    valid = 2.0 * invalid;
+    valid = invalid / step;
   } else {
-    while (!BorderInsideRaw(camera, valid)) {
-      valid *= 2.0;
-      if (valid > kMaxScale) {
-        return Status::Error(
-            "no virtual pinhole view without black borders: even a focal "
-            "1000 times K_n samples outside the image");
-      }
+    while (!holds(valid)) {
+      valid /= step;
+      if (out_of_range(valid)) return BisectionFailure::kHoldsNowhere;
     }
-    invalid = 0.5 * valid;
+    invalid = valid * step;
   }
-  while (valid - invalid > 1e-6 * valid) {
+  while (std::abs(valid - invalid) > kScaleTolerance * valid) {
     const double middle = 0.5 * (valid + invalid);
-    (BorderInsideRaw(camera, middle) ? valid : invalid) = middle;
+    (holds(middle) ? valid : invalid) = middle;
   }
   return valid;
 }
@@ -145,18 +176,195 @@ Status VirtualPinholeView::Check() const {
   return Status::Ok();
 }
 
-StatusOr<VirtualPinholeView> ChooseVirtualPinholeView(
-    const RefractiveCamera& camera, VirtualPinholeFit fit) {
+const char* VirtualPinholeFitName(VirtualPinholeFit fit) {
   switch (fit) {
     case VirtualPinholeFit::kVirtualPinhole:
-      return ScaledView(camera, 1.0);
-    case VirtualPinholeFit::kNoBorder: {
-      const StatusOr<double> scale = NoBorderFocalScale(camera);
-      if (!scale.ok()) return scale.status();
-      return ScaledView(camera, *scale);
-    }
+      return "virtual-pinhole";
+    case VirtualPinholeFit::kNoBorder:
+      return "no-border";
+    case VirtualPinholeFit::kFullFieldOfView:
+      return "full";
   }
-  return ScaledView(camera, 1.0);
+  return "virtual-pinhole";
+}
+
+std::optional<VirtualPinholeFit> VirtualPinholeFitFromName(
+    std::string_view name) {
+  for (VirtualPinholeFit fit :
+       {VirtualPinholeFit::kVirtualPinhole, VirtualPinholeFit::kNoBorder,
+        VirtualPinholeFit::kFullFieldOfView}) {
+    if (name == VirtualPinholeFitName(fit)) return fit;
+  }
+  return std::nullopt;
+}
+
+VirtualPinholeView ZoomedViewFamily::At(
+    double scale, const Eigen::Matrix3d& camera_from_view) const {
+  const double fx = scale * base_focal.x();
+  const double fy = scale * base_focal.y();
+  VirtualPinholeView view;
+  view.k << fx, 0.0, anchor_pixel.x() - fx * anchor_direction.x(), 0.0, fy,
+      anchor_pixel.y() - fy * anchor_direction.y(), 0.0, 0.0, 1.0;
+  view.width = width;
+  view.height = height;
+  view.camera_from_view = camera_from_view;
+  return view;
+}
+
+Status ZoomedViewFamily::Check() const {
+  if (width <= 0 || height <= 0) {
+    std::ostringstream message;
+    message << "zoomed view family: size " << width << " x " << height
+            << " is not positive";
+    return Status::Error(message.str());
+  }
+  if (!base_focal.allFinite() || !(base_focal.x() > 0.0) ||
+      !(base_focal.y() > 0.0) || !anchor_pixel.allFinite() ||
+      !anchor_direction.allFinite()) {
+    return Status::Error(
+        "zoomed view family: the base focal lengths must be finite and "
+        "positive, the anchor finite");
+  }
+  return Status::Ok();
+}
+
+ZoomedViewFamily VirtualPinholeFamily(const RefractiveCamera& camera) {
+  const Eigen::Matrix3d k_n = camera.VirtualPinholeMatrix();
+  ZoomedViewFamily family;
+  family.base_focal = Eigen::Vector2d(k_n(0, 0), k_n(1, 1));
+  family.anchor_pixel = Eigen::Vector2d(k_n(0, 2), k_n(1, 2));
+  family.width = camera.camera().width();
+  family.height = camera.camera().height();
+  return family;
+}
+
+StatusOr<double> FitFocalScale(const std::vector<RotatedCamera>& cameras,
+                               const ZoomedViewFamily& family,
+                               VirtualPinholeFit fit) {
+  if (cameras.empty()) return Status::Error("no camera to fit a view to");
+  RCM_RETURN_IF_ERROR(family.Check());
+  for (const RotatedCamera& rotated : cameras) {
+    // The view's own check covers the rotation.
+    RCM_RETURN_IF_ERROR(family.At(1.0, rotated.camera_from_view).Check());
+  }
+  if (fit == VirtualPinholeFit::kVirtualPinhole) return 1.0;
+  const std::string what =
+      fit == VirtualPinholeFit::kNoBorder
+          ? "no virtual pinhole view without black borders: "
+          : "no virtual pinhole view with the whole field of view: ";
+  if (!InsideCenters(family.anchor_pixel, family.width, family.height)) {
+    return Status::Error(what + "the principal point lies outside the image");
+  }
+  std::variant<double, BisectionFailure> scale;
+  if (fit == VirtualPinholeFit::kNoBorder) {
+    scale = BisectScale(
+        [&](double s) {
+          for (const RotatedCamera& rotated : cameras) {
+            if (!OutputBorderInsideRaw(
+                    rotated.camera, family.At(s, rotated.camera_from_view))) {
+              return false;
+            }
+          }
+          return true;
+        },
+        /*larger_holds=*/true);
+  } else {
+    std::vector<std::vector<Eigen::Vector3d>> rays;
+    for (const RotatedCamera& rotated : cameras) {
+      Eigen::Vector2d behind;
+      std::optional<std::vector<Eigen::Vector3d>> in_view =
+          BorderRaysInView(rotated, &behind);
+      if (!in_view) {
+        std::ostringstream message;
+        message << what << "raw pixel (" << behind.x() << ", " << behind.y()
+                << ") sees a ray 90 degrees or more off the view axis";
+        return Status::Error(message.str());
+      }
+      rays.push_back(std::move(*in_view));
+    }
+    scale = BisectScale(
+        [&](double s) {
+          // K(s) is the same matrix for every camera.
+          const Eigen::Matrix3d k = family.At(s).k;
+          for (const std::vector<Eigen::Vector3d>& camera_rays : rays) {
+            for (const Eigen::Vector3d& ray : camera_rays) {
+              if (!InsideCenters((k * ray).hnormalized(), family.width,
+                                 family.height)) {
+                return false;
+              }
+            }
+          }
+          return true;
+        },
+        /*larger_holds=*/false);
+  }
+  if (const double* found = std::get_if<double>(&scale)) return *found;
+  const bool everywhere =
+      std::get<BisectionFailure>(scale) == BisectionFailure::kHoldsEverywhere;
+  if (fit == VirtualPinholeFit::kNoBorder) {
+    // Not seen: far off axis every lens folds or refraction cuts off.
+    return Status::Error(
+        what + (everywhere ? "the border stays inside the image down to a "
+                             "focal 1/1000 of K_n"
+                           : "even a focal 1000 times K_n samples outside "
+                             "the image"));
+  }
+  return Status::Error(
+      what + (everywhere ? "the raw border stays inside the output up to a "
+                           "focal 1000 times K_n"
+                         : "even a focal 1/1000 of K_n leaves raw border "
+                           "pixels outside the output"));
+}
+
+ViewFieldOfView FieldOfViewInView(const RotatedCamera& rotated) {
+  const Camera& lens = rotated.camera.camera();
+  const Eigen::Matrix3d view_from_camera = rotated.camera_from_view.transpose();
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  // Innermost coordinate of each edge: top (largest y), bottom (smallest
+  // y), left (largest x), right (smallest x).
+  std::array<double, 4> innermost = {-kInf, kInf, -kInf, kInf};
+  ViewFieldOfView field;
+  bool bounded = true;
+  ForEachBorderPixel(lens.width(), lens.height(), [&](int u, int v, int edge) {
+    const std::optional<Eigen::Vector3d> bearing =
+        rotated.camera.BearingInWaterFromImage(Eigen::Vector2d(u, v));
+    if (!bearing) return true;
+    const Eigen::Vector3d in_view = view_from_camera * *bearing;
+    if (!(in_view.z() > 0.0)) {
+      bounded = false;
+      return true;
+    }
+    const Eigen::Vector2d direction = in_view.hnormalized();
+    field.outer.extend(direction);
+    switch (edge) {
+      case 0:
+        innermost[0] = std::max(innermost[0], direction.y());
+        break;
+      case 1:
+        innermost[1] = std::min(innermost[1], direction.y());
+        break;
+      case 2:
+        innermost[2] = std::max(innermost[2], direction.x());
+        break;
+      default:
+        innermost[3] = std::min(innermost[3], direction.x());
+        break;
+    }
+    return true;
+  });
+  field.inner =
+      Eigen::AlignedBox2d(Eigen::Vector2d(innermost[2], innermost[0]),
+                          Eigen::Vector2d(innermost[3], innermost[1]));
+  if (!bounded) field.outer.setEmpty();
+  return field;
+}
+
+StatusOr<VirtualPinholeView> ChooseVirtualPinholeView(
+    const RefractiveCamera& camera, VirtualPinholeFit fit) {
+  const ZoomedViewFamily family = VirtualPinholeFamily(camera);
+  const StatusOr<double> scale = FitFocalScale({{camera}}, family, fit);
+  if (!scale.ok()) return scale.status();
+  return family.At(*scale);
 }
 
 double VirtualPinholeFocalScale(const RefractiveCamera& camera,
@@ -218,18 +426,23 @@ StatusOr<RemapMaps> BuildVirtualPinholeMaps(const RefractiveCamera& camera,
 }
 
 cv::Mat RemapToVirtualPinhole(const cv::Mat& raw, const RemapMaps& maps) {
+  cv::Mat output;
+  RemapToVirtualPinhole(raw, maps, &output);
+  return output;
+}
+
+void RemapToVirtualPinhole(const cv::Mat& raw, const RemapMaps& maps,
+                           cv::Mat* output) {
   CHECK(raw.size() == maps.raw_size)
       << "raw image " << raw.cols << " x " << raw.rows << ", maps sample "
       << maps.raw_size.width << " x " << maps.raw_size.height;
-  cv::Mat output;
   if (!maps.fixed_xy.empty()) {
-    cv::remap(raw, output, maps.fixed_xy, maps.fixed_table, cv::INTER_LINEAR,
+    cv::remap(raw, *output, maps.fixed_xy, maps.fixed_table, cv::INTER_LINEAR,
               cv::BORDER_CONSTANT, cv::Scalar::all(0));
   } else {
-    cv::remap(raw, output, maps.map_x, maps.map_y, cv::INTER_LINEAR,
+    cv::remap(raw, *output, maps.map_x, maps.map_y, cv::INTER_LINEAR,
               cv::BORDER_CONSTANT, cv::Scalar::all(0));
   }
-  return output;
 }
 
 }  // namespace rcm
