@@ -91,10 +91,6 @@ constexpr char kUsage[] =
     "corrected cameras), time shifts and topics are kept.\n\n"
     "Exit status: 0 on success, 1 on bad input, 2 on wrong flags.";
 
-std::string Fixed(double value, int digits) {
-  return FormatFixed(value, digits);
-}
-
 double Milliseconds(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(
              std::chrono::steady_clock::now() - start)
@@ -210,12 +206,12 @@ std::string CameraLine(const std::string& name,
                        const VirtualPinholeCamera& camera) {
   const Camera& pinhole = camera.pinhole;
   std::ostringstream line;
-  line << "  " << name << "K' = [fx " << Fixed(pinhole.fx(), 2) << ", fy "
-       << Fixed(pinhole.fy(), 2) << ", cx " << Fixed(pinhole.cx(), 2) << ", cy "
-       << Fixed(pinhole.cy(), 2) << "], "
+  line << "  " << name << "K' = [fx " << FormatFixed(pinhole.fx(), 2) << ", fy "
+       << FormatFixed(pinhole.fy(), 2) << ", cx " << FormatFixed(pinhole.cx(), 2) << ", cy "
+       << FormatFixed(pinhole.cy(), 2) << "], "
        << SizeText(pinhole.width(), pinhole.height()) << ", focal "
-       << Fixed(camera.FocalScale(), 4) << " x K_n, "
-       << Fixed(100.0 * camera.BlackFraction(), 1) << " % black";
+       << FormatFixed(camera.FocalScale(), 4) << " x K_n, "
+       << FormatFixed(100.0 * camera.BlackFraction(), 1) << " % black";
   return line.str();
 }
 
@@ -577,9 +573,9 @@ int RunUndistort() {
        << CameraLine("left   ", corrected->left()) << "\n"
        << CameraLine("right  ", corrected->right()) << "\n"
        << "  images " << report->images << " written (" << report->pairs
-       << " pairs); maps built once in " << Fixed(corrected->build_ms(), 0)
-       << " ms, remap " << Fixed(Median(report->remap_ms), 2)
-       << " ms per image (median), " << Fixed(report->total_ms / pairs, 1)
+       << " pairs); maps built once in " << FormatFixed(corrected->build_ms(), 0)
+       << " ms, remap " << FormatFixed(Median(report->remap_ms), 2)
+       << " ms per image (median), " << FormatFixed(report->total_ms / pairs, 1)
        << " ms per pair with reading and writing\n"
        << "  wrote ";
   for (const std::string& path : report->written) text << " " << path;
