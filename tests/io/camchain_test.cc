@@ -161,6 +161,16 @@ void ExpectCamchainsBitwiseEqual(const Camchain& a, const Camchain& b) {
     }
     EXPECT_EQ(ca.cam_overlaps, cb.cam_overlaps);
     EXPECT_EQ(ca.rostopic, cb.rostopic);
+    ASSERT_EQ(ca.port.has_value(), cb.port.has_value());
+    if (ca.port.has_value()) {
+      EXPECT_TRUE(BitwiseEqual(ca.port->air_gap, cb.port->air_gap));
+      EXPECT_TRUE(
+          BitwiseEqual(ca.port->glass_thickness, cb.port->glass_thickness));
+      EXPECT_TRUE(BitwiseEqual(ca.port->glass_index, cb.port->glass_index));
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_TRUE(BitwiseEqual(ca.port->normal[k], cb.port->normal[k]));
+      }
+    }
   }
 }
 
@@ -363,6 +373,81 @@ TEST(Camchain, NoneModelRoundTrips) {
   const StatusOr<Camchain> parsed = ParseCamchain(text, "rig.yaml");
   ASSERT_TRUE(parsed.ok()) << parsed.status().message();
   ExpectCamchainsBitwiseEqual(*parsed, camchain);
+}
+
+TEST(Camchain, PortBlockRoundTrips) {
+  Camchain camchain;
+  camchain.cameras.push_back(
+      MakeEntry(MakeCamera(LensModelId::kPinhole, 400.0, {}), std::nullopt));
+  FlatPort port;
+  port.air_gap = 0.008;
+  port.glass_thickness = 0.006;
+  port.glass_index = 1.517;
+  port.normal = TiltedPortNormal(0.02, 0.3);
+  camchain.cameras[0].port = port;
+  const std::string text = FormatCamchain(camchain);
+  EXPECT_NE(text.find("  port:\n"
+                      "    air_gap: 0.008\n"
+                      "    glass_index: 1.517\n"
+                      "    glass_thickness: 0.006\n"
+                      "    normal: ["),
+            std::string::npos)
+      << text;
+  const StatusOr<Camchain> parsed = ParseCamchain(text, "rig.yaml");
+  ASSERT_TRUE(parsed.ok()) << parsed.status().message();
+  ExpectCamchainsBitwiseEqual(*parsed, camchain);
+}
+
+TEST(Camchain, PortDefaultsToAcrylicAlongTheOpticalAxis) {
+  const std::string text = ReplaceOnce(
+      kMinimal, "  resolution: [720, 540]\ncam1:\n",
+      "  resolution: [720, 540]\n  port: {air_gap: 0.01, glass_thickness: "
+      "0.005}\ncam1:\n");
+  const StatusOr<Camchain> parsed = ParseCamchain(text, "rig.yaml");
+  ASSERT_TRUE(parsed.ok()) << parsed.status().message();
+  ASSERT_TRUE(parsed->cameras[0].port.has_value());
+  EXPECT_FALSE(parsed->cameras[1].port.has_value());
+  const FlatPort& port = *parsed->cameras[0].port;
+  EXPECT_EQ(port.air_gap, 0.01);
+  EXPECT_EQ(port.glass_thickness, 0.005);
+  EXPECT_EQ(port.glass_index, 1.49);
+  EXPECT_EQ(port.normal, Eigen::Vector3d::UnitZ());
+}
+
+TEST(Camchain, PortNormalIsNormalized) {
+  const std::string text = ReplaceOnce(
+      kMinimal, "  resolution: [720, 540]\ncam1:\n",
+      "  resolution: [720, 540]\n  port: {air_gap: 0.01, glass_thickness: "
+      "0.0, normal: [0, 0, 2]}\ncam1:\n");
+  const StatusOr<Camchain> parsed = ParseCamchain(text, "rig.yaml");
+  ASSERT_TRUE(parsed.ok()) << parsed.status().message();
+  EXPECT_EQ(parsed->cameras[0].port->normal, Eigen::Vector3d::UnitZ());
+}
+
+TEST(Camchain, RejectsBadPortBlocks) {
+  const auto with_port = [](const std::string& port) {
+    return ParseError(ReplaceOnce(kMinimal, "  resolution: [720, 540]\ncam1:\n",
+                                  "  resolution: [720, 540]\n  port: " + port +
+                                      "\ncam1:\n"));
+  };
+  EXPECT_THAT(with_port("3"), HasSubstr("cam0.port: expected a map"));
+  EXPECT_THAT(with_port("{glass_thickness: 0.005}"),
+              HasSubstr("cam0.port: missing key 'air_gap'"));
+  EXPECT_THAT(with_port("{air_gap: 0.01, glass_thickness: 0.0, gap_mm: 8}"),
+              HasSubstr("cam0.port.gap_mm: unknown key"));
+  EXPECT_THAT(with_port("{air_gap: -0.01, glass_thickness: 0.0}"),
+              HasSubstr("port air_gap = -0.01 m is outside [0, 0.5]"));
+  EXPECT_THAT(with_port("{air_gap: 8, glass_thickness: 0.0}"),
+              HasSubstr("outside [0, 0.5]"));
+  EXPECT_THAT(with_port("{air_gap: .nan, glass_thickness: 0.0}"),
+              HasSubstr("cam0.port.air_gap"));
+  EXPECT_THAT(with_port("{air_gap: 0.01, glass_thickness: 0.0, normal: [0, 1]}"),
+              HasSubstr("cam0.port.normal"));
+  EXPECT_THAT(
+      with_port("{air_gap: 0.01, glass_thickness: 0.0, normal: [0, 1, 0]}"),
+      HasSubstr("tilted 90 degrees"));
+  EXPECT_THAT(with_port("{air_gap: 0.01, glass_thickness: 0.0, glass_index: 3}"),
+              HasSubstr("glass_index = 3 is outside [1, 2]"));
 }
 
 TEST(Camchain, NoneModelMayOmitCoefficients) {

@@ -42,6 +42,57 @@ const YAML::Node* Find(const YamlEntries& entries, std::string_view key) {
   return entry == nullptr ? nullptr : &entry->value;
 }
 
+// The `port` block of a camera (flat_port_geometry.h): air_gap and
+// glass_thickness required, glass_index and normal optional; a normal
+// that is not of unit length is normalized. An unknown key is an error here (a misspelt key of a
+// port would silently give the thin port).
+StatusOr<FlatPort> ReadPort(const YamlReader& reader, const YAML::Node& node,
+                            const std::string& field) {
+  if (!node.IsMap()) {
+    return reader.Error(node, field,
+                        "expected a map {air_gap, glass_thickness, "
+                        "glass_index, normal}, got " +
+                            DescribeYamlNode(node));
+  }
+  const StatusOr<YamlEntries> entries = reader.Entries(node, field);
+  if (!entries.ok()) return entries.status();
+  for (const auto& [key, entry] : *entries) {
+    if (key != "air_gap" && key != "glass_thickness" &&
+        key != "glass_index" && key != "normal") {
+      return reader.Error(entry.key, field + "." + key,
+                          "unknown key (a port has air_gap, "
+                          "glass_thickness, glass_index, normal)");
+    }
+  }
+  FlatPort port;
+  const auto number = [&](const char* key, bool required,
+                          double* value) -> Status {
+    const YAML::Node* item = Find(*entries, key);
+    if (item == nullptr) {
+      return required ? reader.MissingKey(field, key) : Status::Ok();
+    }
+    const StatusOr<double> read = reader.Number(*item, field + "." + key);
+    if (!read.ok()) return read.status();
+    *value = *read;
+    return Status::Ok();
+  };
+  RCM_RETURN_IF_ERROR(number("air_gap", true, &port.air_gap));
+  RCM_RETURN_IF_ERROR(number("glass_thickness", true, &port.glass_thickness));
+  RCM_RETURN_IF_ERROR(number("glass_index", false, &port.glass_index));
+  if (const YAML::Node* item = Find(*entries, "normal")) {
+    const StatusOr<std::vector<double>> normal =
+        reader.NumberList(*item, field + ".normal", 3);
+    if (!normal.ok()) return normal.status();
+    port.normal = Eigen::Vector3d((*normal)[0], (*normal)[1], (*normal)[2]);
+  }
+  if (const Status status = port.Check(); !status.ok()) {
+    return reader.Error(node, field, status.message());
+  }
+  // A unit normal read back from a file rcm wrote stays bit-exact.
+  if (std::abs(port.normal.norm() - 1.0) > 1e-12) port.normal.normalize();
+  return port;
+}
+
 StatusOr<CamchainCamera> ParseCamera(const YamlReader& reader, int index,
                                      const YAML::Node& node) {
   const std::string name = "cam" + std::to_string(index);
@@ -183,6 +234,11 @@ StatusOr<CamchainCamera> ParseCamera(const YamlReader& reader, int index,
         reader.Number(*value, field("timeshift_cam_imu"));
     if (!shift.ok()) return shift.status();
     result.timeshift_cam_imu = *shift;
+  }
+  if (const YAML::Node* value = Find(*entries, "port")) {
+    const StatusOr<FlatPort> port = ReadPort(reader, *value, field("port"));
+    if (!port.ok()) return port.status();
+    result.port = *port;
   }
   return result;
 }
@@ -403,6 +459,19 @@ void AppendCamera(const std::string& name, const CamchainCamera& entry,
   AppendListField(
       "resolution",
       {std::to_string(camera.width()), std::to_string(camera.height())}, out);
+  if (entry.port.has_value()) {
+    // Sorted keys; a map holding a list is written in block style.
+    const FlatPort& port = *entry.port;
+    *out += "  port:\n";
+    *out += "    air_gap: " + YamlFloat(port.air_gap) + "\n";
+    *out += "    glass_index: " + YamlFloat(port.glass_index) + "\n";
+    *out += "    glass_thickness: " + YamlFloat(port.glass_thickness) + "\n";
+    *out += "    normal: ";
+    AppendFlowList(
+        FloatItems({port.normal.x(), port.normal.y(), port.normal.z()}), 6,
+        out);
+    *out += '\n';
+  }
   if (!entry.rostopic.empty()) {
     *out += "  rostopic: " + YamlString(entry.rostopic) + "\n";
   }

@@ -16,6 +16,11 @@
 //     resolution: [720, 540]          # width, height
 //     rostopic: /cam0/image_raw       # optional
 //     timeshift_cam_imu: 0.0012       # optional, seconds
+//     port:                           # optional (rcm), the housing's flat
+//       air_gap: 0.008                #   port in front of the camera, in
+//       glass_index: 1.49             #   meters (flat_port_geometry.h);
+//       glass_thickness: 0.006        #   normal optional, default [0, 0, 1],
+//       normal: [0.0, 0.0, 1.0]       #   glass_index optional, default 1.49
 //   cam1:
 //     T_cn_cnm1:                  # required on cam1 and later, absent on
 //     - [...]                     # cam0: maps cam(n-1) points into cam(n),
@@ -46,6 +51,7 @@
 #include <vector>
 
 #include "rcm/camera/camera.h"
+#include "rcm/camera/flat_port_geometry.h"
 #include "rcm/geometry/rigid3d.h"
 #include "rcm/geometry/stereo_rig.h"
 #include "rcm/util/status.h"
@@ -64,6 +70,9 @@ struct CamchainCamera {
   std::vector<int> cam_overlaps;
   // Empty means the key is absent.
   std::string rostopic;
+  // The housing's flat port in front of this camera (rcm's extension of
+  // Kalibr's format, see above); absent = the paper's thin port.
+  std::optional<FlatPort> port = std::nullopt;
 };
 
 struct Camchain {

@@ -45,28 +45,10 @@
 #include <Eigen/Geometry>
 #include <optional>
 
+#include "rcm/camera/flat_port_geometry.h"
 #include "rcm/util/status.h"
 
 namespace rcm {
-
-// A flat port in front of one camera. The default is the thin port of the
-// paper: no gap, no glass, normal on the optical axis.
-struct FlatPort {
-  double air_gap = 0.0;          // d, meters, camera center to the glass, >= 0
-  double glass_thickness = 0.0;  // tg, meters, >= 0
-  double glass_index = 1.49;     // n_glass (acrylic; BK7 is 1.517), [1, 2]
-  // Port normal in the camera frame; normalized by Check's caller. Must be
-  // finite, nonzero and within 30 degrees of the optical axis.
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
-
-  Status Check() const;
-  // True for the paper's thin port (d = tg = 0, normal = +z exactly).
-  bool IsThin() const;
-};
-
-// The normal of a port tilted by `tilt_radians` about the axis of angle
-// `azimuth_radians` in the image plane (0 = about +x, i.e. pitch).
-Eigen::Vector3d TiltedPortNormal(double tilt_radians, double azimuth_radians);
 
 // Vector Snell's law. `incident` and `normal` unit, normal . incident > 0,
 // eta = n_from / n_to. Returns the unit refracted direction, or nullopt on
