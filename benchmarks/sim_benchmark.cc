@@ -8,7 +8,7 @@
 #include <cmath>
 #include <vector>
 
-#include "rcm/sim/flat_port.h"
+#include "rcm/camera/flat_port.h"
 #include "rcm/sim/reference_rigs.h"
 #include "rcm/sim/stereo_renderer.h"
 #include "rcm/sim/tank_scene.h"

@@ -6,7 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "rcm/estimation/batch_refinement.h"
-#include "rcm/sim/flat_port_camera.h"
+#include "rcm/camera/flat_port_camera.h"
 #include "rcm/sim/reference_rigs.h"
 
 namespace rcm {

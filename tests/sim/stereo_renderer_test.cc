@@ -6,7 +6,7 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 
-#include "rcm/sim/flat_port_camera.h"
+#include "rcm/camera/flat_port_camera.h"
 #include "rcm/sim/reference_rigs.h"
 #include "rcm/sim/trajectory.h"
 

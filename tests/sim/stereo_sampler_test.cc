@@ -8,7 +8,7 @@
 
 #include "rcm/camera/refractive_camera.h"
 #include "rcm/estimation/batch_refinement.h"
-#include "rcm/sim/flat_port_camera.h"
+#include "rcm/camera/flat_port_camera.h"
 #include "support/test_rigs.h"
 
 namespace rcm {

@@ -5,7 +5,7 @@
 #include <sstream>
 #include <utility>
 
-#include "rcm/sim/flat_port_camera.h"
+#include "rcm/camera/flat_port_camera.h"
 #include "rcm/sim/stereo_sampler.h"
 #include "rcm/util/splitmix64.h"
 

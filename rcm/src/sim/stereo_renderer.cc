@@ -6,7 +6,7 @@
 #include <utility>
 #include <vector>
 
-#include "rcm/sim/flat_port_camera.h"
+#include "rcm/camera/flat_port_camera.h"
 #include "rcm/util/parallel_for.h"
 #include "rcm/util/splitmix64.h"
 

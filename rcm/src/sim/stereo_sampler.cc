@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "rcm/camera/refractive_camera.h"
-#include "rcm/sim/flat_port_camera.h"
+#include "rcm/camera/flat_port_camera.h"
 
 namespace rcm {
 

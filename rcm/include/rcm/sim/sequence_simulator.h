@@ -24,7 +24,7 @@
 #include "rcm/geometry/rigid3d.h"
 #include "rcm/geometry/stereo_correspondence.h"
 #include "rcm/geometry/stereo_rig.h"
-#include "rcm/sim/flat_port.h"
+#include "rcm/camera/flat_port.h"
 #include "rcm/sim/media_schedule.h"
 #include "rcm/sim/stereo_renderer.h"
 #include "rcm/sim/tank_scene.h"

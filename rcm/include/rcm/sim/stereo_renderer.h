@@ -1,6 +1,6 @@
 // StereoRenderer: 8-bit monochrome stereo images of a TankScene as the
 // dataset cameras would record them, through each camera's lens and exact
-// flat port (flat_port_camera.h), in air (n = 1, the tank drained) or in
+// flat port (rcm/camera/flat_port_camera.h), in air (n = 1, the tank drained) or in
 // water (n > 1).
 //
 // Per pixel, s x s samples on a regular grid (pixel centers at integers,
@@ -45,7 +45,7 @@
 
 #include "rcm/geometry/rigid3d.h"
 #include "rcm/geometry/stereo_rig.h"
-#include "rcm/sim/flat_port.h"
+#include "rcm/camera/flat_port.h"
 #include "rcm/sim/tank_scene.h"
 #include "rcm/util/status.h"
 

@@ -18,7 +18,7 @@
 
 #include "rcm/geometry/stereo_correspondence.h"
 #include "rcm/geometry/stereo_rig.h"
-#include "rcm/sim/flat_port.h"
+#include "rcm/camera/flat_port.h"
 #include "rcm/util/status.h"
 
 namespace rcm {
@@ -41,7 +41,7 @@ struct StereoSamplerOptions {
 StatusOr<std::vector<StereoCorrespondence>> SampleStereoCorrespondences(
     const StereoRig& rig, const StereoSamplerOptions& options);
 
-// The same sampling through exact flat ports (flat_port_camera.h): the
+// The same sampling through exact flat ports (rcm/camera/flat_port_camera.h): the
 // left pixel's ray in the medium starts on the outer glass face and the
 // point is where it reaches depth Z. The medium of frame f is
 // n_of_frame[f] when given (num_frames entries, each in [1, 2]; media that

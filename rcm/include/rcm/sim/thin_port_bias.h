@@ -10,7 +10,7 @@
 #include <cstdint>
 
 #include "rcm/geometry/stereo_rig.h"
-#include "rcm/sim/flat_port.h"
+#include "rcm/camera/flat_port.h"
 #include "rcm/util/status.h"
 
 namespace rcm {

@@ -1,4 +1,4 @@
-#include "rcm/sim/flat_port.h"
+#include "rcm/camera/flat_port.h"
 
 #include <algorithm>
 #include <cmath>

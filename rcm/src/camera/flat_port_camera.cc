@@ -1,4 +1,4 @@
-#include "rcm/sim/flat_port_camera.h"
+#include "rcm/camera/flat_port_camera.h"
 
 namespace rcm {
 

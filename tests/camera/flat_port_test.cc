@@ -1,4 +1,4 @@
-#include "rcm/sim/flat_port.h"
+#include "rcm/camera/flat_port.h"
 
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <random>
 
 #include "rcm/camera/refractive_model.h"
-#include "rcm/sim/flat_port_camera.h"
+#include "rcm/camera/flat_port_camera.h"
 #include "support/test_rigs.h"
 
 namespace rcm {

@@ -1,16 +1,17 @@
 // FlatPortCamera: an in-air calibrated Camera (lens model) behind an exact
 // flat port (flat_port.h) in a medium of index n. A non-central camera:
 // each pixel sees along its own ray in the medium, which starts on the
-// outer glass face. The simulator's ground truth; with a thin port it is
-// the paper's model (RefractiveCamera) computed another way.
-#ifndef RCM_SIM_FLAT_PORT_CAMERA_H_
-#define RCM_SIM_FLAT_PORT_CAMERA_H_
+// outer glass face. The library's thick-port camera and the simulator's
+// ground truth; with a thin port it is the paper's model
+// (RefractiveCamera) computed another way.
+#ifndef RCM_CAMERA_FLAT_PORT_CAMERA_H_
+#define RCM_CAMERA_FLAT_PORT_CAMERA_H_
 
 #include <Eigen/Core>
 #include <optional>
 
 #include "rcm/camera/camera.h"
-#include "rcm/sim/flat_port.h"
+#include "rcm/camera/flat_port.h"
 #include "rcm/util/status.h"
 
 namespace rcm {
@@ -46,4 +47,4 @@ class FlatPortCamera {
 
 }  // namespace rcm
 
-#endif  // RCM_SIM_FLAT_PORT_CAMERA_H_
+#endif  // RCM_CAMERA_FLAT_PORT_CAMERA_H_

@@ -1,11 +1,13 @@
-// The exact flat port of an underwater housing, for the simulator: a camera
-// whose center sits an air gap d behind a glass plate of thickness tg and
-// index n_glass, beyond which lies the medium of index n. The plate's
-// normal N may be tilted slightly from the optical axis.
+// The exact flat port of an underwater housing (the thick-port model): a
+// camera whose center sits an air gap d behind a glass plate of thickness
+// tg and index n_glass, beyond which lies the medium of index n. The
+// plate's normal N may be tilted slightly from the optical axis. The
+// simulator's physics, and the library's model of housings the paper's
+// thin port does not describe (flat_port_camera.h).
 //
-// This is physics, not the paper's model: it shares no code with
-// refractive_model.h (the thin-port approximation d = tg = 0, N = z of
-// paper Sec. III-A), so that data it generates can test that model.
+// It shares no code with refractive_model.h (the thin-port approximation
+// d = tg = 0, N = z of paper Sec. III-A), so that data it generates can
+// test that model, and the two can be checked against each other.
 //
 // Geometry, in the camera frame (x right, y down, z forward), N unit with
 // N_z > 0, pointing out of the housing:
@@ -38,8 +40,8 @@
 //   v0 = cos(theta_air) N + sin(theta_air) u,  u = lateral unit vector.
 // No root exists past the critical angle of the medium (the limit of f for
 // t -> inf is below rho), which is when the point cannot be seen.
-#ifndef RCM_SIM_FLAT_PORT_H_
-#define RCM_SIM_FLAT_PORT_H_
+#ifndef RCM_CAMERA_FLAT_PORT_H_
+#define RCM_CAMERA_FLAT_PORT_H_
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -101,4 +103,4 @@ class ExactFlatPort {
 
 }  // namespace rcm
 
-#endif  // RCM_SIM_FLAT_PORT_H_
+#endif  // RCM_CAMERA_FLAT_PORT_H_
