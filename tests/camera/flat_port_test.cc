@@ -5,7 +5,10 @@
 #include <cmath>
 #include <random>
 
+#include <ceres/jet.h>
+
 #include "rcm/camera/refractive_model.h"
+#include "rcm/camera/thick_port_refraction.h"
 #include "rcm/camera/flat_port_camera.h"
 #include "support/test_rigs.h"
 
@@ -248,6 +251,99 @@ TEST(FlatPortCamera, RejectsInvalidPortOrIndex) {
   EXPECT_FALSE(FlatPortCamera::Create(test::AlphasenseCam0(), port, 1.333).ok());
   EXPECT_FALSE(
       FlatPortCamera::Create(test::AlphasenseCam0(), FlatPort(), 0.5).ok());
+}
+
+}  // namespace
+}  // namespace rcm
+
+// --- ThickPortRefraction: the templated back-trace.
+
+namespace rcm {
+namespace {
+
+// The templated back-trace against ExactFlatPort's: the same physics
+// written twice (Jet-ready formulas vs Eigen vectors), so they agree to
+// rounding (1e-12 on rays within 80 degrees of the axis).
+TEST(ThickPortRefraction, AgreesWithTheExactPort) {
+  constexpr double kTolerance = 1e-12;
+  const FlatPort port = ThickTiltedPort();
+  for (const double n : {1.0, 1.333, 1.6}) {
+    const ExactFlatPort exact = ExactFlatPort::Create(port, n).value();
+    for (const Eigen::Vector2d& xb : NormalizedPoints(1.4, 2000, 11)) {
+      const std::optional<RayInMedium> ray = exact.RayFromNormalized(xb);
+      double origin[3] = {0.0, 0.0, 0.0};
+      double direction[3] = {0.0, 0.0, 0.0};
+      const bool ok = ThickPortRefraction::RayInMedium(
+          n, port.air_gap, port.glass_thickness, port.glass_index,
+          exact.port().normal, xb.x(), xb.y(), origin, direction);
+      ASSERT_EQ(ok, ray.has_value());
+      if (!ok) continue;
+      EXPECT_LT((Eigen::Vector3d(origin[0], origin[1], origin[2]) - ray->origin)
+                    .norm(),
+                kTolerance);
+      EXPECT_LT((Eigen::Vector3d(direction[0], direction[1], direction[2]) -
+                 ray->direction)
+                    .norm(),
+                kTolerance);
+    }
+  }
+}
+
+TEST(ThickPortRefraction, ThinPortIsThePapersBearing) {
+  const double n = 1.333;
+  for (const Eigen::Vector2d& xb : NormalizedPoints(1.4, 500, 12)) {
+    double origin[3] = {0.0, 0.0, 0.0};
+    double direction[3] = {0.0, 0.0, 0.0};
+    ASSERT_TRUE(ThickPortRefraction::RayInMedium(
+        n, 0.0, 0.0, 1.49, Eigen::Vector3d::UnitZ(), xb.x(), xb.y(), origin,
+        direction));
+    double bearing[3];
+    FlatPortRefraction::BearingInWater(n, xb.x(), xb.y(), bearing);
+    const Eigen::Vector3d expected =
+        Eigen::Vector3d(bearing[0], bearing[1], bearing[2]).normalized();
+    EXPECT_EQ(Eigen::Vector3d(origin[0], origin[1], origin[2]),
+              Eigen::Vector3d::Zero());
+    EXPECT_LT((Eigen::Vector3d(direction[0], direction[1], direction[2]) -
+               expected)
+                  .norm(),
+              1e-12);
+  }
+}
+
+// Jet derivatives in n and the air gap against central differences (step
+// 1e-6: truncation ~1e-12, rounding ~1e-10 relative).
+TEST(ThickPortRefraction, JetDerivativesMatchCentralDifferences) {
+  using Jet = ceres::Jet<double, 2>;
+  const FlatPort port = ThickTiltedPort();
+  const Eigen::Vector3d normal = port.normal.normalized();
+  const double n = 1.34;
+  for (const Eigen::Vector2d& xb : NormalizedPoints(1.2, 50, 13)) {
+    Jet origin[3];
+    Jet direction[3];
+    ASSERT_TRUE(ThickPortRefraction::RayInMedium(
+        Jet(n, 0), Jet(port.air_gap, 1), Jet(port.glass_thickness),
+        Jet(port.glass_index), normal, Jet(xb.x()), Jet(xb.y()), origin,
+        direction));
+    const auto ray = [&](double n_value, double gap, double* o, double* d) {
+      ASSERT_TRUE(ThickPortRefraction::RayInMedium(
+          n_value, gap, port.glass_thickness, port.glass_index, normal, xb.x(),
+          xb.y(), o, d));
+    };
+    constexpr double kStep = 1e-6;
+    double o_plus[3], d_plus[3], o_minus[3], d_minus[3];
+    for (int parameter = 0; parameter < 2; ++parameter) {
+      const double dn = parameter == 0 ? kStep : 0.0;
+      const double dgap = parameter == 1 ? kStep : 0.0;
+      ray(n + dn, port.air_gap + dgap, o_plus, d_plus);
+      ray(n - dn, port.air_gap - dgap, o_minus, d_minus);
+      for (int i = 0; i < 3; ++i) {
+        EXPECT_NEAR(origin[i].v[parameter],
+                    (o_plus[i] - o_minus[i]) / (2 * kStep), 1e-8);
+        EXPECT_NEAR(direction[i].v[parameter],
+                    (d_plus[i] - d_minus[i]) / (2 * kStep), 1e-8);
+      }
+    }
+  }
 }
 
 }  // namespace
