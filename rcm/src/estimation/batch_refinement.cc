@@ -48,18 +48,6 @@ std::optional<double> ClosedFormSeed(
   return 0.5 * (lower + upper);
 }
 
-ceres::LossFunction* MakeLoss(RobustLoss loss, double scale) {
-  switch (loss) {
-    case RobustLoss::kNone:
-      return nullptr;
-    case RobustLoss::kHuber:
-      return new ceres::HuberLoss(scale);
-    case RobustLoss::kCauchy:
-      return new ceres::CauchyLoss(scale);
-  }
-  return nullptr;
-}
-
 // The unknowns: n, and the rotation correction when it is refined.
 struct Parameters {
   double n = 1.0;
@@ -72,7 +60,7 @@ ceres::Solver::Summary Solve(const Eigen::Matrix3d& essential,
                              const std::vector<int64_t>& indices,
                              RobustLoss loss, const RefinementOptions& options,
                              Parameters* parameters, ceres::Problem* problem) {
-  ceres::LossFunction* loss_function = MakeLoss(loss, options.loss_scale_px);
+  ceres::LossFunction* loss_function = NewLossFunction(loss, options.loss_scale_px);
   for (const int64_t i : indices) {
     if (options.refine_rotation) {
       problem->AddResidualBlock(

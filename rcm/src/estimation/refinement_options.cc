@@ -69,4 +69,16 @@ Status RefinementOptions::Check() const {
   return Status::Error(error.str());
 }
 
+ceres::LossFunction* NewLossFunction(RobustLoss loss, double scale_px) {
+  switch (loss) {
+    case RobustLoss::kNone:
+      return nullptr;
+    case RobustLoss::kHuber:
+      return new ceres::HuberLoss(scale_px);
+    case RobustLoss::kCauchy:
+      return new ceres::CauchyLoss(scale_px);
+  }
+  return nullptr;
+}
+
 }  // namespace rcm

@@ -15,6 +15,8 @@
 #ifndef RCM_ESTIMATION_REFINEMENT_OPTIONS_H_
 #define RCM_ESTIMATION_REFINEMENT_OPTIONS_H_
 
+#include <ceres/loss_function.h>
+
 #include <optional>
 #include <string_view>
 
@@ -68,6 +70,10 @@ struct RefinementOptions {
 
   Status Check() const;
 };
+
+// A new Ceres loss of `loss` with scale `scale_px` (owned by the problem
+// it is given to); nullptr for kNone (least squares).
+ceres::LossFunction* NewLossFunction(RobustLoss loss, double scale_px);
 
 }  // namespace rcm
 

@@ -1,0 +1,243 @@
+#include "rcm/estimation/thick_port_refinement.h"
+
+#include <ceres/ceres.h>
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <utility>
+
+#include "rcm/estimation/generalized_epipolar_error.h"
+#include "rcm/estimation/prepared_correspondence.h"
+
+namespace rcm {
+namespace {
+
+struct Parameters {
+  double n = 1.0;
+  double gap_delta = 0.0;
+};
+
+// sum_i rho(r_i^2) at (n, 0), unusable matches at the loss' value of a
+// large residual, for the seed scan.
+double RobustCost(const ThickPortStereo& stereo,
+                  const std::vector<PreparedCorrespondence>& matches, double n,
+                  const RefinementOptions& options) {
+  std::unique_ptr<ceres::LossFunction> loss(
+      NewLossFunction(options.loss, options.loss_scale_px));
+  constexpr double kUnusablePx = 1e3;
+  double cost = 0.0;
+  for (const PreparedCorrespondence& match : matches) {
+    double r = kUnusablePx;
+    if (!GeneralizedEpipolarResidual(stereo, match, n, 0.0, &r) ||
+        !std::isfinite(r)) {
+      r = kUnusablePx;
+    }
+    double rho[3] = {r * r, 1.0, 0.0};
+    if (loss != nullptr) loss->Evaluate(r * r, rho);
+    cost += rho[0];
+  }
+  return cost;
+}
+
+ceres::Solver::Summary Solve(const ThickPortStereo& stereo,
+                             const std::vector<PreparedCorrespondence>& matches,
+                             const std::vector<int64_t>& indices,
+                             RobustLoss loss,
+                             const ThickPortRefinementOptions& options,
+                             Parameters* parameters, ceres::Problem* problem) {
+  ceres::LossFunction* loss_function =
+      NewLossFunction(loss, options.base.loss_scale_px);
+  for (const int64_t i : indices) {
+    problem->AddResidualBlock(
+        GeneralizedEpipolarError::Create(stereo, matches[i]), loss_function,
+        &parameters->n, &parameters->gap_delta);
+  }
+  problem->SetParameterLowerBound(&parameters->n, 0, 1.0);
+  problem->SetParameterUpperBound(&parameters->n, 0, 2.0);
+  if (!options.estimate_air_gap) {
+    problem->SetParameterBlockConstant(&parameters->gap_delta);
+  } else {
+    // A gap cannot be negative.
+    const double smallest_gap =
+        std::min(stereo.left_port.air_gap, stereo.right_port.air_gap);
+    problem->SetParameterLowerBound(&parameters->gap_delta, 0, -smallest_gap);
+  }
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.max_num_iterations = options.base.max_num_iterations;
+  solver_options.num_threads = options.base.num_threads;
+  solver_options.function_tolerance = 1e-14;
+  solver_options.gradient_tolerance = 1e-16;
+  solver_options.parameter_tolerance = 1e-12;
+  solver_options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, problem, &summary);
+  return summary;
+}
+
+}  // namespace
+
+Status ThickPortRefinementOptions::Check() const {
+  RCM_RETURN_IF_ERROR(base.Check());
+  if (base.refine_rotation) {
+    return Status::Error(
+        "the rotation correction is not available with a thick port");
+  }
+  return Status::Ok();
+}
+
+StatusOr<ThickPortRefinementSummary> RefineRefractiveIndexThickPort(
+    const StereoRig& rig, const FlatPort& left_port, const FlatPort& right_port,
+    const std::vector<StereoCorrespondence>& correspondences,
+    const ThickPortRefinementOptions& options) {
+  RCM_RETURN_IF_ERROR(options.Check());
+  RCM_RETURN_IF_ERROR(left_port.Check().WithContext("left camera"));
+  RCM_RETURN_IF_ERROR(right_port.Check().WithContext("right camera"));
+  ThickPortStereo stereo{left_port, right_port, rig.right_from_left()};
+  stereo.left_port.normal.normalize();
+  stereo.right_port.normal.normalize();
+
+  ThickPortRefinementSummary result;
+  RefinementSummary& summary = result.refinement;
+  summary.num_correspondences = static_cast<int64_t>(correspondences.size());
+  const PreparedCorrespondences prepared =
+      PrepareCorrespondences(rig, correspondences);
+  const std::vector<PreparedCorrespondence>& matches = prepared.prepared;
+  summary.num_invalid =
+      summary.num_correspondences - static_cast<int64_t>(matches.size());
+  const int min_inliers = options.base.min_inliers;
+  if (static_cast<int>(matches.size()) < min_inliers) {
+    std::ostringstream message;
+    message << "too few correspondences: " << matches.size()
+            << " usable of " << correspondences.size() << ", at least "
+            << min_inliers << " needed";
+    return Status::Error(message.str());
+  }
+
+  // Seed: the robust cost's minimum over a scan of [1, 2].
+  Parameters parameters;
+  double best_cost = std::numeric_limits<double>::infinity();
+  const int points = options.base.num_scan_points;
+  for (int k = 0; k < points; ++k) {
+    const double n = 1.0 + static_cast<double>(k) / (points - 1);
+    const double cost = RobustCost(stereo, matches, n, options.base);
+    if (cost < best_cost) {
+      best_cost = cost;
+      parameters.n = n;
+    }
+  }
+  summary.n_seed = parameters.n;
+
+  // Stage 1: robust, all matches.
+  std::vector<int64_t> all(matches.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int64_t>(i);
+  {
+    ceres::Problem problem;
+    const ceres::Solver::Summary stage1 =
+        Solve(stereo, matches, all, options.base.loss, options, &parameters,
+              &problem);
+    if (!stage1.IsSolutionUsable()) {
+      return Status::Error("the robust refinement failed: " + stage1.message);
+    }
+    summary.robust_cost = stage1.final_cost;
+    summary.num_iterations += static_cast<int>(stage1.iterations.size());
+  }
+  summary.n_robust = parameters.n;
+
+  // Inliers at the robust estimate.
+  std::vector<int64_t> inliers;
+  for (size_t i = 0; i < matches.size(); ++i) {
+    double r = 0.0;
+    if (GeneralizedEpipolarResidual(stereo, matches[i], parameters.n,
+                                    parameters.gap_delta, &r) &&
+        std::abs(r) <= options.base.inlier_threshold_px) {
+      inliers.push_back(static_cast<int64_t>(i));
+    }
+  }
+  if (static_cast<int>(inliers.size()) < min_inliers) {
+    std::ostringstream message;
+    message << "too few inliers: " << inliers.size() << " of "
+            << matches.size() << " within " << options.base.inlier_threshold_px
+            << " px of the thick-port loci, at least " << min_inliers
+            << " needed";
+    return Status::Error(message.str());
+  }
+
+  // Stage 2: least squares on the inliers, and its covariance.
+  ceres::Problem problem;
+  const ceres::Solver::Summary stage2 = Solve(
+      stereo, matches, inliers, RobustLoss::kNone, options, &parameters,
+      &problem);
+  if (!stage2.IsSolutionUsable()) {
+    return Status::Error("the least-squares refinement failed: " +
+                         stage2.message);
+  }
+  summary.num_iterations += static_cast<int>(stage2.iterations.size());
+  summary.n = parameters.n;
+  summary.cost = stage2.final_cost;
+  const int num_parameters = options.estimate_air_gap ? 2 : 1;
+  const int64_t dof = static_cast<int64_t>(inliers.size()) - num_parameters;
+  summary.sigma_px = std::sqrt(2.0 * summary.cost / static_cast<double>(dof));
+
+  // The information on n alone (port known): sum (dr/dn)^2.
+  double information = 0.0;
+  for (const int64_t i : inliers) {
+    using Jet = ceres::Jet<double, 1>;
+    Jet r;
+    if (GeneralizedEpipolarResidual(stereo, matches[i], Jet(parameters.n, 0),
+                                    Jet(parameters.gap_delta), &r)) {
+      information += r.v[0] * r.v[0];
+    }
+  }
+  if (!(information > 0.0) ||
+      1.0 / std::sqrt(information) > options.base.max_crlb_per_px) {
+    return Status::Error(
+        "the correspondences do not observe n (Cramer-Rao bound at 1 px "
+        "above the limit)");
+  }
+  summary.crlb = summary.sigma_px / std::sqrt(information);
+
+  ceres::Covariance::Options covariance_options;
+  covariance_options.algorithm_type = ceres::DENSE_SVD;
+  covariance_options.num_threads = options.base.num_threads;
+  ceres::Covariance covariance(covariance_options);
+  std::vector<std::pair<const double*, const double*>> blocks = {
+      {&parameters.n, &parameters.n}};
+  if (options.estimate_air_gap) {
+    blocks.emplace_back(&parameters.n, &parameters.gap_delta);
+    blocks.emplace_back(&parameters.gap_delta, &parameters.gap_delta);
+  }
+  if (!covariance.Compute(blocks, &problem)) {
+    return Status::Error(
+        options.estimate_air_gap
+            ? "the air gap cannot be separated from n with these "
+              "correspondences (singular covariance); give the gap instead"
+            : "the covariance of n is singular: the correspondences do not "
+              "observe n");
+  }
+  const double variance_scale = summary.sigma_px * summary.sigma_px;
+  double n_variance = 0.0;
+  covariance.GetCovarianceBlock(&parameters.n, &parameters.n, &n_variance);
+  summary.sigma_n = std::sqrt(n_variance * variance_scale);
+  if (options.estimate_air_gap) {
+    double n_gap = 0.0;
+    double gap_variance = 0.0;
+    covariance.GetCovarianceBlock(&parameters.n, &parameters.gap_delta, &n_gap);
+    covariance.GetCovarianceBlock(&parameters.gap_delta,
+                                  &parameters.gap_delta, &gap_variance);
+    AirGapEstimate gap;
+    gap.left_air_gap = left_port.air_gap + parameters.gap_delta;
+    gap.right_air_gap = right_port.air_gap + parameters.gap_delta;
+    gap.sigma = std::sqrt(gap_variance * variance_scale);
+    gap.correlation_with_n = n_gap / std::sqrt(n_variance * gap_variance);
+    result.air_gap = gap;
+  }
+  summary.inliers.reserve(inliers.size());
+  for (const int64_t i : inliers) {
+    summary.inliers.push_back(prepared.source_index[i]);
+  }
+  return result;
+}
+
+}  // namespace rcm

@@ -1,0 +1,156 @@
+#include "rcm/estimation/thick_port_refinement.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "rcm/estimation/batch_refinement.h"
+#include "rcm/sim/stereo_sampler.h"
+#include "support/reader_inputs.h"
+#include "support/test_rigs.h"
+
+namespace rcm {
+namespace {
+
+FlatPort Port(double air_gap, double glass_thickness) {
+  FlatPort port;
+  port.air_gap = air_gap;
+  port.glass_thickness = glass_thickness;
+  port.glass_index = 1.49;
+  return port;
+}
+
+// Correspondences through the exact port (the simulator's ray tracer),
+// scene depths 0.6-6 m, with Gaussian pixel noise on all four coordinates.
+std::vector<StereoCorrespondence> Matches(const StereoRig& rig,
+                                          const FlatPort& port, double n,
+                                          double noise_px, uint64_t seed,
+                                          int count = 300) {
+  StereoSamplerOptions options;
+  options.n = n;
+  options.per_frame = count;
+  options.seed = seed;
+  std::vector<StereoCorrespondence> matches =
+      SampleFlatPortCorrespondences(rig, port, port, options).value();
+  if (noise_px > 0.0) AddPixelNoise(noise_px, seed + 1000, &matches);
+  return matches;
+}
+
+// Noise-free data through the true port give n to 1e-9 (the solver's
+// tolerance; the templated back-trace agrees with the tracer to 1e-12)
+// over the issue's range of housings, where the thin-port estimate is
+// biased by up to -0.05.
+TEST(ThickPortRefinement, ExactOverGapsAndGlass) {
+  const StereoRig rig = test::AlphasenseRealisticRig();
+  constexpr double kN = 1.335;
+  for (const double gap : {0.0, 0.01, 0.03}) {
+    for (const double glass : {0.0, 0.005, 0.01}) {
+      const FlatPort port = Port(gap, glass);
+      const std::vector<StereoCorrespondence> matches =
+          Matches(rig, port, kN, 0.0, 3);
+      const StatusOr<ThickPortRefinementSummary> thick =
+          RefineRefractiveIndexThickPort(rig, port, port, matches,
+                                         ThickPortRefinementOptions());
+      ASSERT_TRUE(thick.ok()) << thick.status().message();
+      EXPECT_NEAR(thick->refinement.n, kN, 1e-9)
+          << "gap " << gap << " glass " << glass;
+      EXPECT_EQ(thick->refinement.inliers.size(), matches.size());
+    }
+  }
+}
+
+// Noise-free data and a wrong gap in the rig file: estimating the gap
+// with n recovers both.
+TEST(ThickPortRefinement, ExactJointAirGap) {
+  const StereoRig rig = test::AlphasenseRealisticRig();
+  const FlatPort truth = Port(0.008, 0.006);
+  const std::vector<StereoCorrespondence> matches =
+      Matches(rig, truth, 1.335, 0.0, 4);
+  ThickPortRefinementOptions options;
+  options.estimate_air_gap = true;
+  const FlatPort guess = Port(0.004, 0.006);
+  const StatusOr<ThickPortRefinementSummary> result =
+      RefineRefractiveIndexThickPort(rig, guess, guess, matches, options);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  ASSERT_TRUE(result->air_gap.has_value());
+  EXPECT_NEAR(result->refinement.n, 1.335, 1e-9);
+  EXPECT_NEAR(result->air_gap->left_air_gap, 0.008, 1e-9);
+  EXPECT_NEAR(result->air_gap->right_air_gap, 0.008, 1e-9);
+}
+
+// Acceptance (issue 8): with 0.3 px noise the estimate with the true port
+// has an RMS error within 1.5x the Cramer-Rao bound over 12 trials per
+// housing (the RMS of 12 unbiased trials exceeds 1.5x its expectation
+// with probability ~1e-3), while the thin-port estimate is biased by
+// several bounds. Dataset rig, true n = 1.335, 300 matches per trial.
+TEST(ThickPortRefinement, WithinOneAndAHalfCramerRaoBoundsWhereThinPortIsBiased) {
+  const StereoRig rig = test::AlphasenseRealisticRig();
+  constexpr double kN = 1.335;
+  constexpr double kNoisePx = 0.3;
+  constexpr int kTrials = 12;
+  for (const auto& [gap, glass] :
+       std::vector<std::pair<double, double>>{{0.0, 0.0}, {0.008, 0.006},
+                                              {0.03, 0.01}}) {
+    const FlatPort port = Port(gap, glass);
+    double squared_error = 0.0;
+    double crlb = 0.0;
+    double thin_error = 0.0;
+    for (int trial = 0; trial < kTrials; ++trial) {
+      const std::vector<StereoCorrespondence> matches =
+          Matches(rig, port, kN, kNoisePx, 100 + trial);
+      const StatusOr<ThickPortRefinementSummary> thick =
+          RefineRefractiveIndexThickPort(rig, port, port, matches,
+                                         ThickPortRefinementOptions());
+      ASSERT_TRUE(thick.ok()) << thick.status().message();
+      const double error = thick->refinement.n - kN;
+      squared_error += error * error / kTrials;
+      crlb += thick->refinement.crlb / kTrials;
+      const StatusOr<RefinementSummary> thin =
+          RefineRefractiveIndex(rig, matches, RefinementOptions());
+      ASSERT_TRUE(thin.ok()) << thin.status().message();
+      thin_error += (thin->n - kN) / kTrials;
+    }
+    const double rmse = std::sqrt(squared_error);
+    std::printf(
+        "gap %2.0f mm, glass %2.0f mm: thick-port RMSE %.2e (CRLB %.2e, "
+        "ratio %.2f); thin-port mean error %+.4f\n",
+        gap * 1e3, glass * 1e3, rmse, crlb, rmse / crlb, thin_error);
+    EXPECT_LT(rmse, 1.5 * crlb);
+    // The thin-port mean over 12 trials has a standard deviation of about
+    // crlb / sqrt(12) = 0.3 crlb, so a bias beyond 3 bounds is ten of its
+    // standard deviations: a bias, not noise.
+    if (gap >= 0.008) {
+      EXPECT_GT(std::abs(thin_error), 3.0 * crlb);
+    }
+  }
+}
+
+TEST(ThickPortRefinement, RejectsRotationCorrectionAndBadPorts) {
+  const StereoRig rig = test::AlphasenseRealisticRig();
+  const std::vector<StereoCorrespondence> matches =
+      Matches(rig, Port(0.008, 0.006), 1.335, 0.0, 5, 50);
+  ThickPortRefinementOptions options;
+  options.base.refine_rotation = true;
+  EXPECT_NE(test::ErrorMessage(RefineRefractiveIndexThickPort(
+                                   rig, Port(0.008, 0.006), Port(0.008, 0.006),
+                                   matches, options))
+                .find("rotation correction"),
+            std::string::npos);
+  EXPECT_NE(test::ErrorMessage(RefineRefractiveIndexThickPort(
+                                   rig, Port(-0.001, 0.0), Port(0.0, 0.0),
+                                   matches, ThickPortRefinementOptions()))
+                .find("left camera: port air_gap"),
+            std::string::npos);
+  EXPECT_NE(test::ErrorMessage(RefineRefractiveIndexThickPort(
+                                   rig, Port(0.0, 0.0), Port(0.0, 0.0),
+                                   std::vector<StereoCorrespondence>(
+                                       matches.begin(), matches.begin() + 5),
+                                   ThickPortRefinementOptions()))
+                .find("too few correspondences"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace rcm
