@@ -154,3 +154,54 @@ TEST(ThickPortRefinement, RejectsRotationCorrectionAndBadPorts) {
 
 }  // namespace
 }  // namespace rcm
+
+namespace rcm {
+namespace {
+
+// A rig that carries thick ports (from a camchain's port blocks) is refined
+// with the thick-port model by the estimator of record.
+TEST(ThickPortRefinement, RigWithPortsSelectsTheThickModel) {
+  const FlatPort port = Port(0.008, 0.006);
+  const StereoRig rig =
+      test::AlphasenseRealisticRig().WithPorts(port, port).value();
+  ASSERT_TRUE(rig.HasThickPort());
+  const std::vector<StereoCorrespondence> matches =
+      Matches(rig, port, 1.335, 0.0, 21);
+  const StatusOr<RefinementSummary> summary =
+      RefineRefractiveIndex(rig, matches, RefinementOptions());
+  ASSERT_TRUE(summary.ok()) << summary.status().message();
+  EXPECT_NEAR(summary->n, 1.335, 1e-9);
+  RefinementOptions rotation;
+  rotation.refine_rotation = true;
+  EXPECT_NE(test::ErrorMessage(RefineRefractiveIndex(rig, matches, rotation))
+                .find("not available with a thick port"),
+            std::string::npos);
+}
+
+// Thin ports in the rig file change nothing: the paper's model, bit for
+// bit.
+TEST(ThickPortRefinement, ThinPortsGiveTheThinPortResultExactly) {
+  const StereoRig plain = test::AlphasenseRealisticRig();
+  const StereoRig with_thin = plain.WithPorts(FlatPort(), FlatPort()).value();
+  EXPECT_FALSE(with_thin.HasThickPort());
+  const std::vector<StereoCorrespondence> matches =
+      Matches(plain, FlatPort(), 1.335, 0.5, 22);
+  const StatusOr<RefinementSummary> a =
+      RefineRefractiveIndex(plain, matches, RefinementOptions());
+  const StatusOr<RefinementSummary> b =
+      RefineRefractiveIndex(with_thin, matches, RefinementOptions());
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(a->n, b->n);
+  EXPECT_EQ(a->sigma_n, b->sigma_n);
+  EXPECT_EQ(a->inliers, b->inliers);
+}
+
+TEST(StereoRigPorts, WithPortsRejectsInvalidPorts) {
+  const StereoRig rig = test::AlphasenseRealisticRig();
+  EXPECT_EQ(test::ErrorMessage(rig.WithPorts(Port(0.0, 0.0), Port(0.9, 0.0))),
+            "right port: port air_gap = 0.9 m is outside [0, 0.5]");
+  EXPECT_FALSE(rig.ports().has_value());
+}
+
+}  // namespace
+}  // namespace rcm

@@ -12,6 +12,7 @@
 #include "rcm/io/atomic_file.h"
 #include "rcm/sim/reference_rigs.h"
 #include "support/reader_inputs.h"
+#include "support/test_rigs.h"
 #include "support/temp_file.h"
 
 namespace rcm {
@@ -876,6 +877,36 @@ TEST(Camchain, FromStereoRigReadsBackAsTheSameRig) {
   EXPECT_EQ(back.right_from_left().translation,
             rig.right_from_left().translation);
   EXPECT_EQ(parsed.cameras[0].cam_overlaps, std::vector<int>{1});
+}
+
+}  // namespace
+}  // namespace rcm
+
+namespace rcm {
+namespace {
+
+TEST(Camchain, PortBlocksBecomeTheRigsPorts) {
+  FlatPort port;
+  port.air_gap = 0.008;
+  port.glass_thickness = 0.006;
+  StereoRig rig = test::AlphasenseRealisticRig();
+  Camchain camchain = CamchainFromStereoRig(rig);
+  camchain.cameras[1].port = port;
+  const StatusOr<StereoRig> read = StereoRigFromCamchain(
+      ParseCamchain(FormatCamchain(camchain), "rig.yaml").value(), 0, 1);
+  ASSERT_TRUE(read.ok()) << read.status().message();
+  ASSERT_TRUE(read->ports().has_value());
+  EXPECT_TRUE(read->ports()->left.IsThin());  // no block: the thin port
+  EXPECT_EQ(read->ports()->right, port);
+  EXPECT_TRUE(read->HasThickPort());
+  // And back: the rig's ports are written as port blocks.
+  const Camchain written = CamchainFromStereoRig(*read);
+  ASSERT_TRUE(written.cameras[1].port.has_value());
+  EXPECT_EQ(*written.cameras[1].port, port);
+  // A camchain without port blocks gives a rig without ports.
+  EXPECT_FALSE(StereoRigFromCamchain(CamchainFromStereoRig(rig), 0, 1)
+                   ->ports()
+                   .has_value());
 }
 
 }  // namespace

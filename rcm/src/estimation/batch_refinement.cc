@@ -7,9 +7,11 @@
 #include <cmath>
 #include <memory>
 #include <sstream>
+#include <utility>
 
 #include "rcm/estimation/closed_form.h"
 #include "rcm/estimation/cramer_rao_bound.h"
+#include "rcm/estimation/thick_port_refinement.h"
 #include "rcm/estimation/paper_online_estimator.h"
 #include "rcm/estimation/prepared_correspondence.h"
 #include "rcm/estimation/robust_locus_fit.h"
@@ -114,6 +116,17 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
     const std::vector<StereoCorrespondence>& correspondences,
     const RefinementOptions& options) {
   RCM_RETURN_IF_ERROR(options.Check());
+  if (rig.HasThickPort()) {
+    // The thick-port model (thick_port_refinement.h); a rig without ports
+    // or with thin ones takes the paper's model below, unchanged.
+    ThickPortRefinementOptions thick_options;
+    thick_options.base = options;
+    StatusOr<ThickPortRefinementSummary> thick = RefineRefractiveIndexThickPort(
+        rig, rig.ports()->left, rig.ports()->right, correspondences,
+        thick_options);
+    if (!thick.ok()) return thick.status();
+    return std::move(thick->refinement);
+  }
   RefinementSummary summary;
   summary.num_correspondences = static_cast<int64_t>(correspondences.size());
   const PreparedCorrespondences prepared =

@@ -20,6 +20,19 @@ StatusOr<StereoRig> StereoRig::Create(const Camera& left, const Camera& right,
   return StereoRig(left, right, right_from_left);
 }
 
+StatusOr<StereoRig> StereoRig::WithPorts(const FlatPort& left,
+                                         const FlatPort& right) const {
+  RCM_RETURN_IF_ERROR(left.Check().WithContext("left port"));
+  RCM_RETURN_IF_ERROR(right.Check().WithContext("right port"));
+  StereoRig rig = *this;
+  rig.ports_ = Ports{left, right};
+  // Unit normals (as a camchain stores them) are kept bit for bit.
+  for (FlatPort* port : {&rig.ports_->left, &rig.ports_->right}) {
+    if (std::abs(port->normal.norm() - 1.0) > 1e-12) port->normal.normalize();
+  }
+  return rig;
+}
+
 StereoRig::RectificationDeviation StereoRig::DeviationFromRectified() const {
   RectificationDeviation deviation;
   deviation.rotation = right_from_left_.RotationAngle();

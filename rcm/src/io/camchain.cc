@@ -596,6 +596,14 @@ StatusOr<StereoRig> StereoRigFromCamchain(const Camchain& camchain,
     return rig.status().WithContext("cam" + std::to_string(right_index) +
                                     "_from_cam" + std::to_string(left_index));
   }
+  const std::optional<FlatPort>& left_port = camchain.cameras[left_index].port;
+  const std::optional<FlatPort>& right_port =
+      camchain.cameras[right_index].port;
+  if (left_port.has_value() || right_port.has_value()) {
+    // A camera without a port block has the thin port.
+    return rig->WithPorts(left_port.value_or(FlatPort()),
+                          right_port.value_or(FlatPort()));
+  }
   return rig;
 }
 
@@ -605,6 +613,10 @@ Camchain CamchainFromStereoRig(const StereoRig& rig) {
                       {1}, ""};
   CamchainCamera right{rig.right(), rig.right_from_left(), std::nullopt,
                        std::nullopt, {0}, ""};
+  if (rig.ports().has_value()) {
+    left.port = rig.ports()->left;
+    right.port = rig.ports()->right;
+  }
   camchain.cameras = {left, right};
   return camchain;
 }

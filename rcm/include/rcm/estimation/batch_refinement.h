@@ -83,6 +83,10 @@ struct RefinementSummary {
   std::optional<RotationCorrection> rotation;  // with refine_rotation
 };
 
+// A rig with a thick port (StereoRig::HasThickPort, from a camchain's port
+// blocks) is refined with the thick-port model instead
+// (RefineRefractiveIndexThickPort with these options; no rotation
+// correction); a rig without ports, or with thin ones, exactly as above.
 // Fails with one line (and never returns a number) on invalid options,
 // fewer than options.min_inliers usable matches or inliers, data that do
 // not observe n (crlb at 1 px above options.max_crlb_per_px), or a

@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "rcm/camera/camera.h"
+#include "rcm/camera/flat_port_geometry.h"
 #include "rcm/geometry/rigid3d.h"
 #include "rcm/geometry/stereo_correspondence.h"
 #include "rcm/util/status.h"
@@ -21,6 +22,23 @@ class StereoRig {
   // Fails on a zero (< kMinBaseline) or non-finite baseline.
   static StatusOr<StereoRig> Create(const Camera& left, const Camera& right,
                                     const Rigid3d& right_from_left);
+
+  // The housings' flat ports (flat_port_geometry.h), when the rig file
+  // gives them (a camchain's `port` blocks). A rig with a thick port is
+  // estimated with the thick-port model (thick_port_refinement.h); without
+  // ports, or with two thin ones, with the paper's thin port.
+  struct Ports {
+    FlatPort left;
+    FlatPort right;
+  };
+  const std::optional<Ports>& ports() const { return ports_; }
+  // True when a port has an air gap, glass or a tilted normal.
+  bool HasThickPort() const {
+    return ports_.has_value() && (!ports_->left.IsThin() || !ports_->right.IsThin());
+  }
+  // A copy of the rig with ports (normals normalized). Errors: a port
+  // that fails FlatPort::Check, prefixed "left port: " or "right port: ".
+  StatusOr<StereoRig> WithPorts(const FlatPort& left, const FlatPort& right) const;
 
   const Camera& left() const { return left_; }
   const Camera& right() const { return right_; }
@@ -48,6 +66,7 @@ class StereoRig {
   Camera left_;
   Camera right_;
   Rigid3d right_from_left_;
+  std::optional<Ports> ports_;
 };
 
 }  // namespace rcm

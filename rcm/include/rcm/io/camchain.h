@@ -105,13 +105,15 @@ Status WriteCamchain(const std::string& path, const Camchain& camchain);
 // The stereo pair (cam<left_index>, cam<right_index>), with right_from_left
 // chained through the T_cn_cnm1 of the cameras in between; any two distinct
 // cameras, in either order (left 1, right 0 gives the inverse of left 0,
-// right 1). Fails on an index out of range, equal indices, a missing
-// T_cn_cnm1 and a zero baseline.
+// right 1). The cameras' port blocks become the rig's ports (a camera
+// without one has the thin port). Fails on an index out of range, equal
+// indices, a missing T_cn_cnm1 and a zero baseline.
 StatusOr<StereoRig> StereoRigFromCamchain(const Camchain& camchain,
                                           int left_index, int right_index);
 
 // The two-camera camchain of a rig: cam0 the left camera, cam1 the right
-// one with T_cn_cnm1 = right_from_left, each listing the other as overlap.
+// one with T_cn_cnm1 = right_from_left, each listing the other as overlap,
+// and the rig's ports as port blocks.
 Camchain CamchainFromStereoRig(const StereoRig& rig);
 
 // Copies what `source` says of its cameras cam<left_index> and
