@@ -330,8 +330,13 @@ StatusOr<Report> RunRefine(const StereoRig& rig,
   if (!summary.ok()) return summary.status();
   Report report;
   report.method =
-      "robust least squares on the refractive epipolar loci (loss " +
-      LossDescription(options) + ", inliers within " +
+      std::string(rig.HasThickPort()
+                      ? "robust least squares on the thick-port loci "
+                        "(generalized epipolar constraint of the rays in the "
+                        "medium; the camchain's port blocks)"
+                      : "robust least squares on the refractive epipolar "
+                        "loci") +
+      " (loss " + LossDescription(options) + ", inliers within " +
       FormatFixed(options.inlier_threshold_px, 2) + " px)";
   report.n = summary->n;
   report.sigma_n = summary->sigma_n;
@@ -720,6 +725,14 @@ int RunEstimate() {
     PrintError(command, rig.status().message());
     return kExitFailure;
   }
+  if (rig->HasThickPort() && FLAGS_estimator != "refine") {
+    PrintError(command,
+               FLAGS_calib +
+                   " gives a thick port (an air gap or glass), which only "
+                   "--estimator refine models; the " +
+                   FLAGS_estimator + " estimator assumes the paper's thin port");
+    return kExitUsage;
+  }
   // The output folder first: a run is not wasted on one that cannot be
   // written.
   if (!FLAGS_out.empty()) {
@@ -791,6 +804,7 @@ int RunEstimate() {
       rig->DeviationFromRectified();
   nlohmann::json json;
   json["estimator"] = FLAGS_estimator;
+  json["port"] = rig->HasThickPort() ? "thick" : "thin";
   json["n"] = JsonNumber(report->n);
   json["sigma_n"] = JsonNumber(report->sigma_n);
   json["n_closed_form"] = JsonNumber(report->n_closed_form);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "cli/cli_runner.h"
+#include "rcm/io/camchain.h"
 #include "rcm/io/correspondence_csv.h"
 #include "rcm/sim/reference_rigs.h"
 #include "rcm/sim/stereo_sampler.h"
@@ -468,6 +469,54 @@ TEST(EstimateCli, WarnsOnUnrectifiedRig) {
       result.err.find("warning: the rig is 1.00 deg from a rectified pair"),
       std::string::npos)
       << result.err;
+}
+
+}  // namespace
+}  // namespace rcm
+
+namespace rcm {
+namespace {
+
+// A camchain whose cameras have port blocks (8 mm of air, 6 mm of glass)
+// and exact correspondences traced through that port: estimate uses the
+// thick-port model by itself and returns the truth; the same camchain
+// without the blocks gives the thin-port bias.
+TEST(EstimateCli, PortBlocksSelectTheThickPortModel) {
+  FlatPort port;
+  port.air_gap = 0.008;
+  port.glass_thickness = 0.006;
+  const StereoRig rig = AlphasenseFrontRectifiedRig();
+  StereoSamplerOptions options;
+  options.n = 1.335;
+  options.num_frames = 2;
+  options.per_frame = 250;
+  const std::string matches = test::WriteTempFile(
+      "thick.csv", FormatCorrespondenceCsv(
+                       SampleFlatPortCorrespondences(rig, port, port, options)
+                           .value()));
+  const StereoRig with_ports = rig.WithPorts(port, port).value();
+  const std::string thick_rig = test::WriteTempFile(
+      "thick_rig.yaml", FormatCamchain(CamchainFromStereoRig(with_ports)));
+  const std::string thin_rig = test::WriteTempFile(
+      "thin_rig.yaml", FormatCamchain(CamchainFromStereoRig(rig)));
+
+  const RunResult thick =
+      Rcm({"estimate", "--calib", thick_rig, "--matches", matches, "--json"});
+  ASSERT_EQ(thick.exit_code, 0) << thick.err;
+  const nlohmann::json thick_json = nlohmann::json::parse(thick.out);
+  EXPECT_EQ(thick_json["port"], "thick");
+  EXPECT_NEAR(thick_json["n"].get<double>(), 1.335, 1e-9);
+
+  const RunResult thin =
+      Rcm({"estimate", "--calib", thin_rig, "--matches", matches, "--json"});
+  ASSERT_EQ(thin.exit_code, 0) << thin.err;
+  const nlohmann::json thin_json = nlohmann::json::parse(thin.out);
+  EXPECT_EQ(thin_json["port"], "thin");
+  EXPECT_LT(thin_json["n"].get<double>(), 1.335 - 0.01);
+
+  const RunResult online = Rcm({"estimate", "--calib", thick_rig, "--matches",
+                                matches, "--estimator", "online"});
+  ExpectFailsWithOneLine(online, 2, "only --estimator refine models");
 }
 
 }  // namespace
