@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -28,6 +30,7 @@ TEST(ThinPortBias, ThinPortIsUnbiased) {
   EXPECT_LT(std::abs(bias.bias), 1e-9);
   EXPECT_LT(bias.rms_residual, 1e-6);
   EXPECT_EQ(bias.inliers, 2000);
+  EXPECT_EQ(bias.n_thick, bias.n_thin);  // a thin port: the same model
 }
 
 TEST(ThinPortBias, AirGapBiasesTheEstimateDown) {
@@ -42,6 +45,8 @@ TEST(ThinPortBias, AirGapBiasesTheEstimateDown) {
             .value();
     EXPECT_LT(bias.bias, previous) << gap_mm << " mm";
     EXPECT_GT(bias.rms_residual, 0.0);
+    // Told about the port, the estimate is exact.
+    EXPECT_LT(std::abs(bias.thick_bias), 1e-9) << gap_mm << " mm";
     previous = bias.bias;
   }
 }
@@ -78,8 +83,12 @@ std::vector<std::string> Cells(const std::string& row) {
 TEST(ThinPortBias, ReadmeTableIsCurrent) {
   // The README's approximation table is examples/api/thin_port_bias_table
   // run with its defaults (the defaults of ThinPortBiasOptions). Every cell
-  // is recomputed; printed with 4 decimals, so they agree to 5e-5.
+  // is recomputed: the thin-port biases are printed with 4 decimals, so
+  // they agree to 5e-5; the last column, the thick-port model's largest
+  // |bias| over the row, is printed as "1e-12" and must stay below the
+  // 1e-9 of the exact tests, as must its recomputation.
   constexpr double kPrintedPrecision = 5e-5 + 1e-9;
+  constexpr double kThickTolerance = 1e-9;
   std::ifstream readme(std::string(RCM_SOURCE_DIR) + "/README.md");
   ASSERT_TRUE(readme.good());
   std::string line;
@@ -87,18 +96,21 @@ TEST(ThinPortBias, ReadmeTableIsCurrent) {
          line.find("<!-- thin-port-bias-table -->") == std::string::npos) {
   }
   ASSERT_TRUE(readme.good()) << "README has no thin-port-bias-table marker";
-  std::getline(readme, line);  // header: | air gap \ glass | 0 mm | ...
+  std::getline(readme, line);  // | air gap \ glass | 0 mm | ... | thick |
+  const std::vector<std::string> header = Cells(line);
+  ASSERT_GE(header.size(), 4u);
+  EXPECT_EQ(header.back(), "thick-port model, any glass");
   std::vector<double> glass_mm;
-  for (size_t i = 1; i < Cells(line).size(); ++i) {
-    glass_mm.push_back(std::stod(Cells(line)[i]));
+  for (size_t i = 1; i + 1 < header.size(); ++i) {
+    glass_mm.push_back(std::stod(header[i]));
   }
-  ASSERT_GE(glass_mm.size(), 2u);
   std::getline(readme, line);  // |---|---|
   int rows = 0;
   while (std::getline(readme, line) && line.rfind("|", 0) == 0) {
     const std::vector<std::string> cells = Cells(line);
-    ASSERT_EQ(cells.size(), glass_mm.size() + 1) << line;
+    ASSERT_EQ(cells.size(), glass_mm.size() + 2) << line;
     const double gap_mm = std::stod(cells[0]);
+    double thick_bias = 0.0;
     for (size_t j = 0; j < glass_mm.size(); ++j) {
       const ThinPortBias bias =
           MeasureThinPortBias(AlphasenseFrontRectifiedRig(),
@@ -106,7 +118,10 @@ TEST(ThinPortBias, ReadmeTableIsCurrent) {
               .value();
       EXPECT_NEAR(std::stod(cells[j + 1]), bias.bias, kPrintedPrecision)
           << "gap " << gap_mm << " mm, glass " << glass_mm[j] << " mm";
+      thick_bias = std::max(thick_bias, std::abs(bias.thick_bias));
     }
+    EXPECT_LT(std::stod(cells.back()), kThickTolerance) << line;
+    EXPECT_LT(thick_bias, kThickTolerance) << "gap " << gap_mm << " mm";
     ++rows;
   }
   EXPECT_GE(rows, 5);

@@ -43,6 +43,15 @@ StatusOr<ThinPortBias> MeasureThinPortBias(const StereoRig& rig,
   bias.inliers = static_cast<int64_t>(summary.value().inliers.size());
   // sigma_px is sqrt(cost-based RSS / (N - 1)): the RMS misfit.
   bias.rms_residual = summary.value().sigma_px;
+  // The rig told about its ports: RefineRefractiveIndex takes the
+  // thick-port model (the thin model again for a thin port).
+  StatusOr<StereoRig> with_ports = rig.WithPorts(port, port);
+  if (!with_ports.ok()) return with_ports.status();
+  StatusOr<RefinementSummary> thick =
+      RefineRefractiveIndex(*with_ports, matches.value(), RefinementOptions());
+  if (!thick.ok()) return thick.status();
+  bias.n_thick = thick->n;
+  bias.thick_bias = bias.n_thick - options.n;
   return bias;
 }
 

@@ -1,7 +1,8 @@
 // How wrong the paper's thin-port model is for a real housing: the bias of
 // the thin-port estimate of n (batch_refinement.h, default options) on
 // exact, noise-free correspondences traced through a thick flat port
-// (flat_port.h). Noise-free, so the number is the model error alone; it is
+// (flat_port.h), next to the estimate that is given the port (the
+// thick-port model). Noise-free, so the number is the model error alone; it is
 // what the README's approximation table reports, and what a user can
 // compute for their own rig and housing.
 #ifndef RCM_SIM_THIN_PORT_BIAS_H_
@@ -28,6 +29,11 @@ struct ThinPortBiasOptions {
 struct ThinPortBias {
   double n_thin = 0.0;      // the thin-port estimate
   double bias = 0.0;        // n_thin - n
+  // The same data estimated with the true port given (the thick-port
+  // model, thick_port_refinement.h): n_thick - n, which is 0 to the
+  // solver's tolerance.
+  double n_thick = 0.0;
+  double thick_bias = 0.0;
   int64_t inliers = 0;      // matches the robust stage kept (of num_matches)
   double rms_residual = 0;  // pixels: how visibly the thin model misfits
 };
