@@ -174,3 +174,95 @@ TEST(RefractiveCamera, VirtualPinholeBeyondCriticalAngleHasNoSource) {
 
 }  // namespace
 }  // namespace rcm
+
+// --- A thick port made central at a reference depth (CreateWithPort).
+
+namespace rcm {
+namespace {
+
+FlatPort HousingPort() {
+  FlatPort port;
+  port.air_gap = 0.008;
+  port.glass_thickness = 0.006;
+  return port;
+}
+
+TEST(RefractiveCameraWithPort, ThinPortIsThePapersCamera) {
+  const Camera lens = test::AlphasenseCam0();
+  const RefractiveCamera paper = RefractiveCamera::Create(lens, 1.333).value();
+  const RefractiveCamera with_port =
+      RefractiveCamera::CreateWithPort(lens, 1.333, FlatPort(), 2.0).value();
+  for (const Eigen::Vector2d& pixel : test::ImageGrid(lens, 40.0)) {
+    EXPECT_EQ(with_port.BearingInWaterFromImage(pixel),
+              paper.BearingInWaterFromImage(pixel));
+    EXPECT_EQ(with_port.VirtualPinholeFromImage(pixel),
+              paper.VirtualPinholeFromImage(pixel));
+  }
+}
+
+// At the reference depth the central camera is exact: a pixel's bearing
+// hits its own ray there, and projecting that point gives the pixel back
+// (the exact port's Newton solve: 1e-12 in normalized coordinates, so
+// 1e-9 px); the virtual pinhole round trip likewise.
+TEST(RefractiveCameraWithPort, ExactAtTheReferenceDepth) {
+  constexpr double kTolerancePx = 1e-9;
+  constexpr double kDepth = 1.5;
+  const Camera lens = test::AlphasenseCam0();
+  const RefractiveCamera camera =
+      RefractiveCamera::CreateWithPort(lens, 1.333, HousingPort(), kDepth)
+          .value();
+  int checked = 0;
+  for (const Eigen::Vector2d& pixel : test::ImageGrid(lens, 30.0)) {
+    const std::optional<Eigen::Vector3d> bearing =
+        camera.BearingInWaterFromImage(pixel);
+    if (!bearing) continue;
+    const Eigen::Vector3d point = *bearing * (kDepth / bearing->z());
+    const std::optional<Eigen::Vector2d> back =
+        camera.ImageFromPointInWater(point);
+    ASSERT_TRUE(back.has_value());
+    EXPECT_LT((*back - pixel).norm(), kTolerancePx);
+    const std::optional<Eigen::Vector2d> virtual_pixel =
+        camera.VirtualPinholeFromImage(pixel);
+    ASSERT_TRUE(virtual_pixel.has_value());
+    const std::optional<Eigen::Vector2d> raw =
+        camera.ImageFromVirtualPinhole(*virtual_pixel);
+    ASSERT_TRUE(raw.has_value());
+    EXPECT_LT((*raw - pixel).norm(), kTolerancePx);
+    ++checked;
+  }
+  EXPECT_GT(checked, 300);
+}
+
+// Away from the reference depth the central approximation is off by the
+// port's parallax, largest for near points: a 4 m reference against a
+// point at 0.5 m is pixels off at the image border.
+TEST(RefractiveCameraWithPort, ParallaxAwayFromTheReferenceDepth) {
+  const Camera lens = test::AlphasenseCam0();
+  const RefractiveCamera camera =
+      RefractiveCamera::CreateWithPort(lens, 1.333, HousingPort(), 4.0).value();
+  const Eigen::Vector2d pixel(600.0, 400.0);
+  const Eigen::Vector3d bearing = camera.BearingInWaterFromImage(pixel).value();
+  const Eigen::Vector2d at_reference =
+      camera.ImageFromPointInWater(bearing * (4.0 / bearing.z())).value();
+  const Eigen::Vector2d near =
+      camera.ImageFromPointInWater(bearing * (0.5 / bearing.z())).value();
+  EXPECT_LT((at_reference - pixel).norm(), 1e-9);
+  EXPECT_GT((near - pixel).norm(), 1.0);
+}
+
+TEST(RefractiveCameraWithPort, RejectsReferenceDepthInsideTheHousing) {
+  const Camera lens = test::AlphasenseCam0();
+  EXPECT_NE(RefractiveCamera::CreateWithPort(lens, 1.333, HousingPort(), 0.01)
+                .status()
+                .message()
+                .find("not beyond the port's glass"),
+            std::string::npos);
+  FlatPort bad = HousingPort();
+  bad.air_gap = -1.0;
+  EXPECT_FALSE(RefractiveCamera::CreateWithPort(lens, 1.333, bad, 2.0).ok());
+  EXPECT_FALSE(
+      RefractiveCamera::CreateWithPort(lens, 2.5, HousingPort(), 2.0).ok());
+}
+
+}  // namespace
+}  // namespace rcm

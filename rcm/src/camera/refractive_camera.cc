@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 #include "rcm/camera/refractive_model.h"
 
@@ -18,8 +19,42 @@ StatusOr<RefractiveCamera> RefractiveCamera::Create(const Camera& camera,
   return RefractiveCamera(camera, n);
 }
 
+StatusOr<RefractiveCamera> RefractiveCamera::CreateWithPort(
+    const Camera& camera, double n, const FlatPort& port,
+    double reference_depth) {
+  StatusOr<RefractiveCamera> result = Create(camera, n);
+  if (!result.ok()) return result.status();
+  RCM_RETURN_IF_ERROR(port.Check());
+  if (!std::isfinite(reference_depth) ||
+      !(reference_depth > port.air_gap + port.glass_thickness)) {
+    std::ostringstream message;
+    message << "reference depth " << reference_depth
+            << " m is not beyond the port's glass ("
+            << port.air_gap + port.glass_thickness << " m)";
+    return Status::Error(message.str());
+  }
+  result->port_ = port;
+  result->reference_depth_ = reference_depth;
+  if (!port.IsThin()) {
+    StatusOr<FlatPortCamera> thick = FlatPortCamera::Create(camera, port, n);
+    if (!thick.ok()) return thick.status();
+    result->thick_ = std::move(thick).value();
+  }
+  return result;
+}
+
 std::optional<Eigen::Vector3d> RefractiveCamera::BearingInWaterFromImage(
     const Eigen::Vector2d& pixel) const {
+  if (const FlatPortCamera* thick = this->thick()) {
+    // Where the pixel's ray reaches the reference depth, seen from the
+    // center.
+    const std::optional<RayInMedium> ray = thick->RayFromImage(pixel);
+    if (!ray || !(ray->direction.z() > 0.0)) return std::nullopt;
+    const double along =
+        (reference_depth_ - ray->origin.z()) / ray->direction.z();
+    if (!(along > 0.0)) return std::nullopt;
+    return (ray->origin + along * ray->direction).normalized();
+  }
   const std::optional<Eigen::Vector2d> normalized =
       camera_.NormalizedFromImage(pixel);
   if (!normalized) return std::nullopt;
@@ -31,6 +66,9 @@ std::optional<Eigen::Vector3d> RefractiveCamera::BearingInWaterFromImage(
 
 std::optional<Eigen::Vector2d> RefractiveCamera::ImageFromPointInWater(
     const Eigen::Vector3d& point_in_camera) const {
+  if (const FlatPortCamera* thick = this->thick()) {
+    return thick->ImageFromPoint(point_in_camera);
+  }
   Eigen::Vector2d normalized;
   if (!FlatPortRefraction::NormalizedFromPointInWater(
           n_, point_in_camera.data(), &normalized.x(), &normalized.y())) {
@@ -50,6 +88,15 @@ Eigen::Matrix3d RefractiveCamera::VirtualPinholeMatrix() const {
 
 std::optional<Eigen::Vector2d> RefractiveCamera::VirtualPinholeFromImage(
     const Eigen::Vector2d& pixel) const {
+  if (thick() != nullptr) {
+    // K_n applied to the bearing: u = n fx X / Z + cx (eq. 9).
+    const std::optional<Eigen::Vector3d> bearing =
+        BearingInWaterFromImage(pixel);
+    if (!bearing || !(bearing->z() > 0.0)) return std::nullopt;
+    return Eigen::Vector2d(
+        n_ * camera_.fx() * bearing->x() / bearing->z() + camera_.cx(),
+        n_ * camera_.fy() * bearing->y() / bearing->z() + camera_.cy());
+  }
   const std::optional<Eigen::Vector2d> normalized =
       camera_.NormalizedFromImage(pixel);
   if (!normalized) return std::nullopt;
@@ -64,6 +111,12 @@ std::optional<Eigen::Vector2d> RefractiveCamera::ImageFromVirtualPinhole(
     const Eigen::Vector2d& virtual_pixel) const {
   const double xv = (virtual_pixel.x() - camera_.cx()) / camera_.fx();
   const double yv = (virtual_pixel.y() - camera_.cy()) / camera_.fy();
+  if (thick() != nullptr) {
+    // The virtual point (xv, yv) is the ray (xv, yv, n) (eq. 10): the
+    // point at the reference depth along it.
+    return ImageFromPointInWater(Eigen::Vector3d(xv, yv, n_) *
+                                 (reference_depth_ / n_));
+  }
   Eigen::Vector2d normalized;
   if (!FlatPortRefraction::NormalizedFromVirtual(n_, xv, yv, &normalized.x(),
                                                  &normalized.y())) {

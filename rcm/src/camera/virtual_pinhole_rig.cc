@@ -122,7 +122,27 @@ Status VirtualPinholeRigOptions::Check() const {
     return Status::Error("num_threads = " + std::to_string(num_threads) +
                          " must be at least 1");
   }
+  if (!std::isfinite(reference_depth) || !(reference_depth > 0.0)) {
+    std::ostringstream message;
+    message << "reference depth " << reference_depth
+            << " m must be positive and finite";
+    return Status::Error(message.str());
+  }
   return Status::Ok();
+}
+
+StatusOr<RefractiveCamera> RefractiveCameraOfRig(const StereoRig& rig,
+                                                 bool left, double n,
+                                                 double reference_depth) {
+  const Camera& camera = left ? rig.left() : rig.right();
+  if (!rig.HasThickPort()) return RefractiveCamera::Create(camera, n);
+  const FlatPort& port = left ? rig.ports()->left : rig.ports()->right;
+  StatusOr<RefractiveCamera> result =
+      RefractiveCamera::CreateWithPort(camera, n, port, reference_depth);
+  if (!result.ok()) {
+    return result.status().WithContext(left ? "left camera" : "right camera");
+  }
+  return result;
 }
 
 double VirtualPinholeCamera::FocalScale() const {
@@ -158,6 +178,13 @@ std::optional<Eigen::Vector2d> VirtualPinholeCamera::RawFromCorrected(
   const Eigen::Vector3d ray =
       view.camera_from_view *
       (view.k.inverse() * corrected_pixel.homogeneous());
+  if (camera.port().has_value()) {
+    // A thick port is central only at its reference depth: the point
+    // there (any point of the ray for a thin port).
+    if (!(ray.z() > 0.0)) return std::nullopt;
+    return camera.ImageFromPointInWater(ray *
+                                        (camera.reference_depth() / ray.z()));
+  }
   return camera.ImageFromPointInWater(ray);
 }
 
@@ -166,10 +193,10 @@ StatusOr<VirtualPinholeRig> VirtualPinholeRig::Create(
   RCM_RETURN_IF_ERROR(options.Check());
   const auto start = std::chrono::steady_clock::now();
   const StatusOr<RefractiveCamera> left =
-      RefractiveCamera::Create(rig.left(), n);
+      RefractiveCameraOfRig(rig, /*left=*/true, n, options.reference_depth);
   if (!left.ok()) return left.status();
   const StatusOr<RefractiveCamera> right =
-      RefractiveCamera::Create(rig.right(), n);
+      RefractiveCameraOfRig(rig, /*left=*/false, n, options.reference_depth);
   if (!right.ok()) return right.status();
 
   VirtualPinholeView left_view;

@@ -9,6 +9,8 @@
 #include <optional>
 
 #include "rcm/camera/camera.h"
+#include "rcm/camera/flat_port_camera.h"
+#include "rcm/camera/flat_port_geometry.h"
 #include "rcm/util/status.h"
 
 namespace rcm {
@@ -22,6 +24,27 @@ class RefractiveCamera {
 
   // Fails when n is not finite or outside [kMinIndex, kMaxIndex].
   static StatusOr<RefractiveCamera> Create(const Camera& camera, double n);
+
+  // The camera behind a thick port (flat_port_camera.h: an air gap, glass,
+  // a tilted normal), made central for the tools that need a camera with
+  // one center in the water (corrected images, water-side models): a
+  // pixel's bearing is the direction from the camera center to the point
+  // where its ray in the water reaches the depth `reference_depth` (Z in
+  // the camera frame, meters), so that the virtual pinhole images points
+  // at that depth exactly. A point at depth Z' is imaged through the real
+  // port (ImageFromPointInWater is exact at any depth); seen through the
+  // bearings it is off by the parallax of the port's lateral ray offset
+  // delta (a few mm), about delta |1/Z' - 1/Z| times the focal length.
+  // A thin port gives the camera of Create at any reference depth.
+  // Errors: those of Create, an invalid port, a reference depth that is
+  // not finite or not beyond the glass (air_gap + glass_thickness).
+  static StatusOr<RefractiveCamera> CreateWithPort(const Camera& camera,
+                                                   double n,
+                                                   const FlatPort& port,
+                                                   double reference_depth);
+  // The port and reference depth of CreateWithPort; nullopt for Create.
+  const std::optional<FlatPort>& port() const { return port_; }
+  double reference_depth() const { return reference_depth_; }
 
   const Camera& camera() const { return camera_; }
   double n() const { return n_; }
@@ -51,8 +74,16 @@ class RefractiveCamera {
  private:
   RefractiveCamera(const Camera& camera, double n) : camera_(camera), n_(n) {}
 
+  // The thick port's camera, when it is not thin.
+  const FlatPortCamera* thick() const {
+    return thick_.has_value() ? &*thick_ : nullptr;
+  }
+
   Camera camera_;
   double n_;
+  std::optional<FlatPort> port_;
+  std::optional<FlatPortCamera> thick_;
+  double reference_depth_ = 0.0;
 };
 
 }  // namespace rcm

@@ -95,9 +95,21 @@ struct VirtualPinholeRigOptions {
   int num_threads = 2;
   // Also build the fixed-point maps (cv::remap's fast path).
   bool fixed_point_maps = true;
+  // A rig with a thick port (StereoRig::HasThickPort): the depth, in
+  // meters, at which the corrected images are exact pinhole images
+  // (RefractiveCamera::CreateWithPort); points nearer or farther are off
+  // by the port's parallax. Finite and > 0; unused for thin ports.
+  double reference_depth = 2.0;
 
   Status Check() const;
 };
+
+// The camera of one side of `rig` in the water at index n: its ports'
+// thick-port camera at the reference depth when the rig has a thick port
+// (RefractiveCamera::CreateWithPort), the paper's camera otherwise.
+StatusOr<RefractiveCamera> RefractiveCameraOfRig(const StereoRig& rig,
+                                                 bool left, double n,
+                                                 double reference_depth);
 
 // One corrected camera: its camera in the medium, its view, the maps from
 // its raw images, and the pinhole camera its corrected images are.
