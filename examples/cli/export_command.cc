@@ -14,7 +14,9 @@
 #include "command.h"
 #include "index_flag.h"
 #include "lens_model_flag.h"
+#include "reference_depth_flag.h"
 #include "rcm/camera/refractive_camera.h"
+#include "rcm/camera/virtual_pinhole_rig.h"
 #include "rcm/estimation/water_side_model_fit.h"
 #include "rcm/io/camchain.h"
 #include "rcm/io/camera_file.h"
@@ -120,7 +122,8 @@ extern const Subcommand kExportCommand = {
     "conventional water-side models (equidistant, radtan) fitted to the "
     "refractive model",
     kUsage,
-    {__FILE__, kRigFlagsSource, kIndexFlagSource, kLensModelFlagSource},
+    {__FILE__, kRigFlagsSource, kIndexFlagSource, kLensModelFlagSource,
+     kReferenceDepthFlagSource},
     RunExport};
 
 namespace {
@@ -167,12 +170,16 @@ int RunExport() {
   }
 
   // Fit both cameras.
-  const Camera* air[2] = {&rig->left(), &rig->right()};
   const char* names[2] = {"left", "right"};
   std::vector<WaterSideModelFit> fits;
   for (int k = 0; k < 2; ++k) {
-    const RefractiveCamera camera = RefractiveCamera::Create(*air[k], *n).value();
-    StatusOr<WaterSideModelFit> fit = FitWaterSideModel(camera, options);
+    const StatusOr<RefractiveCamera> camera =
+        RefractiveCameraOfRig(*rig, k == 0, *n, FLAGS_reference_depth);
+    if (!camera.ok()) {
+      PrintError(command, camera.status().message());
+      return kExitFailure;
+    }
+    StatusOr<WaterSideModelFit> fit = FitWaterSideModel(*camera, options);
     if (!fit.ok()) {
       PrintError(command, std::string(names[k]) + " camera: " +
                               fit.status().message());
@@ -210,6 +217,8 @@ int RunExport() {
   json["calib"] = FLAGS_calib;
   json["model"] = std::string(LensModelName(*model));
   json["fit_inset"] = options.fit_inset;
+  json["port"] = rig->HasThickPort() ? "thick" : "thin";
+  if (rig->HasThickPort()) json["reference_depth_m"] = FLAGS_reference_depth;
   for (int k = 0; k < 2; ++k) {
     const std::string name = names[k];
     if (Status status = WriteCameraInfo(
@@ -264,6 +273,7 @@ int RunExport() {
   std::cout << "rcm export: " << LensModelName(*model)
             << " water-side models of " << FLAGS_calib << " at n = " << *n
             << "\n";
+  if (rig->HasThickPort()) std::cout << "  " << ThickPortNote(*rig) << "\n";
   for (int k = 0; k < 2; ++k) {
     const WaterSideModelFit& fit = fits[k];
     const Camera& camera = fit.camera;

@@ -20,6 +20,7 @@
 #include "command.h"
 #include "image_input_flags.h"
 #include "index_flag.h"
+#include "reference_depth_flag.h"
 #include "progress.h"
 #include "rcm/camera/virtual_pinhole_rig.h"
 #include "rcm/io/camchain.h"
@@ -148,6 +149,7 @@ StatusOr<VirtualPinholeRigOptions> RigOptionsFromFlags() {
     options.output_size = cv::Size(width, height);
   }
   options.rectify = FLAGS_rectify;
+  options.reference_depth = FLAGS_reference_depth;
   RCM_RETURN_IF_ERROR(options.Check());
   return options;
 }
@@ -426,7 +428,8 @@ extern const Subcommand kUndistortCommand = {
     "refraction and lens corrected images (virtual pinholes) and their "
     "camchain",
     kUsage,
-    {__FILE__, kRigFlagsSource, kIndexFlagSource, kImageInputFlagsSource},
+    {__FILE__, kRigFlagsSource, kIndexFlagSource, kImageInputFlagsSource,
+     kReferenceDepthFlagSource},
     RunUndistort};
 
 namespace {
@@ -562,6 +565,8 @@ int RunUndistort() {
                   {"remap_per_image_mean", Mean(report->remap_ms)},
                   {"per_pair", report->total_ms / pairs}};
     json["out"] = FLAGS_out;
+    json["port"] = rig->HasThickPort() ? "thick" : "thin";
+    if (rig->HasThickPort()) json["reference_depth_m"] = options->reference_depth;
     json.update(report->extra);
     std::cout << json.dump(2) << std::endl;
     return kExitOk;
@@ -570,6 +575,8 @@ int RunUndistort() {
   text << "rcm undistort: n " << *n << ", fit " << fit
        << (options->rectify ? ", rectified" : "") << "\n"
        << "  input  " << report->source << "\n"
+       << (rig->HasThickPort() ? "  port   " + ThickPortNote(*rig) + "\n"
+                               : std::string())
        << CameraLine("left   ", corrected->left()) << "\n"
        << CameraLine("right  ", corrected->right()) << "\n"
        << "  images " << report->images << " written (" << report->pairs

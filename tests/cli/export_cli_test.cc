@@ -225,3 +225,53 @@ TEST(CompareCli, SameCalibrationGivesUnitIndex) {
 
 }  // namespace
 }  // namespace rcm
+
+namespace rcm {
+namespace {
+
+// The dataset rig with port blocks (8 mm of air, 6 mm of glass).
+std::string ThickPortRig() {
+  std::string text = test::ReadWholeFile(kRig);
+  const std::string block = "  resolution: [720, 540]\n";
+  for (size_t at = text.find(block); at != std::string::npos;
+       at = text.find(block, at + 1)) {
+    text.insert(at + block.size(),
+                "  port: {air_gap: 0.008, glass_thickness: 0.006}\n");
+  }
+  return test::WriteTempFile("thick_rig.yaml", text);
+}
+
+// With port blocks, export fits the thick port's camera, central at the
+// reference depth, and says so; the exported camchain is a conventional
+// model without port blocks.
+TEST(ExportCli, HonoursThePortAtTheReferenceDepth) {
+  const std::string folder = Folder("out");
+  const RunResult result =
+      Rcm({"export", "--calib", ThickPortRig(), "--n", "1.333",
+           "--reference-depth", "1.5", "--out", folder, "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json json = nlohmann::json::parse(result.out);
+  EXPECT_EQ(json["port"], "thick");
+  EXPECT_DOUBLE_EQ(json["reference_depth_m"].get<double>(), 1.5);
+  EXPECT_LT(json["left"]["fit_region"]["rms_px"].get<double>(), 0.1);
+  const std::string camchain = test::ReadWholeFile(folder + "/camchain.yaml");
+  EXPECT_EQ(camchain.find("port"), std::string::npos);
+  // The same rig without blocks gives a different (thin-port) model.
+  const RunResult thin =
+      Rcm({"export", "--calib", kRig, "--n", "1.333", "--json", "--out",
+           Folder("thin")});
+  ASSERT_EQ(thin.exit_code, 0) << thin.err;
+  EXPECT_EQ(nlohmann::json::parse(thin.out)["port"], "thin");
+  EXPECT_NE(nlohmann::json::parse(thin.out)["left"]["intrinsics"],
+            json["left"]["intrinsics"]);
+}
+
+TEST(ExportCli, RejectsAReferenceDepthInsideTheHousing) {
+  ExpectFailsWithOneLine(
+      Rcm({"export", "--calib", ThickPortRig(), "--n", "1.333",
+           "--reference-depth", "0.01", "--out", Folder("out")}),
+      1, "reference depth 0.01 m is not beyond the port's glass", "export");
+}
+
+}  // namespace
+}  // namespace rcm

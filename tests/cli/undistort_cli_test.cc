@@ -430,3 +430,41 @@ TEST(UndistortCli, BagGivesACorrectedBagAndItsCamchain) {
 
 }  // namespace
 }  // namespace rcm
+
+namespace rcm {
+namespace {
+
+// Port blocks in the rig: the corrected images are made for the reference
+// depth, stated in the report; the corrected camchain is a pinhole rig
+// without port blocks.
+TEST(UndistortCli, ThickPortIsCorrectedAtTheReferenceDepth) {
+  const std::string dive = Dive();
+  Camchain camchain = SmallCamchain();
+  FlatPort port;
+  port.air_gap = 0.008;
+  port.glass_thickness = 0.006;
+  for (CamchainCamera& camera : camchain.cameras) camera.port = port;
+  const std::string rig = dive + "/thick_rig.yaml";
+  ASSERT_TRUE(WriteCamchain(rig, camchain).ok());
+  const std::string out = Folder("out");
+  const RunResult result = Rcm(
+      {"undistort", "--calib", rig, "--n", "1.333", "--left", dive + "/left",
+       "--right", dive + "/right", "--out", out, "--reference-depth", "1.5",
+       "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json json = nlohmann::json::parse(result.out);
+  EXPECT_EQ(json["port"], "thick");
+  EXPECT_DOUBLE_EQ(json["reference_depth_m"].get<double>(), 1.5);
+  EXPECT_EQ(test::ReadWholeFile(out + "/camchain.yaml").find("port"),
+            std::string::npos);
+  const RunResult text = Rcm({"undistort", "--calib", rig, "--n", "1.333",
+                              "--left", dive + "/left", "--right",
+                              dive + "/right", "--out", Folder("text")});
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("exact for points 2.00 m in front of the cameras"),
+            std::string::npos)
+      << text.out;
+}
+
+}  // namespace
+}  // namespace rcm
