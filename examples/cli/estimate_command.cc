@@ -30,6 +30,7 @@
 #include "rcm/estimation/paper_online_estimator.h"
 #include "rcm/estimation/refinement_options.h"
 #include "rcm/estimation/sliding_window_estimator.h"
+#include "rcm/estimation/thick_port_refinement.h"
 #include "rcm/io/atomic_file.h"
 #include "rcm/io/correspondence_csv.h"
 #include "rcm/io/number_format.h"
@@ -88,6 +89,10 @@ DEFINE_double(inlier_threshold, 2.0,
 DEFINE_bool(refine_rotation, false,
             "refine: also estimate a small rotation correction of cam1 "
             "(reported with its correlation with n)");
+DEFINE_bool(estimate_air_gap, false,
+            "refine: also estimate the ports' air gap (one offset for both "
+            "cameras, from the camchain's port blocks or 0), reported with "
+            "its sigma and its correlation with n");
 DEFINE_double(mask_eta, 0.3,
               "closed-form: use a match when sqrt|u| sqrt|v| > eta, (u, v) "
               "its normalized left coordinates");
@@ -325,8 +330,23 @@ StatusOr<Report> RunRefine(const StereoRig& rig,
                            const std::vector<Frame>& frames,
                            const RefinementOptions& options,
                            const std::vector<FrameRow>* own_rows) {
-  StatusOr<RefinementSummary> summary =
-      RefineRefractiveIndex(rig, matches, options);
+  StatusOr<RefinementSummary> summary = Status::Error("not run");
+  std::optional<AirGapEstimate> air_gap;
+  if (FLAGS_estimate_air_gap) {
+    // The thick-port model with the gap free, from the rig's ports (a
+    // rig without port blocks: thin ports, the gap estimated from 0).
+    const StereoRig::Ports ports = rig.ports().value_or(StereoRig::Ports{});
+    ThickPortRefinementOptions thick_options;
+    thick_options.base = options;
+    thick_options.estimate_air_gap = true;
+    StatusOr<ThickPortRefinementSummary> thick = RefineRefractiveIndexThickPort(
+        rig, ports.left, ports.right, matches, thick_options);
+    if (!thick.ok()) return thick.status();
+    air_gap = thick->air_gap;
+    summary = std::move(thick->refinement);
+  } else {
+    summary = RefineRefractiveIndex(rig, matches, options);
+  }
   if (!summary.ok()) return summary.status();
   Report report;
   report.method =
@@ -355,6 +375,22 @@ StatusOr<Report> RunRefine(const StereoRig& rig,
                               : std::string("n/a")) +
       ", scan " + FormatFixed(summary->n_seed, 4) + ", robust stage " +
       FormatFixed(summary->n_robust, 5));
+  if (air_gap) {
+    report.extra["air_gap"] = {{"left_m", air_gap->left_air_gap},
+                               {"right_m", air_gap->right_air_gap},
+                               {"sigma_m", air_gap->sigma},
+                               {"correlation_with_n",
+                                air_gap->correlation_with_n}};
+    report.text_lines.push_back(
+        "  air gap    " + FormatFixed(1e3 * air_gap->left_air_gap, 2) +
+        " mm (left), " + FormatFixed(1e3 * air_gap->right_air_gap, 2) +
+        " mm (right) +- " + FormatFixed(1e3 * air_gap->sigma, 2) +
+        " mm, correlation with n " +
+        FormatFixed(air_gap->correlation_with_n, 2) +
+        (std::abs(air_gap->correlation_with_n) > 0.9
+             ? " (hardly separable from n: measure the gap instead)"
+             : ""));
+  }
   if (summary->rotation) {
     const RotationCorrection& rotation = *summary->rotation;
     const Eigen::Vector3d degrees = rotation.angle_axis * 180.0 / M_PI;
@@ -672,6 +708,13 @@ int RunEstimate() {
   }
   if (FLAGS_refine_rotation && FLAGS_estimator != "refine") {
     PrintError(command, "--refine-rotation works with --estimator refine only");
+    return kExitUsage;
+  }
+  if (FLAGS_estimate_air_gap &&
+      (FLAGS_estimator != "refine" || FLAGS_refine_rotation)) {
+    PrintError(command,
+               "--estimate-air-gap works with --estimator refine only, "
+               "without --refine-rotation");
     return kExitUsage;
   }
   SlidingWindowOptions window_options;

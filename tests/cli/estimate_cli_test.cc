@@ -521,3 +521,44 @@ TEST(EstimateCli, PortBlocksSelectTheThickPortModel) {
 
 }  // namespace
 }  // namespace rcm
+
+namespace rcm {
+namespace {
+
+// rcm simulate writes a thick port as port blocks; rcm estimate then models
+// it, and --estimate-air-gap reports the gap with its sigma and its
+// correlation with n. 0.3 px noise on 1200 matches: n within 4 sigma, the
+// gap within 4 sigma of the 8 mm simulated.
+TEST(EstimateCli, SimulatedThickPortAndItsAirGap) {
+  const std::string folder = test::TempFilePath("dive");
+  std::filesystem::remove_all(folder);
+  const RunResult simulated = Rcm(
+      {"simulate", "--out", folder, "--noimages", "--depth-range", "0.6,6",
+       "--matches-per-frame", "300", "--match-noise", "0.3", "--frames", "4",
+       "--air-gap", "0.008", "--glass-thickness", "0.006", "--n", "1.335"});
+  ASSERT_EQ(simulated.exit_code, 0) << simulated.err;
+  EXPECT_NE(test::ReadWholeFile(folder + "/camchain.yaml")
+                .find("  port:\n    air_gap: 0.008\n"),
+            std::string::npos);
+  const RunResult estimated =
+      Rcm({"estimate", "--calib", folder + "/camchain.yaml", "--matches",
+           folder + "/matches.csv", "--estimate-air-gap", "--json"});
+  ASSERT_EQ(estimated.exit_code, 0) << estimated.err;
+  const nlohmann::json json = nlohmann::json::parse(estimated.out);
+  EXPECT_EQ(json["port"], "thick");
+  EXPECT_LT(std::abs(json["n"].get<double>() - 1.335),
+            4.0 * json["sigma_n"].get<double>());
+  const nlohmann::json& gap = json["air_gap"];
+  EXPECT_LT(std::abs(gap["left_m"].get<double>() - 0.008),
+            4.0 * gap["sigma_m"].get<double>());
+  EXPECT_GT(std::abs(gap["correlation_with_n"].get<double>()), 0.5);
+
+  ExpectFailsWithOneLine(
+      Rcm({"estimate", "--calib", folder + "/camchain.yaml", "--matches",
+           folder + "/matches.csv", "--estimate-air-gap", "--estimator",
+           "window"}),
+      2, "--estimate-air-gap works with --estimator refine only");
+}
+
+}  // namespace
+}  // namespace rcm

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 #include "rcm/io/atomic_file.h"
@@ -142,8 +143,18 @@ Status WriteSequence(const std::string& folder, SequenceSimulator* simulator,
     RCM_RETURN_IF_ERROR(
         WriteCorrespondenceCsv((root / "matches.csv").string(), matches));
   }
+  // The housing is part of what a user knows of the rig: thick ports are
+  // written as port blocks, so that rcm estimate models them.
+  StereoRig rig = simulator->rig();
+  const SequenceOptions& sequence = simulator->options();
+  if (!sequence.left_port.IsThin() || !sequence.right_port.IsThin()) {
+    StatusOr<StereoRig> with_ports =
+        rig.WithPorts(sequence.left_port, sequence.right_port);
+    if (!with_ports.ok()) return with_ports.status();
+    rig = std::move(with_ports).value();
+  }
   RCM_RETURN_IF_ERROR(WriteCamchain((root / "camchain.yaml").string(),
-                                    CamchainFromStereoRig(simulator->rig())));
+                                    CamchainFromStereoRig(rig)));
   return WriteFileAtomically((root / "truth.csv").string(),
                              FormatTruthCsv(*simulator));
 }

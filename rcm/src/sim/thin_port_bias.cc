@@ -34,8 +34,13 @@ StatusOr<ThinPortBias> MeasureThinPortBias(const StereoRig& rig,
   StatusOr<std::vector<StereoCorrespondence>> matches =
       SampleFlatPortCorrespondences(rig, port, port, sampler);
   if (!matches.ok()) return matches.status();
+  // The thin-port estimate: the rig without any port blocks it was read
+  // with.
+  StatusOr<StereoRig> thin_rig =
+      StereoRig::Create(rig.left(), rig.right(), rig.right_from_left());
+  if (!thin_rig.ok()) return thin_rig.status();
   StatusOr<RefinementSummary> summary =
-      RefineRefractiveIndex(rig, matches.value(), RefinementOptions());
+      RefineRefractiveIndex(*thin_rig, matches.value(), RefinementOptions());
   if (!summary.ok()) return summary.status();
   ThinPortBias bias;
   bias.n_thin = summary.value().n;
@@ -45,7 +50,7 @@ StatusOr<ThinPortBias> MeasureThinPortBias(const StereoRig& rig,
   bias.rms_residual = summary.value().sigma_px;
   // The rig told about its ports: RefineRefractiveIndex takes the
   // thick-port model (the thin model again for a thin port).
-  StatusOr<StereoRig> with_ports = rig.WithPorts(port, port);
+  StatusOr<StereoRig> with_ports = thin_rig->WithPorts(port, port);
   if (!with_ports.ok()) return with_ports.status();
   StatusOr<RefinementSummary> thick =
       RefineRefractiveIndex(*with_ports, matches.value(), RefinementOptions());

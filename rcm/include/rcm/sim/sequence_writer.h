@@ -5,7 +5,8 @@
 //   right/000000.png ...  8-bit mono images of cam1, same names
 //   matches.csv           exact (or noisy) correspondences of all frames,
 //                         `frame,xl,yl,xr,yr,t` (when matches are sampled)
-//   camchain.yaml         the in-air calibration (Kalibr camchain)
+//   camchain.yaml         the in-air calibration (Kalibr camchain), with
+//                         port blocks when the ports are thick
 //   truth.csv             one row per frame: frame,t,n,tx,ty,tz,qx,qy,qz,qw
 //                         with n the medium and (t, q) the pose
 //                         world_from_cam0 (cam0's position in the world
