@@ -82,17 +82,22 @@ TEST(ThickPortRefinement, ExactJointAirGap) {
 
 // Acceptance (issue 8): with 0.3 px noise the estimate with the true port
 // has an RMS error within 1.5x the Cramer-Rao bound over 12 trials per
-// housing (the RMS of 12 unbiased trials exceeds 1.5x its expectation
-// with probability ~1e-3), while the thin-port estimate is biased by
-// several bounds. Dataset rig, true n = 1.335, 300 matches per trial.
+// housing, for gaps of 0, 10 and 30 mm with glass of 0, 5 and 10 mm and
+// the issue's 8 mm + 6 mm (the RMS of 12 unbiased trials exceeds 1.5x its
+// expectation with probability ~1e-3 per housing), while the thin-port
+// estimate is biased by several bounds. Dataset rig, true n = 1.335, 300 matches per trial.
 TEST(ThickPortRefinement, WithinOneAndAHalfCramerRaoBoundsWhereThinPortIsBiased) {
   const StereoRig rig = test::AlphasenseRealisticRig();
   constexpr double kN = 1.335;
   constexpr double kNoisePx = 0.3;
   constexpr int kTrials = 12;
-  for (const auto& [gap, glass] :
-       std::vector<std::pair<double, double>>{{0.0, 0.0}, {0.008, 0.006},
-                                              {0.03, 0.01}}) {
+  std::vector<std::pair<double, double>> housings = {{0.008, 0.006}};
+  for (const double gap : {0.0, 0.01, 0.03}) {
+    for (const double glass : {0.0, 0.005, 0.01}) {
+      housings.emplace_back(gap, glass);
+    }
+  }
+  for (const auto& [gap, glass] : housings) {
     const FlatPort port = Port(gap, glass);
     double squared_error = 0.0;
     double crlb = 0.0;
@@ -121,7 +126,7 @@ TEST(ThickPortRefinement, WithinOneAndAHalfCramerRaoBoundsWhereThinPortIsBiased)
     // The thin-port mean over 12 trials has a standard deviation of about
     // crlb / sqrt(12) = 0.3 crlb, so a bias beyond 3 bounds is ten of its
     // standard deviations: a bias, not noise.
-    if (gap >= 0.008) {
+    if (gap >= 0.008) {  // below, the bias is within a few bounds
       EXPECT_GT(std::abs(thin_error), 3.0 * crlb);
     }
   }
