@@ -77,16 +77,8 @@ ceres::Solver::Summary Solve(const Eigen::Matrix3d& essential,
   problem->SetParameterLowerBound(&parameters->n, 0, 1.0);
   problem->SetParameterUpperBound(&parameters->n, 0, 2.0);
 
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_QR;
-  solver_options.max_num_iterations = options.max_num_iterations;
-  solver_options.num_threads = options.num_threads;
-  // Tight tolerances: one parameter (or four) and cheap iterations, and
-  // the noise-free case must reach 1e-9 in n.
-  solver_options.function_tolerance = 1e-14;
-  solver_options.gradient_tolerance = 1e-16;
-  solver_options.parameter_tolerance = 1e-12;
-  solver_options.logging_type = ceres::SILENT;
+  const ceres::Solver::Options solver_options =
+      RefinementSolverOptions(options);
   ceres::Solver::Summary summary;
   ceres::Solve(solver_options, problem, &summary);
   return summary;

@@ -81,20 +81,14 @@ Status CheckSamples(const std::vector<PixelRay>& samples) {
 }  // namespace
 
 Status CalibrationComparisonOptions::Check() const {
-  std::ostringstream message;
-  if (!(grid_step > 0.0) || !std::isfinite(grid_step)) {
-    message << "calibration comparison: grid_step " << grid_step
-            << " is not positive";
-  } else if (!(inset >= 0.0 && inset <= 0.45)) {
-    message << "calibration comparison: inset " << inset
-            << " is outside [0, 0.45]";
-  } else if (max_iterations <= 0) {
-    message << "calibration comparison: max_iterations " << max_iterations
-            << " is not positive";
-  } else {
-    return Status::Ok();
+  constexpr std::string_view kWhat = "calibration comparison";
+  RCM_RETURN_IF_ERROR(CheckGridStep(kWhat, grid_step));
+  RCM_RETURN_IF_ERROR(CheckInsetFraction(kWhat, "inset", inset));
+  if (max_iterations <= 0) {
+    return Status::Error("calibration comparison: max_iterations " +
+                         std::to_string(max_iterations) + " is not positive");
   }
-  return Status::Error(message.str());
+  return Status::Ok();
 }
 
 StatusOr<IndexFromRays> EstimateIndexFromRays(

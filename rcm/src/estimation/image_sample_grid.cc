@@ -2,8 +2,25 @@
 
 #include <cmath>
 #include <optional>
+#include <sstream>
 
 namespace rcm {
+
+Status CheckGridStep(std::string_view what, double grid_step) {
+  if (grid_step > 0.0 && std::isfinite(grid_step)) return Status::Ok();
+  std::ostringstream message;
+  message << what << ": grid_step " << grid_step << " is not positive";
+  return Status::Error(message.str());
+}
+
+Status CheckInsetFraction(std::string_view what, std::string_view name,
+                          double inset) {
+  if (inset >= 0.0 && inset <= kMaxInsetFraction) return Status::Ok();
+  std::ostringstream message;
+  message << what << ": " << name << " " << inset << " is outside [0, "
+          << kMaxInsetFraction << "]";
+  return Status::Error(message.str());
+}
 
 ImageErrorField CenteredSampleGrid(int width, int height, double step) {
   ImageErrorField grid;

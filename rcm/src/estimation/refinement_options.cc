@@ -69,6 +69,19 @@ Status RefinementOptions::Check() const {
   return Status::Error(error.str());
 }
 
+ceres::Solver::Options RefinementSolverOptions(
+    const RefinementOptions& options) {
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.max_num_iterations = options.max_num_iterations;
+  solver_options.num_threads = options.num_threads;
+  solver_options.function_tolerance = 1e-14;
+  solver_options.gradient_tolerance = 1e-16;
+  solver_options.parameter_tolerance = 1e-12;
+  solver_options.logging_type = ceres::SILENT;
+  return solver_options;
+}
+
 ceres::LossFunction* NewLossFunction(RobustLoss loss, double scale_px) {
   switch (loss) {
     case RobustLoss::kNone:

@@ -63,14 +63,8 @@ ceres::Solver::Summary Solve(const ThickPortStereo& stereo,
         std::min(stereo.left_port.air_gap, stereo.right_port.air_gap);
     problem->SetParameterLowerBound(&parameters->gap_delta, 0, -smallest_gap);
   }
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_QR;
-  solver_options.max_num_iterations = options.base.max_num_iterations;
-  solver_options.num_threads = options.base.num_threads;
-  solver_options.function_tolerance = 1e-14;
-  solver_options.gradient_tolerance = 1e-16;
-  solver_options.parameter_tolerance = 1e-12;
-  solver_options.logging_type = ceres::SILENT;
+  const ceres::Solver::Options solver_options =
+      RefinementSolverOptions(options.base);
   ceres::Solver::Summary summary;
   ceres::Solve(solver_options, problem, &summary);
   return summary;

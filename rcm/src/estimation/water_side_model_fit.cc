@@ -55,23 +55,15 @@ ceres::Solver::Summary Solve(const std::vector<RaySample>& samples,
 }  // namespace
 
 Status WaterSideModelFitOptions::Check() const {
-  std::ostringstream message;
-  if (!(grid_step > 0.0) || !std::isfinite(grid_step)) {
-    message << "water-side model fit: grid_step " << grid_step
-            << " is not positive";
-  } else if (!(fit_inset >= 0.0 && fit_inset <= 0.45)) {
-    message << "water-side model fit: fit_inset " << fit_inset
-            << " is outside [0, 0.45]";
-  } else if (!(report_inset >= 0.0 && report_inset <= 0.45)) {
-    message << "water-side model fit: report_inset " << report_inset
-            << " is outside [0, 0.45]";
-  } else if (max_iterations <= 0) {
-    message << "water-side model fit: max_iterations " << max_iterations
-            << " is not positive";
-  } else {
-    return Status::Ok();
+  constexpr std::string_view kWhat = "water-side model fit";
+  RCM_RETURN_IF_ERROR(CheckGridStep(kWhat, grid_step));
+  RCM_RETURN_IF_ERROR(CheckInsetFraction(kWhat, "fit_inset", fit_inset));
+  RCM_RETURN_IF_ERROR(CheckInsetFraction(kWhat, "report_inset", report_inset));
+  if (max_iterations <= 0) {
+    return Status::Error("water-side model fit: max_iterations " +
+                         std::to_string(max_iterations) + " is not positive");
   }
-  return Status::Error(message.str());
+  return Status::Ok();
 }
 
 StatusOr<WaterSideModelFit> FitWaterSideModel(

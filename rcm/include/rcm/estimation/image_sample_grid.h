@@ -5,10 +5,23 @@
 #define RCM_ESTIMATION_IMAGE_SAMPLE_GRID_H_
 
 #include <Eigen/Core>
+#include <string_view>
 
+#include "rcm/util/status.h"
 #include "rcm/viz/image_error_map.h"
 
 namespace rcm {
+
+// The largest inset fraction at each side: 0.45 leaves the central 10 %.
+inline constexpr double kMaxInsetFraction = 0.45;
+
+// Checks of the settings of a fit on a sample grid, their messages
+// prefixed by `what` ("water-side model fit: grid_step 0 is not
+// positive", "...: inset 0.6 is outside [0, 0.45]"; `name` names the
+// inset's option).
+Status CheckGridStep(std::string_view what, double grid_step);
+Status CheckInsetFraction(std::string_view what, std::string_view name,
+                          double inset);
 
 // A grid every `step` (> 0) pixels over a width x height image, centered
 // (the same margin on both sides), with every error absent.

@@ -16,6 +16,7 @@
 #define RCM_ESTIMATION_REFINEMENT_OPTIONS_H_
 
 #include <ceres/loss_function.h>
+#include <ceres/solver.h>
 
 #include <optional>
 #include <string_view>
@@ -70,6 +71,12 @@ struct RefinementOptions {
 
   Status Check() const;
 };
+
+// The Ceres solver settings of both refinements (batch_refinement.h,
+// thick_port_refinement.h): dense QR, options' iterations and threads,
+// silent, and tight tolerances: one parameter (or a few) and cheap
+// iterations, and the noise-free case must reach 1e-9 in n.
+ceres::Solver::Options RefinementSolverOptions(const RefinementOptions& options);
 
 // A new Ceres loss of `loss` with scale `scale_px` (owned by the problem
 // it is given to); nullptr for kNone (least squares).
