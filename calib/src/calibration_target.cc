@@ -156,6 +156,13 @@ class TargetKeys {
           (*entry)->key, key,
           "must be positive and finite, got " + EscapeForMessage(text));
     }
+    // Found by fuzz_calibration_target: tagSpacing 2.2e57 put the corners
+    // so far out that neighbours rounded to the same point.
+    if (parsed < kMinTargetLength || parsed > kMaxTargetLength) {
+      return reader_.Error((*entry)->key, key,
+                           "must be between 1e-06 and 10, got " +
+                               EscapeForMessage(text));
+    }
     *value = parsed;
     *entry_out = *entry;
     return Status::Ok();

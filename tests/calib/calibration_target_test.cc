@@ -517,5 +517,13 @@ TEST(CalibrationTarget, ErrorRootIsNotAMap) {
             "t.yaml:1: expected a map of target settings, got a list");
 }
 
+// Found by fuzz_calibration_target: a tagSpacing of 2.2e57 was accepted and
+// neighbouring corners coincided.
+TEST(CalibrationTarget, ErrorLengthOutOfRange) {
+  EXPECT_EQ(ErrorOf("target_type: 'aprilgrid'\ntagCols: 6\ntagRows: 6\n"
+                    "tagSize: 0.088\ntagSpacing: 2.2e57\n"),
+            "t.yaml:5: tagSpacing: must be between 1e-06 and 10, got 2.2e57");
+}
+
 }  // namespace
 }  // namespace rcm::calib

@@ -59,12 +59,73 @@ TEST(Camera, RejectsNonFiniteCoefficient) {
             "distortion coefficient 1 is not a finite number");
 }
 
+// Found by fuzz_camera_model: k2 = 2.4e68 broke the series the equidistant
+// model uses near the axis, and a pixel did not reproject onto itself.
+TEST(Camera, RejectsAbsurdCoefficient) {
+  const StatusOr<Camera> camera = Camera::Create(
+      LensModelId::kEquidistant, 640, 480, {300.0, 300.0, 320.0, 240.0},
+      {-1.0, 2.4e68, 0.0, 0.0});
+  ASSERT_FALSE(camera.ok());
+  EXPECT_EQ(camera.status().message(),
+            "distortion coefficient 1 = 2.4e+68 is beyond the accepted "
+            "magnitude of 1000");
+}
+
 TEST(Camera, RejectsNonPositiveImageSize) {
   const StatusOr<Camera> camera = Camera::Create(
       LensModelId::kPinhole, 0, 480, {300.0, 300.0, 320.0, 240.0}, {});
   ASSERT_FALSE(camera.ok());
   EXPECT_EQ(camera.status().message(),
             "image size must be positive, got 0 x 480");
+}
+
+// A focal length in metres, or a denormal one (found by fuzz_camera_model:
+// fy = 7e-322 passed "positive" and sent the unprojection to inf).
+TEST(Camera, RejectsFocalLengthOutsidePixelRange) {
+  const StatusOr<Camera> metres = Camera::Create(
+      LensModelId::kPinhole, 640, 480, {0.004, 0.004, 320.0, 240.0}, {});
+  ASSERT_FALSE(metres.ok());
+  EXPECT_EQ(metres.status().message(),
+            "fx = 0.004 is not a focal length in pixels (accepted: 1 to 1e+06)");
+  EXPECT_FALSE(Camera::Create(LensModelId::kPinhole, 640, 480,
+                              {300.0, 7e-322, 320.0, 240.0}, {})
+                   .ok());
+  EXPECT_FALSE(Camera::Create(LensModelId::kPinhole, 640, 480,
+                              {2e6, 300.0, 320.0, 240.0}, {})
+                   .ok());
+  EXPECT_TRUE(Camera::Create(LensModelId::kPinhole, 640, 480,
+                             {1.0, 1e6, 320.0, 240.0}, {})
+                  .ok());
+}
+
+TEST(Camera, RejectsPrincipalPointOutsidePixelRange) {
+  const StatusOr<Camera> camera = Camera::Create(
+      LensModelId::kPinhole, 640, 480, {300.0, 300.0, 320.0, -3e9}, {});
+  ASSERT_FALSE(camera.ok());
+  EXPECT_EQ(camera.status().message(),
+            "cy = -3e+09 is not a principal point in pixels (accepted: within "
+            "1e+06 of 0)");
+}
+
+TEST(Camera, RejectsImageSideBeyondLimit) {
+  const StatusOr<Camera> camera = Camera::Create(
+      LensModelId::kPinhole, 640, 20001, {300.0, 300.0, 320.0, 240.0}, {});
+  ASSERT_FALSE(camera.ok());
+  EXPECT_EQ(camera.status().message(),
+            "image size 640 x 20001 is beyond the largest accepted side of "
+            "20000 px");
+}
+
+// The unprojection refuses what has no finite normalized point instead of
+// returning inf (found by fuzz_camera_model).
+TEST(Camera, UnprojectionOfNonFinitePixelFails) {
+  const StatusOr<Camera> camera = Camera::Create(
+      LensModelId::kPinhole, 640, 480, {300.0, 300.0, 320.0, 240.0}, {});
+  ASSERT_TRUE(camera.ok());
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(camera->NormalizedFromImage(Eigen::Vector2d(inf, 0.0)));
+  EXPECT_FALSE(camera->NormalizedFromImage(Eigen::Vector2d(0.0, NAN)));
+  EXPECT_TRUE(camera->NormalizedFromImage(Eigen::Vector2d(1e9, -1e9)));
 }
 
 TEST(Camera, LensModelNamesRoundTrip) {

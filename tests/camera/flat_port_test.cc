@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include <ceres/jet.h>
@@ -227,6 +228,28 @@ TEST(ExactFlatPort, InvisiblePointsHaveNoProjection) {
       Eigen::Vector3d(std::sin(inside), 0.0, std::cos(inside))));
 }
 
+// Found by fuzz_camera_model: with an air gap of 1e-107 m the air leg is
+// unbounded, so a point 80 degrees off a port tilted 15 degrees the other
+// way is "reached" by a ray at 90 degrees to the normal, which does not
+// reach the glass when traced forward. Such a point is not visible.
+TEST(ExactFlatPort, GrazingSolutionIsNotVisible) {
+  FlatPort port;
+  port.air_gap = 8.68097232975773e-107;
+  port.glass_thickness = 0.077686274509803935;
+  port.glass_index = 1.0333305969827433;
+  port.normal =
+      Eigen::Vector3d(0.26563418610022183, 3.4730605460704332e-164,
+                      0.9999999013601566);
+  const ExactFlatPort exact =
+      ExactFlatPort::Create(port, 1.8490196078431373).value();
+  EXPECT_FALSE(exact.NormalizedFromPoint(Eigen::Vector3d(
+      -26.970280264941159, -1.8414600739130327, 8.5757061839103699)));
+  const std::optional<Eigen::Vector2d> visible =
+      exact.NormalizedFromPoint(Eigen::Vector3d(-2.0, -1.84, 8.576));
+  ASSERT_TRUE(visible.has_value());
+  EXPECT_TRUE(exact.RayFromNormalized(*visible).has_value());
+}
+
 TEST(FlatPortCamera, PixelRoundTripThroughTheLens) {
   // Alphasense equidistant lens, thick tilted port: pixel -> ray -> point
   // -> pixel. Floored by the iterative lens undistortion (1e-9 px).
@@ -307,6 +330,27 @@ TEST(ThickPortRefraction, ThinPortIsThePapersBearing) {
                expected)
                   .norm(),
               1e-12);
+  }
+}
+
+// Found by fuzz_residual: an air-gap offset of -5e187 gave a ray whose
+// origin overflowed the Sampson gradient (residual 0, derivative NaN). A gap
+// outside [0, kMaxAirGap] has no ray.
+TEST(ThickPortRefraction, NoRayForAnAirGapOutsideTheAcceptedRange) {
+  double origin[3];
+  double direction[3];
+  const Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  EXPECT_TRUE(ThickPortRefraction::RayInMedium(1.333, 0.0, 0.005, 1.49,
+                                               normal, 0.2, 0.1, origin,
+                                               direction));
+  EXPECT_TRUE(ThickPortRefraction::RayInMedium(
+      1.333, FlatPort::kMaxAirGap, 0.005, 1.49, normal, 0.2, 0.1, origin,
+      direction));
+  for (const double gap : {-1e-9, -5e187, FlatPort::kMaxAirGap * 1.001,
+                           std::numeric_limits<double>::quiet_NaN()}) {
+    EXPECT_FALSE(ThickPortRefraction::RayInMedium(
+        1.333, gap, 0.005, 1.49, normal, 0.2, 0.1, origin, direction))
+        << gap;
   }
 }
 

@@ -5,6 +5,7 @@
 
 #include <Eigen/LU>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "rcm/camera/camera.h"
@@ -58,6 +59,80 @@ TEST(LensModels, EquidistantRoundTripNinetyDegreeFieldOfView) {
   const Eigen::Vector2d corner =
       camera.NormalizedFromImage({-0.5, -0.5}).value();
   EXPECT_NEAR(std::atan(corner.norm()) * 180.0 / M_PI, 89.5, 1e-9);
+}
+
+// Found by fuzz_camera_model: with k1..k4 = -0.2157, theta_d rises to a
+// maximum of 0.73 near 0.87 rad, then falls below zero before pi/2. Every
+// pixel failed to unproject, because the angle solve only bracketed
+// [0, pi/2]. Pixels inside the fold's radius unproject onto the rising
+// branch; pixels beyond it have no ray.
+TEST(EquidistantLens, UnprojectsWhenThetaDFoldsBeforeNinetyDegrees) {
+  const double k = -0.21568627450980393;
+  const Camera camera =
+      Camera::Create(LensModelId::kEquidistant, 1687, 1687,
+                     {1954.7, 1954.7, 1507.8, 1507.8}, {k, k, k, k})
+          .value();
+  const double dist[4] = {k, k, k, k};
+  double peak = 0.0;
+  double peak_theta = 0.0;
+  for (double theta = 0.0; theta < 1.5; theta += 1e-4) {
+    const double value = EquidistantLens::DistortedAngle(dist, theta);
+    if (value > peak) {
+      peak = value;
+      peak_theta = theta;
+    }
+  }
+  ASSERT_LT(EquidistantLens::DistortedAngle(dist, M_PI / 2), 0.0);
+  int unprojected = 0;
+  for (double radius = 0.01; radius < 0.99 * peak; radius += 0.01) {
+    const Eigen::Vector2d pixel(1507.8 - 1954.7 * radius * 0.6,
+                                1507.8 + 1954.7 * radius * 0.8);
+    const std::optional<Eigen::Vector2d> normalized =
+        camera.NormalizedFromImage(pixel);
+    ASSERT_TRUE(normalized.has_value()) << radius;
+    EXPECT_LT((camera.ImageFromNormalized(*normalized) - pixel).norm(),
+              kRoundTripPixelTolerance);
+    EXPECT_LT(std::atan(normalized->norm()), peak_theta) << "folded branch";
+    ++unprojected;
+  }
+  EXPECT_GT(unprojected, 50);
+  EXPECT_FALSE(camera.NormalizedFromImage({1507.8 + 1954.7 * 1.01 * peak,
+                                           1507.8})
+                   .has_value());
+}
+
+// Found by fuzz_camera_model: with k1 = k2 = -0.26, theta_d folds at 0.8
+// rad and turns negative near 1.2 rad; beyond, the radial scale and its
+// derivative are both negative, the Jacobian's determinant is positive
+// again, and a point there projected onto the opposite side of the image.
+TEST(LensModels, PrincipalBranchEndsAtTheFirstFold) {
+  const Camera equidistant =
+      Camera::Create(LensModelId::kEquidistant, 640, 480,
+                     {300.0, 300.0, 320.0, 240.0}, {-0.26, -0.26, 0.0, 0.0})
+          .value();
+  const double fold = std::atan(equidistant.MaxInvertibleRadius());
+  const double dist[4] = {-0.26, -0.26, 0.0, 0.0};
+  double derivative;
+  EquidistantLens::DistortedAngle(dist, fold, &derivative);
+  EXPECT_NEAR(derivative, 0.0, 1e-12);
+  const Eigen::Vector2d far_branch(0.0, std::tan(1.45));
+  ASSERT_GT(equidistant.ImageFromNormalizedJacobian(far_branch).determinant(),
+            0.0);
+  EXPECT_FALSE(equidistant.LensInvertibleAt(far_branch));
+  EXPECT_FALSE(equidistant.ProjectNormalized(far_branch).has_value());
+  EXPECT_TRUE(equidistant.LensInvertibleAt({0.0, std::tan(0.99 * fold)}));
+
+  // radtan r (1 + k1 r^2): the fold at r^2 = -1 / (3 k1).
+  const Camera radtan =
+      Camera::Create(LensModelId::kRadTan, 640, 480,
+                     {300.0, 300.0, 320.0, 240.0}, {-0.5, 0.0, 0.0, 0.0})
+          .value();
+  EXPECT_NEAR(radtan.MaxInvertibleRadius(), std::sqrt(1.0 / 1.5), 1e-15);
+  // 1 + 3 k1 s + 5 k2 s^2 without a positive root: no fold.
+  EXPECT_EQ(test::EurocRadtanCamera().MaxInvertibleRadius(),
+            std::numeric_limits<double>::infinity());
+  EXPECT_EQ(test::PinholeCamera().MaxInvertibleRadius(),
+            std::numeric_limits<double>::infinity());
 }
 
 TEST(LensModels, NormalizedRoundTripUpToEightyNineDegrees) {

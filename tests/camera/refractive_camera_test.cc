@@ -115,6 +115,22 @@ TEST(RefractiveCamera, ProjectionFailsBehindCameraAndPastCriticalAngle) {
                    .has_value());
 }
 
+// Found by fuzz_camera_model: a pinhole pixel at u = 4e175 gave the bearing
+// (0, 0, NaN). What overflows has no bearing.
+TEST(RefractiveCamera, NoBearingForAPixelThatOverflows) {
+  const Camera pinhole = Camera::Create(LensModelId::kPinhole, 3557, 1687,
+                                        {1954.7, 1954.7, 1516.9, 1507.8}, {})
+                             .value();
+  const RefractiveCamera refractive =
+      RefractiveCamera::Create(pinhole, 1.284).value();
+  EXPECT_TRUE(refractive.BearingInWaterFromImage({1e5, -1000.0}).has_value());
+  EXPECT_FALSE(
+      refractive.BearingInWaterFromImage({4.03e175, -1000.0}).has_value());
+  // r^2 just below the largest double: the bearing's length overflows.
+  EXPECT_FALSE(
+      refractive.BearingInWaterFromImage({1635.0, 2.6e157}).has_value());
+}
+
 TEST(RefractiveCamera, ProjectionRefusesFoldedLensBranch) {
   // A radtan lens that folds at r = 0.816: points beyond the fold would land
   // on wrong pixels inside the image.
@@ -262,6 +278,20 @@ TEST(RefractiveCameraWithPort, RejectsReferenceDepthInsideTheHousing) {
   EXPECT_FALSE(RefractiveCamera::CreateWithPort(lens, 1.333, bad, 2.0).ok());
   EXPECT_FALSE(
       RefractiveCamera::CreateWithPort(lens, 2.5, HousingPort(), 2.0).ok());
+  EXPECT_EQ(RefractiveCamera::CreateWithPort(lens, 1.333, HousingPort(), 1e217)
+                .status()
+                .message(),
+            "reference depth 1e+217 m is beyond the accepted 10000 m");
+  EXPECT_TRUE(RefractiveCamera::CreateWithPort(
+                  lens, 1.333, HousingPort(),
+                  RefractiveCamera::kMaxReferenceDepth)
+                  .ok());
+  // Found by fuzz_camera_model: 4e-217 m is beyond a thin port's glass, but
+  // not by the millimetre the arithmetic needs.
+  EXPECT_FALSE(
+      RefractiveCamera::CreateWithPort(lens, 1.333, FlatPort(), 4e-217).ok());
+  EXPECT_TRUE(
+      RefractiveCamera::CreateWithPort(lens, 1.333, FlatPort(), 1e-3).ok());
 }
 
 }  // namespace

@@ -131,6 +131,19 @@ TEST(Observability, FirstOrderSigmaUndefinedOnHorizontalAxis) {
   EXPECT_FALSE(FirstOrderSigmaN(rig, c, 1.333, 0.5).has_value());
 }
 
+// Found by fuzz_closed_form: a negative pixel sigma gave a negative sigma_n.
+TEST(Observability, FirstOrderSigmaUndefinedForInvalidPixelSigma) {
+  const StereoRig rig =
+      test::IdealRig(test::PinholeCamera(), test::PinholeCamera());
+  StereoCorrespondence c;
+  c.left_pixel = Eigen::Vector2d(500.0, 400.0);
+  c.right_pixel = Eigen::Vector2d(480.0, 401.0);
+  ASSERT_TRUE(FirstOrderSigmaN(rig, c, 1.333, 0.5).has_value());
+  EXPECT_FALSE(FirstOrderSigmaN(rig, c, 1.333, -0.5).has_value());
+  EXPECT_FALSE(FirstOrderSigmaN(rig, c, 1.333, NAN).has_value());
+  EXPECT_FALSE(FirstOrderSigmaN(rig, c, 1.333, INFINITY).has_value());
+}
+
 TEST(Observability, FirstOrderSigmaGrowsTowardTheAxes) {
   // The same depth and disparity, closer to the horizontal axis: worse.
   const StereoRig rig =

@@ -301,27 +301,30 @@ TEST(Camchain, IgnoresUnknownKeys) {
 
 TEST(Camchain, RoundTripIsByteStable) {
   // Values that exercise every number layout: long mantissas, exponents on
-  // both sides of the fixed/scientific switch, -0.0, integral values.
+  // both sides of the fixed/scientific switch, -0.0, integral values
+  // (those that no camera has go into the IMU transform and time shifts).
   Camchain camchain;
   CamchainCamera cam0 = MakeEntry(
       Camera::Create(LensModelId::kEquidistant, 1440, 1080,
-                     {1234.5678901234567, 1e16, -0.0, 9999999999999998.0},
+                     {1234.5678901234567, 999999.9999999999, -0.0, 123456.0},
                      {1e-05, -2.365797666527927e-05, 0.1, 5e-324})
           .value(),
       std::nullopt);
-  cam0.cam_from_imu = MakeTransform(Eigen::Vector3d(1.2, -1.2, 1.2),
-                                    Eigen::Vector3d(1e-17, -0.0, 123456.0));
+  cam0.cam_from_imu =
+      MakeTransform(Eigen::Vector3d(1.2, -1.2, 1.2),
+                    Eigen::Vector3d(1e16, 1e-17, 9999999999999998.0));
   cam0.timeshift_cam_imu = -0.0001;
   cam0.cam_overlaps = {1, 2};
   cam0.rostopic = "/rig/left/image_raw";
   CamchainCamera cam1 =
       MakeEntry(Camera::Create(LensModelId::kRadTan, 640, 480,
-                               {0.1 + 0.2, 1.0 / 3.0, 320.0, 240.0},
+                               {100.0 / 3.0, 1000.0 / 3.0, 320.0, 240.0},
                                {-0.28, 0.07, 1.9e-4, -3.1e-5})
                     .value(),
                 MakeTransform(Eigen::Vector3d(0.003, -0.02, 0.001),
                               Eigen::Vector3d(-0.12, 1e-4, 2.5e-3)));
   cam1.cam_overlaps = {0};
+  cam1.timeshift_cam_imu = 0.1 + 0.2;
   CamchainCamera cam2 =
       MakeEntry(MakeCamera(LensModelId::kPinhole, 500.0, {}),
                 MakeTransform(Eigen::Vector3d(0.5, 0.25, -0.125),
@@ -743,6 +746,14 @@ TEST(Camchain, RejectsYamlSyntaxError) {
   EXPECT_EQ(ParseError(ReplaceOnce(kMinimal, "[346.7, 346.8, 360.5, 271.0]",
                                    "[346.7, 346.8, 360.5, 271.0")),
             "rig.yaml:7: YAML syntax error: end of sequence flow not found");
+}
+
+// Found by fuzz_calibration_yaml: yaml-cpp's message quotes the offending
+// character raw, here an escape byte (0x1b) after a backslash in a
+// double-quoted string; the error must stay one line.
+TEST(Camchain, YamlSyntaxErrorIsOneLineWhateverTheCharacter) {
+  EXPECT_EQ(ParseError("cam0:\n  rostopic: \"a\\\x1b[31m\"\n"),
+            "rig.yaml:2: YAML syntax error: unknown escape character: \\x1b");
 }
 
 TEST(Camchain, RejectsEmptyFile) {

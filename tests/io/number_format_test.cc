@@ -105,6 +105,13 @@ TEST(QuoteForMessage, ShortensTextPast40Bytes) {
             "'" + std::string(39, 'x') + "\\x0a...'");
 }
 
+TEST(EscapeControlCharacters, EscapesWithoutShortening) {
+  const std::string long_text(50, 'x');
+  EXPECT_EQ(EscapeControlCharacters(long_text + "\n"), long_text + "\\x0a");
+  EXPECT_EQ(EscapeControlCharacters("unknown escape character: \x01"),
+            "unknown escape character: \\x01");
+}
+
 TEST(FormatFixed, PrintsFixedDecimalsAndNaForNonFinite) {
   EXPECT_EQ(FormatFixed(1.334981, 5), "1.33498");
   EXPECT_EQ(FormatFixed(0.5, 0), "0");

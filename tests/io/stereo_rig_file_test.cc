@@ -228,6 +228,20 @@ TEST(StereoRigFile, RejectsCamchainInPair) {
                                     "camera_info"));
 }
 
+// Found by the CLI bad-input table: an empty or non-YAML file in a pair was
+// "a Kalibr camchain"; it is a camera_info with its own problem.
+TEST(StereoRigFile, ReportsEmptyOrGarbledCameraInfoInPair) {
+  const std::string left = WriteTempFile(
+      "garbled_left.yaml", RectifiedCameraInfoText("left", 344.5, 0.0));
+  const std::string empty = WriteTempFile("garbled_empty.yaml", "");
+  EXPECT_EQ(ErrorMessage(ReadStereoRig(left + "," + empty)),
+            empty + ": empty file");
+  const std::string syntax =
+      WriteTempFile("garbled_syntax.yaml", "image_width: [720\n");
+  EXPECT_THAT(ErrorMessage(ReadStereoRig(left + "," + syntax)),
+              StartsWith(syntax + ":2: YAML syntax error: "));
+}
+
 TEST(StereoRigFile, RejectsPairWithEmptyPath) {
   const std::string left = WriteTempFile(
       "lonely_left.yaml", RectifiedCameraInfoText("left", 346.5, 0.0));

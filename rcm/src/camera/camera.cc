@@ -1,10 +1,73 @@
 #include "rcm/camera/camera.h"
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace rcm {
+
+namespace {
+
+// Camera::MaxInvertibleRadius of a lens.
+double FirstFoldRadius(LensModelId model,
+                       const std::vector<double>& distortion) {
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  switch (model) {
+    case LensModelId::kPinhole:
+      return kInfinity;
+    case LensModelId::kRadTan: {
+      // d/dr [r (1 + k1 s + k2 s^2)] = 1 + 3 k1 s + 5 k2 s^2 with s = r^2:
+      // its smallest positive root in s, by the stable quadratic formula.
+      const double a = 5.0 * distortion[1];
+      const double b = 3.0 * distortion[0];
+      double smallest = kInfinity;
+      if (a == 0.0) {
+        if (b < 0.0) smallest = -1.0 / b;
+      } else {
+        const double discriminant = b * b - 4.0 * a;
+        if (discriminant >= 0.0) {
+          const double q =
+              -0.5 * (b + std::copysign(std::sqrt(discriminant), b));
+          for (const double root : {q / a, q != 0.0 ? 1.0 / q : kInfinity}) {
+            if (root > 0.0) smallest = std::min(smallest, root);
+          }
+        }
+      }
+      return std::sqrt(smallest);
+    }
+    case LensModelId::kEquidistant: {
+      // The first angle below pi/2 where d theta_d / d theta stops being
+      // positive: a scan in steps of pi/2048, then bisection.
+      constexpr double kHalfPi = 1.5707963267948966;
+      constexpr int kSteps = 1024;
+      const double* dist = distortion.data();
+      double derivative = 1.0;
+      for (int k = 1; k <= kSteps; ++k) {
+        const double theta = kHalfPi * k / kSteps;
+        EquidistantLens::DistortedAngle(dist, theta, &derivative);
+        if (derivative > 0.0) continue;
+        double rising = kHalfPi * (k - 1) / kSteps;
+        double falling = theta;
+        for (int it = 0; it < 60; ++it) {
+          const double middle = 0.5 * (rising + falling);
+          EquidistantLens::DistortedAngle(dist, middle, &derivative);
+          if (derivative > 0.0) {
+            rising = middle;
+          } else {
+            falling = middle;
+          }
+        }
+        return std::tan(rising);
+      }
+      return kInfinity;
+    }
+  }
+  return kInfinity;
+}
+
+}  // namespace
 
 std::string_view LensModelName(LensModelId model) {
   switch (model) {
@@ -34,9 +97,19 @@ int NumDistortionParams(LensModelId model) {
 }
 
 Status Camera::CheckImageSize(int width, int height) {
-  if (width > 0 && height > 0) return Status::Ok();
+  if (width > 0 && height > 0 && width <= kMaxImageSide &&
+      height <= kMaxImageSide) {
+    return Status::Ok();
+  }
   std::ostringstream message;
-  message << "image size must be positive, got " << width << " x " << height;
+  if (width > 0 && height > 0) {
+    message << "image size " << width << " x " << height
+            << " is beyond the largest accepted side of " << kMaxImageSide
+            << " px";
+  } else {
+    message << "image size must be positive, got " << width << " x "
+            << height;
+  }
   return Status::Error(message.str());
 }
 
@@ -52,6 +125,22 @@ Status Camera::CheckIntrinsics(const std::array<double, 4>& intrinsics) {
       std::ostringstream message;
       message << "focal length must be positive, got " << kNames[i] << " = "
               << intrinsics[i];
+      return Status::Error(message.str());
+    }
+    if (intrinsics[i] < kMinFocalLength || intrinsics[i] > kMaxFocalLength) {
+      std::ostringstream message;
+      message << kNames[i] << " = " << intrinsics[i]
+              << " is not a focal length in pixels (accepted: "
+              << kMinFocalLength << " to " << kMaxFocalLength << ")";
+      return Status::Error(message.str());
+    }
+  }
+  for (int i = 2; i < 4; ++i) {
+    if (std::abs(intrinsics[i]) > kMaxPrincipalPointOffset) {
+      std::ostringstream message;
+      message << kNames[i] << " = " << intrinsics[i]
+              << " is not a principal point in pixels (accepted: within "
+              << kMaxPrincipalPointOffset << " of 0)";
       return Status::Error(message.str());
     }
   }
@@ -73,6 +162,13 @@ Status Camera::CheckDistortion(LensModelId model,
       message << "distortion coefficient " << i << " is not a finite number";
       return Status::Error(message.str());
     }
+    if (std::abs(distortion[i]) > kMaxDistortionCoefficient) {
+      std::ostringstream message;
+      message << "distortion coefficient " << i << " = " << distortion[i]
+              << " is beyond the accepted magnitude of "
+              << kMaxDistortionCoefficient;
+      return Status::Error(message.str());
+    }
   }
   return Status::Ok();
 }
@@ -90,6 +186,7 @@ StatusOr<Camera> Camera::Create(LensModelId model, int width, int height,
   camera.height_ = height;
   for (int i = 0; i < 4; ++i) camera.params_[i] = intrinsics[i];
   for (int i = 0; i < expected; ++i) camera.params_[4 + i] = distortion[i];
+  camera.max_invertible_radius_ = FirstFoldRadius(model, distortion);
   return camera;
 }
 
@@ -138,7 +235,8 @@ std::optional<Eigen::Vector2d> Camera::ProjectNormalized(
 }
 
 bool Camera::LensInvertibleAt(const Eigen::Vector2d& normalized) const {
-  return ImageFromNormalizedJacobian(normalized).determinant() > 0.0;
+  return normalized.norm() < max_invertible_radius_ &&
+         ImageFromNormalizedJacobian(normalized).determinant() > 0.0;
 }
 
 bool Camera::InImage(const Eigen::Vector2d& pixel) const {

@@ -123,7 +123,14 @@ std::optional<Eigen::Vector2d> ExactFlatPort::NormalizedFromPoint(
     const Eigen::Vector3d& point) const {
   const std::optional<Eigen::Vector3d> in_air = AirDirectionFromPoint(point);
   if (!in_air || !(in_air->z() > 0.0)) return std::nullopt;
-  return Eigen::Vector2d(in_air->x() / in_air->z(), in_air->y() / in_air->z());
+  const Eigen::Vector2d normalized(in_air->x() / in_air->z(),
+                                   in_air->y() / in_air->z());
+  // A solution that grazes the port can round to a ray in air that no
+  // longer reaches the glass.
+  if (!normalized.allFinite() || !RayFromNormalized(normalized)) {
+    return std::nullopt;
+  }
+  return normalized;
 }
 
 }  // namespace rcm

@@ -26,11 +26,19 @@ StatusOr<RefractiveCamera> RefractiveCamera::CreateWithPort(
   if (!result.ok()) return result.status();
   RCM_RETURN_IF_ERROR(port.Check());
   if (!std::isfinite(reference_depth) ||
-      !(reference_depth > port.air_gap + port.glass_thickness)) {
+      !(reference_depth >= port.air_gap + port.glass_thickness +
+                               kMinReferenceDepthBeyondGlass)) {
     std::ostringstream message;
     message << "reference depth " << reference_depth
             << " m is not beyond the port's glass ("
-            << port.air_gap + port.glass_thickness << " m)";
+            << port.air_gap + port.glass_thickness << " m) by "
+            << kMinReferenceDepthBeyondGlass * 1e3 << " mm at least";
+    return Status::Error(message.str());
+  }
+  if (reference_depth > kMaxReferenceDepth) {
+    std::ostringstream message;
+    message << "reference depth " << reference_depth
+            << " m is beyond the accepted " << kMaxReferenceDepth << " m";
     return Status::Error(message.str());
   }
   result->port_ = port;
@@ -43,6 +51,27 @@ StatusOr<RefractiveCamera> RefractiveCamera::CreateWithPort(
   return result;
 }
 
+namespace {
+
+// `value`, or nullopt when an entry is not finite: a pixel far outside the
+// image (found by fuzz_camera_model: u = 4e175 overflowed the bearing).
+template <int kRows>
+std::optional<Eigen::Matrix<double, kRows, 1>> IfFinite(
+    const Eigen::Matrix<double, kRows, 1>& value) {
+  if (!value.allFinite()) return std::nullopt;
+  return value;
+}
+
+// `direction` scaled to unit length, or nullopt when its length is not a
+// positive finite number (it overflowed or underflowed).
+std::optional<Eigen::Vector3d> UnitOrNothing(const Eigen::Vector3d& direction) {
+  const double length = direction.norm();
+  if (!std::isfinite(length) || !(length > 0.0)) return std::nullopt;
+  return IfFinite<3>(direction / length);
+}
+
+}  // namespace
+
 std::optional<Eigen::Vector3d> RefractiveCamera::BearingInWaterFromImage(
     const Eigen::Vector2d& pixel) const {
   if (const FlatPortCamera* thick = this->thick()) {
@@ -53,7 +82,7 @@ std::optional<Eigen::Vector3d> RefractiveCamera::BearingInWaterFromImage(
     const double along =
         (reference_depth_ - ray->origin.z()) / ray->direction.z();
     if (!(along > 0.0)) return std::nullopt;
-    return (ray->origin + along * ray->direction).normalized();
+    return UnitOrNothing(ray->origin + along * ray->direction);
   }
   const std::optional<Eigen::Vector2d> normalized =
       camera_.NormalizedFromImage(pixel);
@@ -61,7 +90,7 @@ std::optional<Eigen::Vector3d> RefractiveCamera::BearingInWaterFromImage(
   Eigen::Vector3d bearing;
   FlatPortRefraction::BearingInWater(n_, normalized->x(), normalized->y(),
                                      bearing.data());
-  return bearing.normalized();
+  return UnitOrNothing(bearing);
 }
 
 std::optional<Eigen::Vector2d> RefractiveCamera::ImageFromPointInWater(
@@ -93,9 +122,9 @@ std::optional<Eigen::Vector2d> RefractiveCamera::VirtualPinholeFromImage(
     const std::optional<Eigen::Vector3d> bearing =
         BearingInWaterFromImage(pixel);
     if (!bearing || !(bearing->z() > 0.0)) return std::nullopt;
-    return Eigen::Vector2d(
+    return IfFinite<2>(Eigen::Vector2d(
         n_ * camera_.fx() * bearing->x() / bearing->z() + camera_.cx(),
-        n_ * camera_.fy() * bearing->y() / bearing->z() + camera_.cy());
+        n_ * camera_.fy() * bearing->y() / bearing->z() + camera_.cy()));
   }
   const std::optional<Eigen::Vector2d> normalized =
       camera_.NormalizedFromImage(pixel);
@@ -103,8 +132,8 @@ std::optional<Eigen::Vector2d> RefractiveCamera::VirtualPinholeFromImage(
   double xv, yv;
   FlatPortRefraction::VirtualFromNormalized(n_, normalized->x(),
                                             normalized->y(), &xv, &yv);
-  return Eigen::Vector2d(camera_.fx() * xv + camera_.cx(),
-                         camera_.fy() * yv + camera_.cy());
+  return IfFinite<2>(Eigen::Vector2d(camera_.fx() * xv + camera_.cx(),
+                                     camera_.fy() * yv + camera_.cy()));
 }
 
 std::optional<Eigen::Vector2d> RefractiveCamera::ImageFromVirtualPinhole(

@@ -14,6 +14,7 @@ double LocusTangentSeparation(double n0, double dn, double xl, double yl) {
 std::optional<double> FirstOrderSigmaN(const StereoRig& rig,
                                        const StereoCorrespondence& match,
                                        double n, double sigma_px) {
+  if (!std::isfinite(sigma_px) || !(sigma_px >= 0.0)) return std::nullopt;
   // Derivative slots: 0 = n, 1..2 = left pixel, 3..4 = right pixel.
   using Jet = ceres::Jet<double, 5>;
   const Jet n_jet(n, 0);

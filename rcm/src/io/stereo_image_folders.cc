@@ -393,7 +393,7 @@ StatusOr<std::vector<PairFiles>> ReadPairList(const std::string& list_path) {
         return Status::Error(where + ": empty " +
                              (side == 0 ? "left" : "right") + " path");
       }
-      fs::path path(std::string(fields[side]));
+      fs::path path{std::string(fields[side])};
       if (path.is_relative() && !base.empty()) path = base / path;
       std::error_code error;
       const fs::file_status status = fs::status(path, error);

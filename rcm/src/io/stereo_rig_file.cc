@@ -7,6 +7,7 @@
 #include "rcm/io/camchain.h"
 #include "rcm/io/camera_file.h"
 #include "rcm/io/camera_info.h"
+#include "rcm/io/yaml_fields.h"
 
 namespace rcm {
 namespace {
@@ -44,6 +45,12 @@ StatusOr<StereoRig> ReadCamchainRig(const std::string& path,
   return rig;
 }
 
+// True when `text` parses as YAML and holds a document.
+bool IsYamlDocument(const std::string& path, const std::string& text) {
+  const StatusOr<YAML::Node> root = YamlReader(path).Load(text);
+  return root.ok() && !root->IsNull();
+}
+
 StatusOr<StereoRig> ReadCameraInfoPair(const std::string& left_path,
                                        const std::string& right_path) {
   const std::string paths[2] = {left_path, right_path};
@@ -51,7 +58,11 @@ StatusOr<StereoRig> ReadCameraInfoPair(const std::string& left_path,
   for (int i = 0; i < 2; ++i) {
     const StatusOr<RigFile> file = ReadRigFile(paths[i]);
     if (!file.ok()) return file.status();
-    if (file->format != CalibrationFileFormat::kCameraInfo) {
+    // Empty text and YAML syntax errors detect as a camchain (so that a
+    // lone file's problem is told by the camchain parser); in a pair the
+    // camera_info parser tells it.
+    if (file->format != CalibrationFileFormat::kCameraInfo &&
+        IsYamlDocument(paths[i], file->text)) {
       return Status::Error(paths[i] +
                            ": is a Kalibr camchain, expected a ROS "
                            "camera_info (give a camchain alone, not in a "

@@ -165,7 +165,7 @@ StatusOr<YAML::Node> YamlReader::Load(const std::string& text) const {
       location += ":" + std::to_string(exception.mark.line + 1);
     }
     return Status::Error(location + ": " + syntax_error_ + ": " +
-                         exception.msg);
+                         EscapeControlCharacters(exception.msg));
   } catch (const std::exception& exception) {
     return CannotRead("YAML", exception);
   }
@@ -284,7 +284,7 @@ StatusOr<YamlEntries> YamlReader::RootEntries(const YAML::Node& root,
 Status YamlReader::CannotRead(std::string_view document,
                               const std::exception& exception) const {
   return Status::Error(source_name_ + ": cannot read " + std::string(document) +
-                       ": " + exception.what());
+                       ": " + EscapeControlCharacters(exception.what()));
 }
 
 Status YamlReader::ReadMatrix(const YAML::Node& node, std::string_view field,

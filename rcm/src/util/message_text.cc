@@ -2,10 +2,10 @@
 
 namespace rcm {
 
-std::string EscapeForMessage(std::string_view text) {
+std::string EscapeControlCharacters(std::string_view text) {
   static constexpr char kHex[] = "0123456789abcdef";
   std::string shown;
-  for (const char c : text.substr(0, kMaxMessageTextLength)) {
+  for (const char c : text) {
     const auto byte = static_cast<unsigned char>(c);
     if (byte < 0x20 || byte == 0x7f) {
       shown += "\\x";
@@ -15,6 +15,12 @@ std::string EscapeForMessage(std::string_view text) {
       shown += c;
     }
   }
+  return shown;
+}
+
+std::string EscapeForMessage(std::string_view text) {
+  std::string shown =
+      EscapeControlCharacters(text.substr(0, kMaxMessageTextLength));
   if (text.size() > kMaxMessageTextLength) shown += "...";
   return shown;
 }

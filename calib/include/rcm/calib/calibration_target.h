@@ -96,6 +96,12 @@ enum class TargetType { kCheckerboard, kAprilGrid, kCharuco };
 // board, and small enough that TargetPoints cannot exhaust memory.
 inline constexpr int kMaxTargetCount = 1000;
 
+// Accepted range of a target's lengths in meters and of tagSpacing (a
+// ratio): far beyond any printable board either way, and narrow enough
+// that neighbouring corners stay distinct in double precision.
+inline constexpr double kMinTargetLength = 1e-6;
+inline constexpr double kMaxTargetLength = 10.0;
+
 // The ChArUco dictionary used when the YAML file names none.
 inline constexpr char kDefaultCharucoDictionary[] = "DICT_6X6_250";
 

@@ -52,11 +52,26 @@ class Camera {
 
   // The checks of Create, one per input, so that a file reader can
   // attribute a problem to the key it came from.
-  // Width and height positive.
+  // The accepted ranges, far beyond any camera, so that a value off by a
+  // unit (a focal length in metres) or corrupted is refused before it
+  // overflows a computation or an image allocation: image sides up to
+  // kMaxImageSide px, focal lengths in [kMinFocalLength, kMaxFocalLength]
+  // px, the principal point within kMaxPrincipalPointOffset px of pixel
+  // (0, 0), distortion coefficients of magnitude up to
+  // kMaxDistortionCoefficient (real lenses stay below ~10; the lens models'
+  // series near the axis assume far less than 1e16).
+  static constexpr int kMaxImageSide = 20000;
+  static constexpr double kMinFocalLength = 1.0;
+  static constexpr double kMaxFocalLength = 1e6;
+  static constexpr double kMaxPrincipalPointOffset = 1e6;
+  static constexpr double kMaxDistortionCoefficient = 1e3;
+
+  // Width and height in [1, kMaxImageSide].
   static Status CheckImageSize(int width, int height);
-  // All four finite, focal lengths positive.
+  // All four finite, focal lengths and principal point in the ranges above.
   static Status CheckIntrinsics(const std::array<double, 4>& intrinsics);
-  // NumDistortionParams(model) coefficients, all finite.
+  // NumDistortionParams(model) coefficients, all finite and within the
+  // magnitude above.
   static Status CheckDistortion(LensModelId model,
                                 const std::vector<double>& distortion);
 
@@ -93,11 +108,21 @@ class Camera {
   Eigen::Matrix2d ImageFromNormalizedJacobian(
       const Eigen::Vector2d& normalized) const;
 
-  // True where the lens map is locally invertible (det of its Jacobian
-  // > 0). Beyond the radius where a radial polynomial folds back, a point
-  // would project onto a wrong pixel inside the image; projection refuses
-  // such points.
+  // True where the point lies on the lens map's principal branch: inside
+  // the radius where the radial polynomial first folds back
+  // (MaxInvertibleRadius) and where the map is locally invertible (det of
+  // its Jacobian > 0). Beyond the fold a point would project onto a wrong
+  // pixel inside the image; projection refuses such points. (The
+  // determinant alone is not enough: past a second turn of the polynomial,
+  // where the radial scale and its derivative are both negative, it is
+  // positive again; found by fuzz_camera_model.)
   bool LensInvertibleAt(const Eigen::Vector2d& normalized) const;
+
+  // The normalized radius at which the radial distortion first stops
+  // increasing (infinity when it never does: pinhole, and most real
+  // lenses within the field of view): radtan r (1 + k1 r^2 + k2 r^4),
+  // equidistant theta_d(theta) with r = tan(theta) (theta < pi/2).
+  double MaxInvertibleRadius() const { return max_invertible_radius_; }
 
   // True when the pixel lies on the sensor: [-0.5, width - 0.5] x
   // [-0.5, height - 0.5] with pixel centers at integers.
@@ -113,6 +138,8 @@ class Camera {
   int width_ = 0;
   int height_ = 0;
   std::array<double, kMaxLensParams> params_{};
+  // Derived from params_ by Create.
+  double max_invertible_radius_ = 0.0;
 };
 
 // ---------------------------------------------------------------------------

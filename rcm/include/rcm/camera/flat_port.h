@@ -83,8 +83,12 @@ class ExactFlatPort {
 
   // The normalized point (xb, yb) in air whose ray passes through `point`
   // (camera frame). Accurate to ~1e-15 relative. nullopt when the point is
-  // not beyond the outer glass face, past the critical angle, or its ray in
-  // air would not point forward (v0_z <= 0, not representable as (xb, yb)).
+  // not beyond the outer glass face, past the critical angle, its ray in
+  // air would not point forward (v0_z <= 0, not representable as (xb, yb)),
+  // or the ray grazes the port so closely that RayFromNormalized of the
+  // result, rounded, misses the glass (found by fuzz_camera_model: with an
+  // air gap of 1e-107 m, a point 80 degrees off a port tilted 15 degrees
+  // the other way was "reached" at 90 degrees to the port's normal).
   std::optional<Eigen::Vector2d> NormalizedFromPoint(
       const Eigen::Vector3d& point) const;
 

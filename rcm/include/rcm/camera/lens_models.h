@@ -180,9 +180,13 @@ struct PinholeLens : public BaseLens<PinholeLens> {
     jacobian[2] = T(0.0);
     jacobian[3] = T(1.0);
   }
+  // False for a point that is not finite, as the iterative models.
   template <typename T>
   static bool Undistort(const T* /*dist*/, const T& xd, const T& yd, T* x,
                         T* y) {
+    if (!std::isfinite(ScalarPart(xd)) || !std::isfinite(ScalarPart(yd))) {
+      return false;
+    }
     *x = xd;
     *y = yd;
     return true;
@@ -344,14 +348,63 @@ struct EquidistantLens : public BaseLens<EquidistantLens> {
     return true;
   }
 
+  static constexpr double kHalfPi = 1.5707963267948966;
+
+  // A bracket [lo, hi] of the root of theta_d = target on the rising
+  // branch that starts at 0, for a lens whose theta_d folds back below the
+  // target before pi/2 (strongly negative coefficients): theta is scanned
+  // upward in steps of pi/128 while theta_d rises; where it stops rising,
+  // the fold is found by bisection on the sign of the derivative. False
+  // when theta_d does not reach the target before the fold.
+  static bool BracketBeforeFold(const double* dist, double target, double* lo,
+                                double* hi) {
+    constexpr int kSteps = 64;
+    double previous = 0.0;
+    for (int k = 1; k <= kSteps; ++k) {
+      const double theta = kHalfPi * k / kSteps;
+      double derivative;
+      if (DistortedAngle(dist, theta, &derivative) > target &&
+          derivative > 0.0) {
+        *lo = previous;
+        *hi = theta;
+        return true;
+      }
+      if (!(derivative > 0.0)) {
+        double rising = previous;
+        double falling = theta;
+        for (int it = 0; it < 60; ++it) {
+          const double middle = 0.5 * (rising + falling);
+          DistortedAngle(dist, middle, &derivative);
+          if (derivative > 0.0) {
+            rising = middle;
+          } else {
+            falling = middle;
+          }
+        }
+        if (!(DistortedAngle(dist, rising) > target)) return false;
+        *lo = previous;
+        *hi = rising;
+        return true;
+      }
+      previous = theta;
+    }
+    return false;
+  }
+
   // The double-precision angle solve behind Undistort.
   static bool SolveTheta(const double* dist, double target, double* theta) {
-    constexpr double kHalfPi = 1.5707963267948966;
     double lo = 0.0;
     double hi = kHalfPi;
-    // The bracket holds a root only if theta_d(pi/2) exceeds the target.
-    if (!(DistortedAngle(dist, hi) > target)) return false;
+    // The bracket [0, pi/2] holds a root if theta_d(pi/2) exceeds the
+    // target; otherwise theta_d may still reach it before folding back
+    // (found by fuzz_camera_model: k1..k4 = -0.22 folds at 0.8 rad, and
+    // every pixel failed to unproject).
+    if (!(DistortedAngle(dist, hi) > target) &&
+        !BracketBeforeFold(dist, target, &lo, &hi)) {
+      return false;
+    }
     double t = std::min(target, 0.5 * (lo + hi));
+    if (!(t > lo)) t = 0.5 * (lo + hi);
     for (int it = 0; it < 200; ++it) {
       double derivative;
       const double f = DistortedAngle(dist, t, &derivative) - target;

@@ -21,6 +21,15 @@ class RefractiveCamera {
   // any liquid or glass a port looks into (2).
   static constexpr double kMinIndex = 1.0;
   static constexpr double kMaxIndex = 2.0;
+  // The largest reference depth of CreateWithPort, meters: far beyond what
+  // a camera sees under water, small enough that the bearings' arithmetic
+  // cannot overflow (found by fuzz_camera_model: 1e217 m gave the bearing
+  // (0, 0, 0)).
+  static constexpr double kMaxReferenceDepth = 1e4;
+  // How far beyond the outer glass face the reference depth must lie,
+  // meters: nearer, the central camera's arithmetic degenerates (found by
+  // fuzz_camera_model: a reference depth of 4e-217 m).
+  static constexpr double kMinReferenceDepthBeyondGlass = 1e-3;
 
   // Fails when n is not finite or outside [kMinIndex, kMaxIndex].
   static StatusOr<RefractiveCamera> Create(const Camera& camera, double n);
@@ -37,7 +46,8 @@ class RefractiveCamera {
   // delta (a few mm), about delta |1/Z' - 1/Z| times the focal length.
   // A thin port gives the camera of Create at any reference depth.
   // Errors: those of Create, an invalid port, a reference depth that is
-  // not finite or not beyond the glass (air_gap + glass_thickness).
+  // not finite, not kMinReferenceDepthBeyondGlass beyond the glass
+  // (air_gap + glass_thickness) or beyond kMaxReferenceDepth.
   static StatusOr<RefractiveCamera> CreateWithPort(const Camera& camera,
                                                    double n,
                                                    const FlatPort& port,
@@ -50,7 +60,8 @@ class RefractiveCamera {
   double n() const { return n_; }
 
   // Unit bearing in the medium (camera frame) of a raw pixel; nullopt when
-  // the lens cannot undistort it.
+  // the lens cannot undistort it or the pixel is so far outside the image
+  // that the bearing overflows.
   std::optional<Eigen::Vector3d> BearingInWaterFromImage(
       const Eigen::Vector2d& pixel) const;
 
@@ -63,7 +74,8 @@ class RefractiveCamera {
 
   // The virtual pinhole K_n = [n fx, 0, cx; 0, n fy, cy; 0, 0, 1] (eq. 9).
   Eigen::Matrix3d VirtualPinholeMatrix() const;
-  // Virtual pinhole pixel of a raw pixel (refraction and lens removed).
+  // Virtual pinhole pixel of a raw pixel (refraction and lens removed);
+  // nullopt as for BearingInWaterFromImage.
   std::optional<Eigen::Vector2d> VirtualPinholeFromImage(
       const Eigen::Vector2d& pixel) const;
   // Raw pixel of a virtual pinhole pixel: the map an image remap needs.

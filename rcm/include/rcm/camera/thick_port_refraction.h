@@ -29,6 +29,7 @@
 #include <Eigen/Core>
 #include <cmath>
 
+#include "rcm/camera/flat_port_geometry.h"
 #include "rcm/util/scalar.h"
 
 namespace rcm {
@@ -55,13 +56,19 @@ struct ThickPortRefraction {
   // The ray in the medium of the lens-undistorted normalized point
   // (xb, yb): `origin` on the outer glass face, unit `direction`.
   // `normal` is the port's unit normal. False when the ray in air does not
-  // reach the glass (N . v0 <= 0).
+  // reach the glass (N . v0 <= 0), and for an air gap outside
+  // [0, FlatPort::kMaxAirGap] (an estimated gap can be stepped there; a
+  // huge one overflows the ray's origin).
   template <typename T>
   static bool RayInMedium(const T& n, const T& air_gap,
                           const T& glass_thickness, const T& glass_index,
                           const Eigen::Vector3d& normal, const T& xb,
                           const T& yb, T origin[3], T direction[3]) {
     using std::sqrt;
+    if (!(ScalarPart(air_gap) >= 0.0 &&
+          ScalarPart(air_gap) <= FlatPort::kMaxAirGap)) {
+      return false;
+    }
     const T length = sqrt(xb * xb + yb * yb + T(1.0));
     const T v0[3] = {xb / length, yb / length, T(1.0) / length};
     const T c0 = T(normal.x()) * v0[0] + T(normal.y()) * v0[1] +

@@ -43,8 +43,8 @@ T LocusTangentAngle(const T& n, const T& xl, const T& yl) {
 double LocusTangentSeparation(double n0, double dn, double xl, double yl);
 
 // sigma_n above for the correspondence at refractive index n. nullopt when
-// a pixel cannot be undistorted or de/dn vanishes (n unobservable from
-// this correspondence).
+// a pixel cannot be undistorted, de/dn vanishes (n unobservable from this
+// correspondence) or sigma_px is negative or not finite.
 std::optional<double> FirstOrderSigmaN(const StereoRig& rig,
                                        const StereoCorrespondence& match,
                                        double n, double sigma_px);

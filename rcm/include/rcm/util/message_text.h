@@ -23,6 +23,11 @@ namespace rcm {
 // How many bytes of a value a message shows before "...".
 inline constexpr size_t kMaxMessageTextLength = 40;
 
+// `text` with its control characters written as \xNN, whole: for text
+// that a message shows in full, such as a parser library's own description
+// of an error ("unknown escape character: \x0a").
+std::string EscapeControlCharacters(std::string_view text);
+
 // `text` made fit for a one-line message, without quotes:
 // "a\tb" -> "a\x09b". For values whose spelling is already known to be
 // plain (such as a number that parsed), where quotes would be noise.
