@@ -1,10 +1,13 @@
 // rcm calibrate: air stereo calibration from images of a target.
 #include <gflags/gflags.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -155,16 +158,57 @@ std::string WithSigma(double value, double sigma, int digits,
   return text;
 }
 
-// The detection pass over every pair.
+// Whether `folder` exists as a folder or can be created: its nearest
+// existing ancestor must be a folder we may write in. Creates nothing, so
+// that a run that fails later leaves no empty folders.
+Status CheckFolderCanBeCreated(const std::string& folder) {
+  namespace fs = std::filesystem;
+  fs::path existing = fs::path(folder).lexically_normal();
+  std::error_code error;
+  while (!existing.empty() && !fs::exists(existing, error)) {
+    existing = existing.parent_path();
+  }
+  if (existing.empty()) existing = ".";
+  if (!fs::is_directory(existing, error)) {
+    return Status::Error("cannot create folder " + folder + ": " +
+                         existing.string() + " is not a folder");
+  }
+  if (access(existing.c_str(), W_OK | X_OK) != 0) {
+    return Status::Error("cannot create folder " + folder + ": " +
+                         existing.string() + ": " + std::strerror(errno));
+  }
+  return Status::Ok();
+}
+
+// The outputs before the detection: a calibration is not wasted on a
+// camchain or report that cannot be written.
+Status CheckOutputPaths(const OutputPaths& paths) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  if (fs::is_directory(paths.camchain, error)) {
+    return Status::Error(paths.camchain +
+                         ": is a folder, expected the camchain file to write");
+  }
+  const std::string camchain_folder =
+      fs::path(paths.camchain).parent_path().string();
+  if (!camchain_folder.empty()) {
+    RCM_RETURN_IF_ERROR(CheckFolderCanBeCreated(camchain_folder));
+  }
+  return CheckFolderCanBeCreated(paths.report);
+}
+
+// The detection pass over every pair. Its warnings wait until the pass is
+// over, so that a run that fails says one thing, its error.
 struct Detections {
   std::vector<StereoView> views;
   std::optional<ImageSize> sizes[2];
   int unreadable = 0;
+  std::string first_unreadable;  // why the first unreadable pair was skipped
+  std::vector<std::string> warnings;
 };
 
 StatusOr<Detections> DetectAll(StereoImageSource* source,
-                               const CalibrationTarget& target,
-                               const Subcommand& command) {
+                               const CalibrationTarget& target) {
   Detections detections;
   const size_t pairs = source->NumPairs();
   Progress progress("rcm calibrate: detecting, pair", pairs);
@@ -173,8 +217,10 @@ StatusOr<Detections> DetectAll(StereoImageSource* source,
     StatusOr<StereoImagePair> pair = source->ReadPair(i);
     if (!pair.ok()) {
       // One unreadable image loses its pair, never the pairing of others.
-      PrintWarning(command, pair.status().message() + "; pair skipped");
-      ++detections.unreadable;
+      detections.warnings.push_back(pair.status().message() + "; pair skipped");
+      if (detections.unreadable++ == 0) {
+        detections.first_unreadable = pair.status().message();
+      }
       progress.Update(i + 1);
       continue;
     }
@@ -200,8 +246,8 @@ StatusOr<Detections> DetectAll(StereoImageSource* source,
     view.right_name = pair->right_name;
     view.timestamp = pair->timestamp.value_or(0.0);
     if (!view.note.empty()) {
-      PrintWarning(command, pair->left_name + " and " + pair->right_name +
-                                ": " + view.note);
+      detections.warnings.push_back(pair->left_name + " and " +
+                                    pair->right_name + ": " + view.note);
     }
     found += view.stereo() ? 1 : 0;
     detections.views.push_back(std::move(view));
@@ -286,12 +332,17 @@ int RunCalibrate() {
     PrintError(command, (*source)->Describe() + ": no image pairs");
     return kExitFailure;
   }
+  if (const Status status = CheckOutputPaths(paths); !status.ok()) {
+    PrintError(command, status.message());
+    return kExitFailure;
+  }
+  // What is being calibrated, with the report on stdout; stderr keeps to
+  // warnings and the error.
   if (!FLAGS_json) {
-    std::cerr << "rcm calibrate: " << (*source)->Describe() << ", "
-              << (*source)->NumPairs() << " pairs; target "
+    std::cout << "rcm calibrate: " << (*source)->Describe() << "; target "
               << calib::DescribeTarget(*target) << std::endl;
   }
-  StatusOr<Detections> detections = DetectAll(source->get(), *target, command);
+  StatusOr<Detections> detections = DetectAll(source->get(), *target);
   if (!detections.ok()) {
     PrintError(command, detections.status().message());
     return kExitFailure;
@@ -306,7 +357,12 @@ int RunCalibrate() {
     right_only += view.right && !view.left ? 1 : 0;
   }
   if (!detections->sizes[0] || !detections->sizes[1]) {
-    PrintError(command, "no pair could be read");
+    const int more = detections->unreadable - 1;
+    PrintError(command,
+               "no pair could be read: " + detections->first_unreadable +
+                   (more > 0 ? " (and " + std::to_string(more) + " more " +
+                                   (more == 1 ? "pair)" : "pairs)")
+                             : ""));
     return kExitFailure;
   }
   if (stereo == 0) {
@@ -318,6 +374,9 @@ int RunCalibrate() {
     return kExitFailure;
   }
   const ImageSize sizes[2] = {*detections->sizes[0], *detections->sizes[1]};
+  for (const std::string& warning : detections->warnings) {
+    PrintWarning(command, warning);
+  }
 
   Progress solving("rcm calibrate: bundle adjustment", 2);
   solving.Update(1);

@@ -231,18 +231,18 @@ cv::Mat PlotNPerFrame(const std::vector<FrameResult>& frames,
 int RunDemo() {
   const Subcommand& command = kDemoCommand;
   const auto start = Clock::now();
+  // The flags before the folder: a wrong flag leaves nothing behind.
+  StatusOr<Simulation> simulation = SimulationFromFlags("");
+  if (!simulation.ok()) {
+    PrintError(command, simulation.status().message());
+    return kExitFailure;
+  }
   const std::string folder = FLAGS_out.empty() ? kDefaultFolder : FLAGS_out;
   std::error_code error;
   std::filesystem::create_directories(folder, error);
   if (error) {
     PrintError(command,
                "cannot create folder " + folder + ": " + error.message());
-    return kExitFailure;
-  }
-
-  StatusOr<Simulation> simulation = SimulationFromFlags("");
-  if (!simulation.ok()) {
-    PrintError(command, simulation.status().message());
     return kExitFailure;
   }
   const StereoRig& rig = simulation.value().rig;

@@ -304,6 +304,8 @@ StatusOr<StereoFrontEndOptions> FrontEndOptionsFromFlags() {
                          FLAGS_search_range + "'");
   }
   options.search_range = {low, high};
+  RCM_RETURN_IF_ERROR(options.search_range.Check().WithContext(
+      "--search-range " + FLAGS_search_range));
   RCM_RETURN_IF_ERROR(options.Check());
   return options;
 }

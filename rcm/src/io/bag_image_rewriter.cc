@@ -12,9 +12,11 @@
 #include <map>
 #include <memory>
 #include <set>
+#include <string_view>
 #include <system_error>
 #include <utility>
 
+#include "rcm/io/image_file.h"
 #include "rcm/util/message_text.h"
 #include "ros_image_message.h"
 
@@ -106,6 +108,13 @@ StatusOr<cv::Mat> Decode(const sensor_msgs::Image& message) {
 }
 
 StatusOr<cv::Mat> Decode(const sensor_msgs::CompressedImage& message) {
+  // A cut or damaged PNG or JPEG is refused before it is decoded: libpng and
+  // libjpeg would print their own warnings.
+  RCM_RETURN_IF_ERROR(
+      CheckImageFileStructure(
+          std::string_view(reinterpret_cast<const char*>(message.data.data()),
+                           message.data.size()))
+          .WithContext("compressed image"));
   StatusOr<cv::Mat> image = DecodeCompressedImage(message);
   if (!image.ok()) return image;
   RCM_RETURN_IF_ERROR(CompressedFormat(message).status());

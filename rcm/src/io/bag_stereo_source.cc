@@ -9,9 +9,11 @@
 #include <cmath>
 #include <exception>
 #include <numeric>
+#include <string_view>
 #include <utility>
 #include <vector>
 
+#include "rcm/io/image_file.h"
 #include "rcm/io/number_format.h"
 #include "ros_image_message.h"
 
@@ -191,6 +193,18 @@ class BagStereoSource final : public StereoImageSource {
     return StampedName(topic, stamp_s);
   }
 
+  // A cut or damaged PNG or JPEG is refused before it is decoded: libpng
+  // and libjpeg would print their own warnings.
+  static StatusOr<cv::Mat> DecodeCompressed(
+      const sensor_msgs::CompressedImage& message) {
+    RCM_RETURN_IF_ERROR(
+        CheckImageFileStructure(
+            std::string_view(reinterpret_cast<const char*>(message.data.data()),
+                             message.data.size()))
+            .WithContext("compressed image"));
+    return DecodeCompressedImage(message);
+  }
+
   StatusOr<cv::Mat> Decode(const rosbag::MessageInstance& message,
                            const std::string& name) const {
     // Opening read every message as its type; a null message here would
@@ -204,7 +218,7 @@ class BagStereoSource final : public StereoImageSource {
       } else {
         const auto decoded =
             message.instantiate<sensor_msgs::CompressedImage>();
-        if (decoded != nullptr) image = DecodeCompressedImage(*decoded);
+        if (decoded != nullptr) image = DecodeCompressed(*decoded);
       }
     } catch (const std::exception& error) {
       return Status::Error(path_ + ": " + name +

@@ -6,6 +6,7 @@
 
 #include <opencv2/core.hpp>
 #include <string>
+#include <string_view>
 
 #include "rcm/util/status.h"
 
@@ -18,10 +19,38 @@ namespace rcm {
 // cannot hold.
 Status WritePng(const cv::Mat& image, const std::string& path);
 
+// Checks the bytes of a PNG or a JPEG file before they are decoded: libpng
+// and libjpeg print their own warnings on stderr for a cut or damaged file,
+// and libjpeg decodes a cut or damaged JPEG without an error (the missing
+// rows gray, the damaged ones garbled). A PNG must have its IHDR chunk
+// first with values libpng reads (at most 1000000 pixels wide and high),
+// every chunk whole with a matching CRC, a PLTE chunk before the IDAT
+// chunks of a palette image, its IDAT chunks one after the other, no
+// unknown critical chunk and the IEND chunk; the data of its IDAT chunks
+// must be one zlib stream, whole (Adler-32 checked), that inflates to
+// exactly the bytes the header implies (inflated through a small buffer,
+// not kept). A JPEG must have its markers and segments in order, at least
+// one scan and the end-of-image marker (EOI), and libjpeg must read it
+// (markers and the entropy-coded data of every scan, no inverse DCT)
+// without an error or a warning, printing nothing. What follows IEND or
+// EOI is ignored. Bytes that start as neither are not checked (OK).
+// Errors, without context: "truncated PNG (the file ends inside chunk IDAT
+// at byte 40960)", "corrupt PNG (chunk IDAT at byte 33: CRC mismatch)",
+// "corrupt PNG (IDAT data: incorrect data check)" (zlib's message),
+// "corrupt PNG (IDAT data holds 8190 bytes, the header implies 8192)",
+// "truncated JPEG (the file ends inside the scan of marker 0xDA at byte
+// 318, before its end-of-image marker)", "corrupt JPEG (marker 0x7A at
+// byte 2 is not a JPEG marker)", "corrupt JPEG (libjpeg: 9695 extraneous
+// bytes before marker 0xd9)" (libjpeg's message). Images of more than
+// 2^30 pixels, which OpenCV refuses to decode, get the structure check
+// only.
+Status CheckImageFileStructure(std::string_view bytes);
+
 // Reads an image file in any format OpenCV decodes (PNG, JPEG, PPM, ...) as
 // 8-bit: CV_8UC1 when `grayscale`, else CV_8UC3 BGR. Errors: "PATH: cannot
-// open: <reason>", "PATH: is a directory, expected a file", "PATH: not an
-// image OpenCV can decode (corrupt or unsupported format)".
+// open: <reason>", "PATH: is a directory, expected a file", "PATH: " and
+// CheckImageFileStructure's error, "PATH: not an image OpenCV can decode
+// (corrupt or unsupported format)".
 StatusOr<cv::Mat> ReadImage(const std::string& path, bool grayscale);
 
 // The same, with the depth and channels as stored (cv::IMREAD_UNCHANGED):
