@@ -15,6 +15,7 @@ packages=(
   libyaml-cpp-dev      # Kalibr camchain / ROS camera_info YAML
   nlohmann-json3-dev   # --json output
   libopencv-dev        # images: PNG/JPEG I/O, remap, drawing plots, SIFT
+  zlib1g-dev libjpeg-dev  # silent integrity checks of PNG/JPEG data before decoding
   libopencv-contrib-dev  # aruco: AprilTag 36h11 and ChArUco targets
   opencv-doc           # the real stereo chessboard images a calibration test uses
   libgtest-dev libgmock-dev  # tests
@@ -22,6 +23,8 @@ packages=(
   librosbag-storage-dev libsensor-msgs-dev  # ROS1 bags: rcm estimate/undistort --bag
   pluginlib-dev libclass-loader-dev librcpputils-dev librcutils-dev \
     libament-index-cpp-dev  # ROS 2 headers that rosbag's headers include
+  clang-14 libclang-rt-14-dev  # sanitizer build and libFuzzer (test_sanitizers.sh)
+  llvm-14              # llvm-symbolizer: source lines in sanitizer reports
 )
 
 missing=()
