@@ -76,6 +76,23 @@ TEST(FlatPort, CheckRejectsImpossiblePorts) {
   EXPECT_TRUE(ExactFlatPort::Create(FlatPort(), 1.0).ok());
 }
 
+// Found by fuzz_camera_model: a 2.8e-82 m air gap made the virtual pinhole
+// round trip fail. Layers are 0 or at least a micron.
+TEST(FlatPort, CheckRejectsLayersThinnerThanAMicron) {
+  FlatPort port;
+  port.air_gap = 2.8e-82;
+  EXPECT_EQ(port.Check().message(),
+            "port air_gap = 2.8e-82 m is neither 0 nor at least 1e-06");
+  port.air_gap = FlatPort::kMinLayerThickness;
+  EXPECT_TRUE(port.Check().ok());
+  port = FlatPort();
+  port.glass_thickness = 5e-7;
+  EXPECT_EQ(port.Check().message(),
+            "port glass_thickness = 5e-07 m is neither 0 nor at least 1e-06");
+  port.glass_thickness = FlatPort::kMinLayerThickness;
+  EXPECT_TRUE(port.Check().ok());
+}
+
 TEST(FlatPort, TiltedNormalIsUnitAndTilted) {
   const Eigen::Vector3d normal = TiltedPortNormal(0.1, 0.3);
   EXPECT_NEAR(normal.norm(), 1.0, 1e-15);
@@ -228,13 +245,17 @@ TEST(ExactFlatPort, InvisiblePointsHaveNoProjection) {
       Eigen::Vector3d(std::sin(inside), 0.0, std::cos(inside))));
 }
 
-// Found by fuzz_camera_model: with an air gap of 1e-107 m the air leg is
-// unbounded, so a point 80 degrees off a port tilted 15 degrees the other
-// way is "reached" by a ray at 90 degrees to the normal, which does not
-// reach the glass when traced forward. Such a point is not visible.
-TEST(ExactFlatPort, GrazingSolutionIsNotVisible) {
+// Found by fuzz_camera_model: with an air gap of 8.7e-107 m (refused since,
+// see CheckRejectsLayersThinnerThanAMicron) the air leg was unbounded, so a
+// point 80 degrees off a port tilted 15 degrees the other way was "reached"
+// by a ray at 90 degrees to the normal, which did not reach the glass when
+// traced forward. With the thinnest accepted gap that point is seen by a
+// nearly grazing ray, which must trace forward to it. The solve is accurate
+// to ~1e-9 relative (3e-8 m at 27 m, measured): 1e-6 m bounds it.
+TEST(ExactFlatPort, NearlyGrazingSolutionTracesForwardToThePoint) {
+  constexpr double kMissTolerance = 1e-6;  // meters
   FlatPort port;
-  port.air_gap = 8.68097232975773e-107;
+  port.air_gap = FlatPort::kMinLayerThickness;
   port.glass_thickness = 0.077686274509803935;
   port.glass_index = 1.0333305969827433;
   port.normal =
@@ -242,12 +263,23 @@ TEST(ExactFlatPort, GrazingSolutionIsNotVisible) {
                       0.9999999013601566);
   const ExactFlatPort exact =
       ExactFlatPort::Create(port, 1.8490196078431373).value();
-  EXPECT_FALSE(exact.NormalizedFromPoint(Eigen::Vector3d(
-      -26.970280264941159, -1.8414600739130327, 8.5757061839103699)));
-  const std::optional<Eigen::Vector2d> visible =
-      exact.NormalizedFromPoint(Eigen::Vector3d(-2.0, -1.84, 8.576));
-  ASSERT_TRUE(visible.has_value());
-  EXPECT_TRUE(exact.RayFromNormalized(*visible).has_value());
+  for (const Eigen::Vector3d& point :
+       {Eigen::Vector3d(-26.970280264941159, -1.8414600739130327,
+                        8.5757061839103699),
+        Eigen::Vector3d(-2.0, -1.84, 8.576)}) {
+    const std::optional<Eigen::Vector2d> visible =
+        exact.NormalizedFromPoint(point);
+    ASSERT_TRUE(visible.has_value()) << point.transpose();
+    const std::optional<RayInMedium> ray = exact.RayFromNormalized(*visible);
+    ASSERT_TRUE(ray.has_value()) << point.transpose();
+    const Eigen::Vector3d to_point = point - ray->origin;
+    EXPECT_LT((to_point - to_point.dot(ray->direction) * ray->direction).norm(),
+              kMissTolerance)
+        << point.transpose();
+  }
+  // 100 m off to the side is past the grazing limit: not visible.
+  EXPECT_FALSE(exact.NormalizedFromPoint(
+      Eigen::Vector3d(-100.0, -1.8414600739130327, 8.5757061839103699)));
 }
 
 TEST(FlatPortCamera, PixelRoundTripThroughTheLens) {

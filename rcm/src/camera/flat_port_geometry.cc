@@ -14,10 +14,16 @@ Status FlatPort::Check() const {
   if (!std::isfinite(air_gap) || air_gap < 0.0 || air_gap > kMaxAirGap) {
     message << "port air_gap = " << air_gap << " m is outside [0, "
             << kMaxAirGap << "]";
+  } else if (air_gap > 0.0 && air_gap < kMinLayerThickness) {
+    message << "port air_gap = " << air_gap << " m is neither 0 nor at least "
+            << kMinLayerThickness;
   } else if (!std::isfinite(glass_thickness) || glass_thickness < 0.0 ||
              glass_thickness > kMaxGlassThickness) {
     message << "port glass_thickness = " << glass_thickness
             << " m is outside [0, " << kMaxGlassThickness << "]";
+  } else if (glass_thickness > 0.0 && glass_thickness < kMinLayerThickness) {
+    message << "port glass_thickness = " << glass_thickness
+            << " m is neither 0 nor at least " << kMinLayerThickness;
   } else if (!std::isfinite(glass_index) || glass_index < 1.0 ||
              glass_index > kMaxIndex) {
     message << "port glass_index = " << glass_index << " is outside [1, "

@@ -28,16 +28,24 @@ struct FlatPort {
   static constexpr double kMaxAirGap = 0.5;          // meters
   static constexpr double kMaxGlassThickness = 0.1;  // meters
   static constexpr double kMaxTiltDegrees = 30.0;
+  // Smallest nonzero air gap or glass thickness. Below it a layer is not a
+  // housing but rounding: a ray through a gap of 1e-80 m leaves it at a
+  // grazing angle the solvers cannot tell from a miss, so the port's round
+  // trip fails (a fuzzing finding). Thinner layers must be given as 0.
+  static constexpr double kMinLayerThickness = 1e-6;  // meters
 
-  double air_gap = 0.0;          // d, meters, camera center to the glass, >= 0
-  double glass_thickness = 0.0;  // tg, meters, >= 0
+  // d, meters, camera center to the glass: 0 or in [1e-6, 0.5].
+  double air_gap = 0.0;
+  // tg, meters: 0 or in [1e-6, 0.1].
+  double glass_thickness = 0.0;
   double glass_index = 1.49;     // n_glass (acrylic; BK7 is 1.517), [1, 2]
   // Port normal in the camera frame; normalized by Check's caller. Must be
   // finite, nonzero and within 30 degrees of the optical axis.
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
 
   // Errors name the offending field: "port air_gap = 8 m is outside
-  // [0, 0.5]", ...
+  // [0, 0.5]", "port air_gap = 1e-09 m is neither 0 nor at least 1e-06",
+  // ...
   Status Check() const;
   // True for the paper's thin port (d = tg = 0, normal = +z exactly).
   bool IsThin() const;
