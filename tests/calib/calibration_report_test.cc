@@ -602,11 +602,14 @@ Synthetic RealisticCalibration() {
       Eigen::Matrix<double, 8, 8>::Zero(), Eigen::Matrix<double, 8, 8>::Zero()};
   for (int v = 0; v < kViews; ++v) {
     const double depth = 0.45 + 0.35 * (0.5 + 0.5 * uniform(rng));
-    const Eigen::Vector3d center(0.9 * depth * uniform(rng),
-                                 0.6 * depth * uniform(rng), depth);
+    // Draws in statements of their own, last coordinate first (gcc's
+    // order): argument evaluation order is unspecified.
+    const double center_y = 0.6 * depth * uniform(rng);
+    const Eigen::Vector3d center(0.9 * depth * uniform(rng), center_y, depth);
+    const double axis_z = 0.3 * uniform(rng);
+    const double axis_y = uniform(rng);
     const Eigen::Vector3d axis =
-        Eigen::Vector3d(uniform(rng), uniform(rng), 0.3 * uniform(rng))
-            .normalized();
+        Eigen::Vector3d(uniform(rng), axis_y, axis_z).normalized();
     Rigid3d pose;
     pose.rotation = Eigen::AngleAxisd(0.6 * uniform(rng), axis).matrix();
     pose.translation =
@@ -633,7 +636,8 @@ Synthetic RealisticCalibration() {
           corner.point_id = row * 7 + col;
           corner.pixel = *pixel;
           const double scale = (v == 11 && c == 0) ? 12.0 : 1.0;
-          corner.residual = scale * Eigen::Vector2d(noise(rng), noise(rng));
+          const double noise_y = noise(rng);  // before x, as above
+          corner.residual = scale * Eigen::Vector2d(noise(rng), noise_y);
           if (c == 1) {
             const Eigen::Vector2d offset =
                 *pixel - Eigen::Vector2d(cameras[c].cx(), cameras[c].cy());

@@ -45,13 +45,15 @@ inline std::vector<Rigid3d> BoardPoses(const Camera& camera,
         min_depth + (max_depth - min_depth) * 0.5 * (1.0 + unit(rng));
     const double deg = M_PI / 180.0;
     Rigid3d pose;
-    pose.rotation =
-        (Eigen::AngleAxisd(30.0 * deg * unit(rng), Eigen::Vector3d::UnitZ()) *
-         Eigen::AngleAxisd(max_tilt_deg * deg * unit(rng),
-                           Eigen::Vector3d::UnitY()) *
-         Eigen::AngleAxisd(max_tilt_deg * deg * unit(rng),
-                           Eigen::Vector3d::UnitX()))
-            .toRotationMatrix();
+    // Draws in statements of their own, last factor first (gcc's order):
+    // the operands' evaluation order is unspecified.
+    const double roll = max_tilt_deg * deg * unit(rng);
+    const double pitch = max_tilt_deg * deg * unit(rng);
+    const double yaw = 30.0 * deg * unit(rng);
+    pose.rotation = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+                     Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                     Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+                        .toRotationMatrix();
     pose.translation =
         depth * Eigen::Vector3d(normalized.x(), normalized.y(), 1.0) -
         pose.rotation * center;
@@ -78,7 +80,8 @@ inline std::optional<TargetObservation> ObserveTarget(
     if (!pixel || !camera.InImage(*pixel)) continue;
     Eigen::Vector2d measured = *pixel;
     if (noise_px > 0.0) {
-      measured += noise_px * Eigen::Vector2d(noise(*rng), noise(*rng));
+      const double noise_y = noise(*rng);  // before x, as above
+      measured += noise_px * Eigen::Vector2d(noise(*rng), noise_y);
     }
     observation.point_ids.push_back(id);
     observation.pixels.push_back(measured);

@@ -196,7 +196,11 @@ std::vector<Eigen::Vector2d> JacobianTestPoints() {
       {0.7, -0.45}, {-1.1, -0.8},  {2.0, 1.5},   {-30.0, 12.0}};
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> uniform(-1.5, 1.5);
-  for (int i = 0; i < 50; ++i) points.emplace_back(uniform(rng), uniform(rng));
+  for (int i = 0; i < 50; ++i) {
+    // y before x, in a statement of its own (argument order is unspecified).
+    const double y = uniform(rng);
+    points.emplace_back(uniform(rng), y);
+  }
   return points;
 }
 

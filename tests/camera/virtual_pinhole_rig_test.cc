@@ -65,8 +65,10 @@ std::vector<Eigen::Vector3d> WaterPoints(const StereoRig& rig, int count,
   std::uniform_real_distribution<double> depth(0.6, 6.0);
   std::vector<Eigen::Vector3d> points;
   while (static_cast<int>(points.size()) < count) {
+    // v before u, in a statement of its own (argument order is unspecified).
+    const double drawn_v = v(random);
     const std::optional<Eigen::Vector3d> bearing =
-        left.BearingInWaterFromImage(Eigen::Vector2d(u(random), v(random)));
+        left.BearingInWaterFromImage(Eigen::Vector2d(u(random), drawn_v));
     if (!bearing) continue;
     const Eigen::Vector3d point = *bearing / bearing->z() * depth(random);
     const std::optional<Eigen::Vector2d> seen =
@@ -739,7 +741,8 @@ TEST(VirtualPinholeRig, ThickPortIsExactAtTheReferenceDepth) {
   double worst_at_reference = 0.0;
   double worst_near = 0.0;
   for (int i = 0; i < 200; ++i) {
-    const Eigen::Vector2d xy(lateral(random), 0.7 * lateral(random));
+    const double y = 0.7 * lateral(random);  // before x, as above
+    const Eigen::Vector2d xy(lateral(random), y);
     for (const double depth : {2.0, 0.7}) {
       const Eigen::Vector3d point(xy.x() * depth / 2.0, xy.y() * depth / 2.0,
                                   depth);

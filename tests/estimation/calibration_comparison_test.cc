@@ -44,7 +44,12 @@ std::vector<PixelRay> Observations(const Camera& camera, double n,
         refractive.BearingInWaterFromImage(pixel);
     if (!ray.has_value() || !((*ray)[2] > 0.0)) continue;
     Eigen::Vector2d observed = pixel;
-    if (sigma_px > 0.0) observed += Eigen::Vector2d(noise(random), noise(random));
+    if (sigma_px > 0.0) {
+      // y before x, in a statement of its own (argument order is
+      // unspecified).
+      const double noise_y = noise(random);
+      observed += Eigen::Vector2d(noise(random), noise_y);
+    }
     samples.push_back({observed, *ray});
   }
   return samples;

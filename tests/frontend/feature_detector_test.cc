@@ -16,10 +16,15 @@ cv::Mat Blobs(int width, int height, int count, uint64_t seed) {
   cv::RNG rng(seed);
   cv::Mat image(height, width, CV_8UC1, cv::Scalar(128));
   for (int i = 0; i < count; ++i) {
-    const cv::Point center(rng.uniform(0, width), rng.uniform(0, height));
-    const cv::Size axes(rng.uniform(2, 9), rng.uniform(2, 9));
+    // Each draw in a statement of its own, last argument first (gcc's
+    // order): argument evaluation order is unspecified.
+    const int center_y = rng.uniform(0, height);
+    const cv::Point center(rng.uniform(0, width), center_y);
+    const int axis_y = rng.uniform(2, 9);
+    const cv::Size axes(rng.uniform(2, 9), axis_y);
+    const int gray = rng.uniform(0, 256);
     cv::ellipse(image, center, axes, rng.uniform(0.0, 180.0), 0.0, 360.0,
-                cv::Scalar(rng.uniform(0, 256)), cv::FILLED, cv::LINE_AA);
+                cv::Scalar(gray), cv::FILLED, cv::LINE_AA);
   }
   cv::GaussianBlur(image, image, cv::Size(0, 0), 1.0);
   return image;

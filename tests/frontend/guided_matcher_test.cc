@@ -39,8 +39,10 @@ std::vector<ExactPair> ExactPairs(const StereoRig& rig, int count,
   std::uniform_real_distribution<double> depth(0.6, 6.0);
   std::vector<ExactPair> pairs;
   while (static_cast<int>(pairs.size()) < count) {
+    // v before u, in a statement of its own (argument order is unspecified).
+    const double drawn_v = v(rng);
     const Eigen::Vector3d bearing =
-        left.BearingInWaterFromImage(Eigen::Vector2d(u(rng), v(rng))).value();
+        left.BearingInWaterFromImage(Eigen::Vector2d(u(rng), drawn_v)).value();
     ExactPair pair;
     pair.point = bearing * (depth(rng) / bearing.z());
     const std::optional<Eigen::Vector2d> right_pixel =
@@ -162,7 +164,8 @@ DistractorScene MakeDistractorScene(const StereoRig& rig, const LocusBand& band,
   for (int i = 0; i < count; ++i) {
     const LocusKey left_key = band.LeftKey(pairs[i].left);
     for (int added = 0; added < distractors;) {
-      const Eigen::Vector2d pixel(u(pixel_rng), v(pixel_rng));
+      const double drawn_v = v(pixel_rng);  // before u, as above
+      const Eigen::Vector2d pixel(u(pixel_rng), drawn_v);
       if (band.Contains(left_key, band.RightKey(pixel))) continue;
       right_pixels.push_back(pixel);
       right_descriptors.push_back(descriptors.row(i));
@@ -418,9 +421,11 @@ TEST(GuidedMatcher, SameMatchesOnAnyNumberOfThreads) {
     right_descriptors.push_back(FlipBits(descriptor, 0, bits(random), i));
   }
   for (int i = 0; i < 400; ++i) {
-    left_pixels.emplace_back(u(random), v(random));
+    const double left_v = v(random);  // before u, as above
+    left_pixels.emplace_back(u(random), left_v);
     left_descriptors.push_back(RandomBinaryDescriptors(1, &rng));
-    right_pixels.emplace_back(u(random), v(random));
+    const double right_v = v(random);
+    right_pixels.emplace_back(u(random), right_v);
     right_descriptors.push_back(RandomBinaryDescriptors(1, &rng));
   }
   left_pixels.push_back(

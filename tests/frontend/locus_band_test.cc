@@ -43,7 +43,9 @@ std::vector<ExactPair> ExactPairs(
   for (int attempt = 0;
        attempt < 100 * count && static_cast<int>(pairs.size()) < count;
        ++attempt) {
-    const Eigen::Vector2d pixel(u(rng), v(rng));
+    // v before u, in a statement of its own (argument order is unspecified).
+    const double drawn_v = v(rng);
+    const Eigen::Vector2d pixel(u(rng), drawn_v);
     const double z = depth(rng);
     if (std::abs(pixel.x() - rig.left().cx()) < min_offset.x() ||
         std::abs(pixel.y() - rig.left().cy()) < min_offset.y()) {

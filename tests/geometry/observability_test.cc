@@ -107,8 +107,12 @@ TEST(Observability, FirstOrderSigmaIsHonest) {
     double sum = 0.0, sum_squares = 0.0;
     for (int trial = 0; trial < kTrials; ++trial) {
       StereoCorrespondence noisy = c;
-      noisy.left_pixel += Eigen::Vector2d(noise(rng), noise(rng));
-      noisy.right_pixel += Eigen::Vector2d(noise(rng), noise(rng));
+      // Each y before its x, in statements of their own (argument order is
+      // unspecified).
+      const double left_y = noise(rng);
+      noisy.left_pixel += Eigen::Vector2d(noise(rng), left_y);
+      const double right_y = noise(rng);
+      noisy.right_pixel += Eigen::Vector2d(noise(rng), right_y);
       const double estimate = ClosedFormN(rig.Normalize(noisy).value()).value();
       sum += estimate;
       sum_squares += estimate * estimate;

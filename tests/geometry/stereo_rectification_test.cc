@@ -44,8 +44,10 @@ TEST(StereoRectification, RectifiedViewsAreTheIdealPair) {
   std::uniform_real_distribution<double> lateral(-2.0, 2.0);
   std::uniform_real_distribution<double> depth(0.5, 6.0);
   for (int i = 0; i < 100; ++i) {
-    const Eigen::Vector3d point_in_left(lateral(rng), lateral(rng),
-                                        depth(rng));
+    // z, y, x, in statements of their own (argument order is unspecified).
+    const double z = depth(rng);
+    const double y = lateral(rng);
+    const Eigen::Vector3d point_in_left(lateral(rng), y, z);
     const Eigen::Vector3d in_left_view =
         rectification.left_camera_from_rect.transpose() * point_in_left;
     const Eigen::Vector3d in_right_view =

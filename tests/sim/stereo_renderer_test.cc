@@ -353,7 +353,9 @@ TEST(StereoRenderer, LeftAndRightPatchesAgreeThroughThePorts) {
   std::uniform_int_distribution<int> v(kHalf, 539 - kHalf);
   int tested = 0, agreeing = 0;
   while (tested < 200) {
-    const Eigen::Vector2d left_pixel(u(rng), v(rng));
+    // v before u, in a statement of its own (argument order is unspecified).
+    const double drawn_v = v(rng);
+    const Eigen::Vector2d left_pixel(u(rng), drawn_v);
     const RayInMedium ray = left.RayFromImage(left_pixel).value();
     const SurfaceHit hit =
         Pool()

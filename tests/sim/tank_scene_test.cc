@@ -148,11 +148,14 @@ TEST(TankScene, RandomRaysFromInsideEndOnTheBoundary) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::normal_distribution<double> gaussian;
   for (int i = 0; i < 2000; ++i) {
-    const Eigen::Vector3d origin(12.0 * unit(rng), 8.0 * unit(rng),
-                                 3.0 * unit(rng));
+    // z, y, x, in statements of their own (argument order is unspecified).
+    const double origin_z = 3.0 * unit(rng);
+    const double origin_y = 8.0 * unit(rng);
+    const Eigen::Vector3d origin(12.0 * unit(rng), origin_y, origin_z);
+    const double direction_z = gaussian(rng);
+    const double direction_y = gaussian(rng);
     const Eigen::Vector3d direction =
-        Eigen::Vector3d(gaussian(rng), gaussian(rng), gaussian(rng))
-            .normalized();
+        Eigen::Vector3d(gaussian(rng), direction_y, direction_z).normalized();
     const std::optional<SurfaceHit> hit = scene.Intersect(origin, direction);
     ASSERT_TRUE(hit.has_value());
     EXPECT_TRUE(scene.Contains(hit->point));
@@ -225,7 +228,8 @@ std::vector<SurfaceHit> FloorHits(const TankScene& scene, int count,
   std::uniform_real_distribution<double> y(0.0, scene.width());
   std::vector<SurfaceHit> hits;
   for (int i = 0; i < count; ++i) {
-    hits.push_back(*scene.Intersect(Eigen::Vector3d(x(rng), y(rng), 1.0),
+    const double drawn_y = y(rng);  // before x, as above
+    hits.push_back(*scene.Intersect(Eigen::Vector3d(x(rng), drawn_y, 1.0),
                                     Eigen::Vector3d(0.0, 0.0, -1.0)));
   }
   return hits;

@@ -127,7 +127,11 @@ std::vector<StereoCorrespondence> SequenceSimulator::SampleMatches(int index,
                          static_cast<int>(matches.size()) <
                              options_.matches_per_frame;
        ++draw) {
-    const Eigen::Vector2d left_pixel(u(rng), v(rng));
+    // v before u, in a statement of its own: arguments are evaluated in an
+    // unspecified order (gcc right to left, clang left to right), and seeded
+    // data must not depend on the compiler. gcc's order, as always.
+    const double drawn_v = v(rng);
+    const Eigen::Vector2d left_pixel(u(rng), drawn_v);
     const std::optional<RayInMedium> left_ray = left.RayFromImage(left_pixel);
     if (!left_ray) continue;
     const std::optional<SurfaceHit> hit =

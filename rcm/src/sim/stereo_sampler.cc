@@ -70,7 +70,12 @@ StatusOr<std::vector<StereoCorrespondence>> SampleWithTracer(
                 << options.min_depth << ", " << options.max_depth << "] m?";
         return Status::Error(message.str());
       }
-      const Eigen::Vector2d drawn(u_dist(rng), v_dist(rng));
+      // v before u, in statements of their own: arguments are evaluated in
+      // an unspecified order (gcc right to left, clang left to right), and
+      // seeded data must not depend on the compiler. This is the order gcc
+      // has always drawn them in.
+      const double drawn_v = v_dist(rng);
+      const Eigen::Vector2d drawn(u_dist(rng), drawn_v);
       const double depth = depth_dist(rng);
       StereoCorrespondence correspondence;
       if (!trace(frame, drawn, depth, &correspondence.left_pixel,
@@ -200,7 +205,8 @@ std::vector<int64_t> AddOutliers(
   std::uniform_real_distribution<double> u(-0.5, right.width() - 0.5);
   std::uniform_real_distribution<double> v(-0.5, right.height() - 0.5);
   for (const int64_t i : order) {
-    (*correspondences)[i].right_pixel = Eigen::Vector2d(u(rng), v(rng));
+    const double drawn_v = v(rng);  // before u, as above
+    (*correspondences)[i].right_pixel = Eigen::Vector2d(u(rng), drawn_v);
   }
   return order;
 }
