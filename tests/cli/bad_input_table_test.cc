@@ -10,6 +10,7 @@
 // BadInput/CliBadInput.Refuses/EstimateMatchesWrongColumnCount.
 #include <gtest/gtest.h>
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -23,6 +24,7 @@
 #include <vector>
 
 #include "cli/cli_runner.h"
+#include "support/camera_info_text.h"
 #include "support/temp_file.h"
 #ifdef RCM_HAVE_ROSBAG
 #include "rcm/io/bag_image_writer.h"
@@ -224,37 +226,23 @@ Setup RigWith(const std::string& name, const std::string& from,
 // ROS camera_info files of a pinhole pair with an 11 cm baseline (R = I;
 // the right projection's P[3] = -fx * baseline), with `from` replaced by
 // `to` in the left or right file.
-std::string CameraInfoText(const std::string& name, double p03) {
-  return "image_width: 720\n"
-         "image_height: 540\n"
-         "camera_name: " +
-         name +
-         "\n"
-         "camera_matrix:\n"
-         "  rows: 3\n"
-         "  cols: 3\n"
-         "  data: [346.7, 0, 360.5, 0, 346.8, 271.0, 0, 0, 1]\n"
-         "distortion_model: plumb_bob\n"
-         "distortion_coefficients:\n"
-         "  rows: 1\n"
-         "  cols: 5\n"
-         "  data: [-0.01, 0.002, 0, 0, 0]\n"
-         "rectification_matrix:\n"
-         "  rows: 3\n"
-         "  cols: 3\n"
-         "  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n"
-         "projection_matrix:\n"
-         "  rows: 3\n"
-         "  cols: 4\n"
-         "  data: [346.7, 0, 360.5, " +
-         std::to_string(p03) + ", 0, 346.8, 271.0, 0, 0, 0, 1, 0]\n";
+// The right projection's P[3] = -fx * baseline.
+constexpr double kRightP03 = -346.7 * 0.11;
+
+std::string PinholeCameraInfo(const std::string& name, double p03) {
+  Eigen::Matrix3d k;
+  k << 346.7, 0.0, 360.5, 0.0, 346.8, 271.0, 0.0, 0.0, 1.0;
+  Eigen::Matrix<double, 3, 4> projection;
+  projection << k, Eigen::Vector3d(p03, 0.0, 0.0);
+  return test::CameraInfoText(name, k, {-0.01, 0.002, 0.0, 0.0, 0.0},
+                              Eigen::Matrix3d::Identity(), projection);
 }
 
 Setup CameraInfos(bool change_left, const std::string& from,
                   const std::string& to) {
   return [=](const std::string& dir) {
-    std::string left = CameraInfoText("left", 0.0);
-    std::string right = CameraInfoText("right", -346.7 * 0.11);
+    std::string left = PinholeCameraInfo("left", 0.0);
+    std::string right = PinholeCameraInfo("right", kRightP03);
     std::string& changed = change_left ? left : right;
     if (!from.empty()) {
       const size_t at = changed.find(from);
@@ -448,14 +436,14 @@ std::vector<RigDefect> RigDefects() {
               [](const std::string& dir) { fs::remove(dir + "/right.yaml"); }}),
        infos, "$D/right.yaml: cannot open: No such file or directory"},
       {"CameraInfoNanFocal",
-       CameraInfos(true, "data: [346.7, 0, 360.5, 0, 346.8",
-                   "data: [nan, 0, 360.5, 0, 346.8"),
+       CameraInfos(true, "data: [346.7,", "data: [nan,"),
        infos, "$D/left.yaml:7: camera_matrix"},
       {"CameraInfoInfDistortion",
        CameraInfos(false, "[-0.01, 0.002", "[-0.01, .inf"), infos,
        "$D/right.yaml:12: distortion_coefficients"},
       {"CameraInfoZeroBaseline",
-       CameraInfos(false, "360.5, -38.137", "360.5, 0.000"), infos,
+       CameraInfos(false, "360.5, " + FormatDouble(kRightP03), "360.5, 0"),
+       infos,
        "zero baseline"},
   };
 }
