@@ -38,30 +38,11 @@ double FirstFoldRadius(LensModelId model,
       return std::sqrt(smallest);
     }
     case LensModelId::kEquidistant: {
-      // The first angle below pi/2 where d theta_d / d theta stops being
-      // positive: a scan in steps of pi/2048, then bisection.
-      constexpr double kHalfPi = 1.5707963267948966;
-      constexpr int kSteps = 1024;
-      const double* dist = distortion.data();
-      double derivative = 1.0;
-      for (int k = 1; k <= kSteps; ++k) {
-        const double theta = kHalfPi * k / kSteps;
-        EquidistantLens::DistortedAngle(dist, theta, &derivative);
-        if (derivative > 0.0) continue;
-        double rising = kHalfPi * (k - 1) / kSteps;
-        double falling = theta;
-        for (int it = 0; it < 60; ++it) {
-          const double middle = 0.5 * (rising + falling);
-          EquidistantLens::DistortedAngle(dist, middle, &derivative);
-          if (derivative > 0.0) {
-            rising = middle;
-          } else {
-            falling = middle;
-          }
-        }
-        return std::tan(rising);
-      }
-      return kInfinity;
+      // Once per camera: a fine scan, in steps of pi/2048.
+      constexpr int kFoldScanSteps = 1024;
+      const double fold =
+          EquidistantLens::FirstFoldAngle(distortion.data(), kFoldScanSteps);
+      return fold < EquidistantLens::kHalfPi ? std::tan(fold) : kInfinity;
     }
   }
   return kInfinity;

@@ -350,45 +350,33 @@ struct EquidistantLens : public BaseLens<EquidistantLens> {
 
   static constexpr double kHalfPi = 1.5707963267948966;
 
-  // A bracket [lo, hi] of the root of theta_d = target on the rising
-  // branch that starts at 0, for a lens whose theta_d folds back below the
-  // target before pi/2 (strongly negative coefficients): theta is scanned
-  // upward in steps of pi/128 while theta_d rises; where it stops rising,
-  // the fold is found by bisection on the sign of the derivative. False
-  // when theta_d does not reach the target before the fold.
-  static bool BracketBeforeFold(const double* dist, double target, double* lo,
-                                double* hi) {
-    constexpr int kSteps = 64;
-    double previous = 0.0;
-    for (int k = 1; k <= kSteps; ++k) {
-      const double theta = kHalfPi * k / kSteps;
+  // The first angle in (0, pi/2) where d theta_d / d theta stops being
+  // positive, i.e. where theta_d folds back (strongly negative
+  // coefficients): theta is scanned upward in `steps` steps of
+  // pi / (2 steps), and the fold is found by 60 bisections on the sign of
+  // the derivative, on its rising side. pi/2 when theta_d rises all the
+  // way, as it does for any real lens. A coarse scan can step over a fold
+  // narrower than its step.
+  static double FirstFoldAngle(const double* dist, int steps) {
+    for (int k = 1; k <= steps; ++k) {
+      const double theta = kHalfPi * k / steps;
       double derivative;
-      if (DistortedAngle(dist, theta, &derivative) > target &&
-          derivative > 0.0) {
-        *lo = previous;
-        *hi = theta;
-        return true;
-      }
-      if (!(derivative > 0.0)) {
-        double rising = previous;
-        double falling = theta;
-        for (int it = 0; it < 60; ++it) {
-          const double middle = 0.5 * (rising + falling);
-          DistortedAngle(dist, middle, &derivative);
-          if (derivative > 0.0) {
-            rising = middle;
-          } else {
-            falling = middle;
-          }
+      DistortedAngle(dist, theta, &derivative);
+      if (derivative > 0.0) continue;
+      double rising = kHalfPi * (k - 1) / steps;
+      double falling = theta;
+      for (int it = 0; it < 60; ++it) {
+        const double middle = 0.5 * (rising + falling);
+        DistortedAngle(dist, middle, &derivative);
+        if (derivative > 0.0) {
+          rising = middle;
+        } else {
+          falling = middle;
         }
-        if (!(DistortedAngle(dist, rising) > target)) return false;
-        *lo = previous;
-        *hi = rising;
-        return true;
       }
-      previous = theta;
+      return rising;
     }
-    return false;
+    return kHalfPi;
   }
 
   // The double-precision angle solve behind Undistort.
@@ -399,9 +387,12 @@ struct EquidistantLens : public BaseLens<EquidistantLens> {
     // target; otherwise theta_d may still reach it before folding back
     // (found by fuzz_camera_model: k1..k4 = -0.22 folds at 0.8 rad, and
     // every pixel failed to unproject).
-    if (!(DistortedAngle(dist, hi) > target) &&
-        !BracketBeforeFold(dist, target, &lo, &hi)) {
-      return false;
+    if (!(DistortedAngle(dist, hi) > target)) {
+      constexpr int kFoldScanSteps = 64;  // per pixel: coarse
+      hi = FirstFoldAngle(dist, kFoldScanSteps);
+      if (!(hi < kHalfPi) || !(DistortedAngle(dist, hi) > target)) {
+        return false;
+      }
     }
     double t = std::min(target, 0.5 * (lo + hi));
     if (!(t > lo)) t = 0.5 * (lo + hi);
