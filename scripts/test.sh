@@ -1,6 +1,11 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds, and runs every test (ctest, two jobs).
+# Installs what is missing, builds, and runs every test (ctest, two jobs),
+# twice: the Release build (build/), then the same suite built with clang
+# under AddressSanitizer and UndefinedBehaviorSanitizer, followed by a
+# short run of each fuzz target (scripts/test_sanitizers.sh,
+# build-sanitize/).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/build.sh
 ctest --test-dir build --output-on-failure -j2
+./scripts/test_sanitizers.sh
