@@ -335,7 +335,9 @@ TEST(RefractiveCameraWithPort, VirtualPinholeRoundTripUpToGrazingBearings) {
     EXPECT_TRUE(raw->allFinite());
     const std::optional<Eigen::Vector2d> back =
         camera.VirtualPinholeFromImage(*raw);
-    if (back) EXPECT_TRUE(back->allFinite());
+    if (back) {
+      EXPECT_TRUE(back->allFinite());
+    }
   }
 }
 
