@@ -29,11 +29,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const rcm::StatusOr<rcm::calib::CalibrationTarget> target =
       rcm::calib::ParseCalibrationTarget(text, kSource);
   if (!target.ok()) {
-    const std::string message = target.status().message();
-    FuzzCheck(!message.empty() && message.find('\n') == std::string::npos,
-              "error message not one line");
-    FuzzCheck(message.rfind(kSource, 0) == 0,
-              "error message without the source name");
+    rcm::fuzz::CheckErrorMessage(target.status().message(), kSource);
     return 0;
   }
   FuzzCheck(!rcm::calib::DescribeTarget(*target).empty(), "no description");

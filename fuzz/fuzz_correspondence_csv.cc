@@ -47,11 +47,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const rcm::StatusOr<std::vector<rcm::StereoCorrespondence>> parsed =
       rcm::ParseCorrespondenceCsv(text, kSource);
   if (!parsed.ok()) {
-    const std::string message = parsed.status().message();
-    FuzzCheck(!message.empty() && message.find('\n') == std::string::npos,
-              "error message not one line");
-    FuzzCheck(message.rfind(kSource, 0) == 0,
-              "error message without the source name");
+    rcm::fuzz::CheckErrorMessage(parsed.status().message(), kSource);
     return 0;
   }
   const std::vector<rcm::StereoCorrespondence>& rows = *parsed;

@@ -1,6 +1,7 @@
 // Helpers shared by the fuzz targets: doubles drawn from libFuzzer's bytes
-// (FuzzedDataProvider, shipped with clang), and a check that aborts, so that
-// a violated property is a finding like a crash.
+// (FuzzedDataProvider, shipped with clang), a check that aborts, so that a
+// violated property is a finding like a crash, and the property every
+// reader's error message has.
 #ifndef RCM_FUZZ_FUZZ_INPUT_H_
 #define RCM_FUZZ_FUZZ_INPUT_H_
 
@@ -11,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <string>
 
 namespace rcm::fuzz {
 
@@ -36,6 +38,16 @@ inline void FuzzCheck(bool condition, const char* what) {
     std::fprintf(stderr, "fuzz property violated: %s\n", what);
     std::abort();
   }
+}
+
+// A reader's error: one nonempty line that starts with the name of the
+// source it read (the file's path in the rcm executable).
+inline void CheckErrorMessage(const std::string& message, const char* source) {
+  FuzzCheck(!message.empty(), "empty error message");
+  FuzzCheck(message.find('\n') == std::string::npos,
+            "error message of more than one line");
+  FuzzCheck(message.rfind(source, 0) == 0,
+            "error message without the source name");
 }
 
 inline bool AllFinite(const double* values, int count) {
