@@ -1,5 +1,7 @@
 #include "rcm/geometry/stereo_rig.h"
 
+#include <ceres/rotation.h>
+
 #include <cmath>
 #include <sstream>
 
@@ -30,6 +32,23 @@ StatusOr<StereoRig> StereoRig::WithPorts(const FlatPort& left,
   for (FlatPort* port : {&rig.ports_->left, &rig.ports_->right}) {
     if (std::abs(port->normal.norm() - 1.0) > 1e-12) port->normal.normalize();
   }
+  return rig;
+}
+
+StatusOr<StereoRig> StereoRig::WithCam1Moved(
+    const Eigen::Vector3d& rotation, const Eigen::Vector3d& translation) const {
+  if (!rotation.allFinite() || !translation.allFinite()) {
+    return Status::Error("the change of cam1_from_cam0 is not finite");
+  }
+  Eigen::Matrix3d delta;
+  ceres::AngleAxisToRotationMatrix(rotation.data(),
+                                   ceres::ColumnMajorAdapter3x3(delta.data()));
+  Rigid3d moved;
+  moved.rotation = delta * right_from_left_.rotation;
+  moved.translation = delta * right_from_left_.translation + translation;
+  StatusOr<StereoRig> rig = Create(left_, right_, moved);
+  if (!rig.ok()) return rig.status();
+  rig->ports_ = ports_;
   return rig;
 }
 

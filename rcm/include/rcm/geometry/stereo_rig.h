@@ -3,6 +3,7 @@
 #ifndef RCM_GEOMETRY_STEREO_RIG_H_
 #define RCM_GEOMETRY_STEREO_RIG_H_
 
+#include <Eigen/Core>
 #include <optional>
 
 #include "rcm/camera/camera.h"
@@ -39,6 +40,20 @@ class StereoRig {
   // A copy of the rig with ports (normals normalized). Errors: a port
   // that fails FlatPort::Check, prefixed "left port: " or "right port: ".
   StatusOr<StereoRig> WithPorts(const FlatPort& left, const FlatPort& right) const;
+
+  // A copy of the rig with cam1 moved relative to cam0: cam1_from_cam0 =
+  // (R, t) becomes
+  //
+  //   R' = exp([w]x) R,   t' = exp([w]x) t + dt,
+  //
+  // i.e. cam1 turned about its own center by the angle-axis w (radians, in
+  // the cam1 frame), then cam1_from_cam0's translation changed by dt
+  // (meters, cam1 frame). The convention of the rotation correction
+  // (sampson_coplanarity_error.h) and of `rcm simulate --extrinsic-drift`.
+  // Ports are kept. Fails as Create does (non-finite, zero baseline).
+  StatusOr<StereoRig> WithCam1Moved(const Eigen::Vector3d& rotation,
+                                    const Eigen::Vector3d& translation =
+                                        Eigen::Vector3d::Zero()) const;
 
   const Camera& left() const { return left_; }
   const Camera& right() const { return right_; }
