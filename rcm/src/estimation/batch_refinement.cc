@@ -1,14 +1,19 @@
 #include "rcm/estimation/batch_refinement.h"
 
 #include <ceres/ceres.h>
+#include <ceres/normal_prior.h>
 #include <ceres/rotation.h>
 
+#include <Eigen/Cholesky>
 #include <algorithm>
+#include <iomanip>
+#include <limits>
 #include <cmath>
 #include <memory>
 #include <sstream>
 #include <utility>
 
+#include "rcm/estimation/calibration_propagation.h"
 #include "rcm/estimation/closed_form.h"
 #include "rcm/estimation/cramer_rao_bound.h"
 #include "rcm/estimation/thick_port_refinement.h"
@@ -23,6 +28,9 @@ namespace {
 
 // The paper's mask threshold, for the closed-form seed.
 constexpr double kSeedMaskEta = 0.3;
+// n's upper bound, and how close to it an estimate counts as pinned there.
+constexpr double kUpperBound = 2.0;
+constexpr double kPinnedTolerance = 1e-6;
 
 // The median of eq. 14 over the matches that pass the paper's mask.
 std::optional<double> ClosedFormSeed(
@@ -56,15 +64,34 @@ struct Parameters {
   double rotation[3] = {0.0, 0.0, 0.0};
 };
 
-// One Ceres problem over `indices` of `matches`; returns the summary.
+// The prior of the rotation correction in pixels of residual: with
+// Sigma = L L^T (Cholesky) and sigma_px the pixel noise,
+// |sigma_px L^-1 w|^2 = sigma_px^2 w^T Sigma^-1 w, the prior's negative
+// log-likelihood in the units of the Sampson residuals' sum of squares.
+ceres::CostFunction* NewRotationPrior(const Eigen::Matrix3d& covariance,
+                                      double sigma_px) {
+  const Eigen::Matrix3d lower = covariance.llt().matrixL();
+  const ceres::Matrix root_information =
+      sigma_px * lower.triangularView<Eigen::Lower>().solve(
+                     Eigen::Matrix3d::Identity());
+  return new ceres::NormalPrior(root_information, ceres::Vector::Zero(3));
+}
+
+// One Ceres problem over `indices` of `matches`, with the rotation
+// correction when `with_rotation` and its prior when `prior` is not null
+// (NewRotationPrior); returns the summary.
 ceres::Solver::Summary Solve(const Eigen::Matrix3d& essential,
                              const std::vector<PreparedCorrespondence>& matches,
                              const std::vector<int64_t>& indices,
                              RobustLoss loss, const RefinementOptions& options,
+                             bool with_rotation, ceres::CostFunction* prior,
                              Parameters* parameters, ceres::Problem* problem) {
   ceres::LossFunction* loss_function = NewLossFunction(loss, options.loss_scale_px);
+  if (prior != nullptr) {
+    problem->AddResidualBlock(prior, nullptr, parameters->rotation);
+  }
   for (const int64_t i : indices) {
-    if (options.refine_rotation) {
+    if (with_rotation) {
       problem->AddResidualBlock(
           SampsonCoplanarityError::CreateWithRotation(essential, matches[i]),
           loss_function, &parameters->n, parameters->rotation);
@@ -137,6 +164,19 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
   }
   const Eigen::Matrix3d essential = EssentialMatrix(rig.right_from_left());
 
+  // How cam1's rotation is treated: free (refine_rotation), estimated with
+  // the calibration's rotation covariance as prior (self-calibration), or
+  // held at the calibration's.
+  const CalibrationUncertainty uncertainty =
+      rig.calibration_uncertainty().value_or(CalibrationUncertainty());
+  const bool rotation_uncertain = !uncertainty.RotationCovariance().isZero(0.0);
+  const RotationMode mode =
+      options.refine_rotation ? RotationMode::kFree
+      : options.self_calibrate_rotation && rotation_uncertain
+          ? RotationMode::kPrior
+          : RotationMode::kHeld;
+  const bool with_rotation = mode != RotationMode::kHeld;
+
   // Seed and stage 1 (robust, all usable matches).
   summary.n_closed_form = ClosedFormSeed(matches);
   std::optional<double> candidate;
@@ -144,7 +184,7 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
     candidate = std::clamp(*summary.n_closed_form, 1.0, 2.0);
   }
   Parameters parameters;
-  if (!options.refine_rotation) {
+  if (!with_rotation) {
     // n alone: a 1-D search is exact and several times faster than a
     // Ceres solve of the robust cost, whose Gauss-Newton model converges
     // only linearly on it.
@@ -159,8 +199,16 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
     std::vector<int64_t> all(matches.size());
     for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int64_t>(i);
     ceres::Problem problem;
-    const ceres::Solver::Summary stage1 = Solve(
-        essential, matches, all, options.loss, options, &parameters, &problem);
+    // The prior's weight needs the pixel noise, unknown before stage 2:
+    // half the loss scale, which the options call about twice the noise.
+    ceres::CostFunction* prior =
+        mode == RotationMode::kPrior
+            ? NewRotationPrior(uncertainty.RotationCovariance(),
+                               0.5 * options.loss_scale_px)
+            : nullptr;
+    const ceres::Solver::Summary stage1 =
+        Solve(essential, matches, all, options.loss, options, with_rotation,
+              prior, &parameters, &problem);
     if (!stage1.IsSolutionUsable()) {
       return Status::Error("the robust refinement failed: " + stage1.message);
     }
@@ -171,7 +219,7 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
 
   // Inliers at the robust estimate.
   const Rigid3d robust_extrinsics =
-      options.refine_rotation
+      with_rotation
           ? CorrectedExtrinsics(rig.right_from_left(), parameters.rotation)
           : rig.right_from_left();
   const Eigen::Matrix3d robust_essential = EssentialMatrix(robust_extrinsics);
@@ -206,74 +254,111 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
     return Status::Error(message.str());
   }
 
-  // Stage 2: least squares on the inliers, and its covariance.
-  ceres::Problem problem;
-  const ceres::Solver::Summary stage2 =
-      Solve(essential, matches, inliers, RobustLoss::kNone, options,
-            &parameters, &problem);
-  if (!stage2.IsSolutionUsable()) {
-    return Status::Error("the least-squares refinement failed: " +
-                         stage2.message);
-  }
-  summary.num_iterations += static_cast<int>(stage2.iterations.size());
-  summary.n = parameters.n;
-  summary.cost = stage2.final_cost;
-  const int num_parameters = options.refine_rotation ? 4 : 1;
+  // Stage 2: least squares on the inliers. With the prior, its weight
+  // sigma_px^2 comes from the inliers' residuals, refined until it settles
+  // (two or three solves).
+  const int num_parameters = with_rotation ? 4 : 1;
   const int64_t dof = static_cast<int64_t>(inliers.size()) - num_parameters;
-  summary.sigma_px = std::sqrt(2.0 * summary.cost / static_cast<double>(dof));
-
-  ceres::Covariance::Options covariance_options;
-  covariance_options.algorithm_type = ceres::DENSE_SVD;
-  covariance_options.num_threads = options.num_threads;
-  ceres::Covariance covariance(covariance_options);
-  std::vector<std::pair<const double*, const double*>> blocks = {
-      {&parameters.n, &parameters.n}};
-  if (options.refine_rotation) {
-    blocks.emplace_back(&parameters.n, parameters.rotation);
-    blocks.emplace_back(parameters.rotation, parameters.rotation);
+  const auto data_sigma_px = [&](const Parameters& at) {
+    const Rigid3d extrinsics =
+        with_rotation ? CorrectedExtrinsics(rig.right_from_left(), at.rotation)
+                      : rig.right_from_left();
+    const std::vector<double> residuals =
+        LocusResiduals(EssentialMatrix(extrinsics), inlier_matches, at.n);
+    double sum = 0.0;
+    for (const double r : residuals) {
+      if (std::isfinite(r)) sum += r * r;
+    }
+    return std::sqrt(sum / static_cast<double>(dof));
+  };
+  double prior_sigma_px = mode == RotationMode::kPrior
+                              ? data_sigma_px(parameters)
+                              : 0.0;
+  constexpr int kMaxPriorSolves = 3;
+  constexpr double kPriorSigmaTolerance = 0.02;  // relative
+  for (int solve = 0;; ++solve) {
+    ceres::Problem problem;
+    ceres::CostFunction* prior =
+        mode == RotationMode::kPrior
+            ? NewRotationPrior(uncertainty.RotationCovariance(),
+                               std::max(prior_sigma_px, 1e-6))
+            : nullptr;
+    const ceres::Solver::Summary stage2 =
+        Solve(essential, matches, inliers, RobustLoss::kNone, options,
+              with_rotation, prior, &parameters, &problem);
+    if (!stage2.IsSolutionUsable()) {
+      return Status::Error("the least-squares refinement failed: " +
+                           stage2.message);
+    }
+    summary.num_iterations += static_cast<int>(stage2.iterations.size());
+    summary.sigma_px = data_sigma_px(parameters);
+    summary.cost = 0.5 * summary.sigma_px * summary.sigma_px *
+                   static_cast<double>(dof);
+    if (mode != RotationMode::kPrior || solve + 1 >= kMaxPriorSolves ||
+        std::abs(summary.sigma_px - prior_sigma_px) <=
+            kPriorSigmaTolerance * summary.sigma_px) {
+      break;
+    }
+    prior_sigma_px = summary.sigma_px;
   }
-  if (!covariance.Compute(blocks, &problem)) {
-    return Status::Error(
-        options.refine_rotation
-            ? "the rotation correction cannot be separated from n with these "
-              "correspondences (singular covariance); refine n alone"
-            : "the covariance of n is singular: the correspondences do not "
-              "observe n");
-  }
-  const double variance_scale = summary.sigma_px * summary.sigma_px;
-  double n_variance = 0.0;
-  covariance.GetCovarianceBlock(&parameters.n, &parameters.n, &n_variance);
-  summary.sigma_n = std::sqrt(n_variance * variance_scale);
+  summary.n = parameters.n;
 
+  // Uncertainty (calibration_propagation.h): the normal equations at the
+  // solution, the frames' consistency, and the propagation of the pixel
+  // noise and the calibration's uncertainty into n.
+  const Eigen::Vector3d rotation(parameters.rotation[0], parameters.rotation[1],
+                                 parameters.rotation[2]);
   const Rigid3d final_extrinsics =
-      options.refine_rotation
-          ? CorrectedExtrinsics(rig.right_from_left(), parameters.rotation)
-          : rig.right_from_left();
+      with_rotation ? CorrectedExtrinsics(rig.right_from_left(), parameters.rotation)
+                    : rig.right_from_left();
   const Eigen::Matrix3d final_essential = EssentialMatrix(final_extrinsics);
+  std::vector<StereoCorrespondence> raw;
+  raw.reserve(matches.size());
+  for (const int64_t i : prepared.source_index) raw.push_back(correspondences[i]);
+  const CalibrationParameterLayout layout = CalibrationParameterLayout::Of(rig);
+  LocusNormalEquations equations(layout.Size());
+  std::vector<LocusNormalEquations> per_frame;
+  AccumulateLocusNormalEquations(rig, raw, matches, inliers, parameters.n,
+                                 rotation, &equations, &per_frame);
+  summary.consistency = FrameConsistencyOf(per_frame, summary.sigma_px);
+  const double inflation =
+      summary.consistency ? summary.consistency->inflation : 1.0;
+  StatusOr<CalibrationPropagation> propagation = PropagateCalibration(
+      equations, layout, uncertainty, mode, summary.sigma_px, inflation);
+  if (!propagation.ok()) return propagation.status();
+  summary.sigma_n = propagation->sigma_n;
+  summary.sigma_n_noise = propagation->sigma_n_noise;
+  summary.sigma_n_calibration = propagation->sigma_n_calibration;
   summary.crlb =
       summary.sigma_px / std::sqrt(LocusInformation(
                              final_essential, inlier_matches, parameters.n));
 
-  if (options.refine_rotation) {
-    double n_rotation[3];
-    double rotation_rotation[9];
-    covariance.GetCovarianceBlock(&parameters.n, parameters.rotation,
-                                  n_rotation);
-    covariance.GetCovarianceBlock(parameters.rotation, parameters.rotation,
-                                  rotation_rotation);
+  if (with_rotation) {
     RotationCorrection correction;
+    correction.angle_axis = rotation;
     for (int k = 0; k < 3; ++k) {
-      correction.angle_axis[k] = parameters.rotation[k];
-      const double variance = rotation_rotation[4 * k];
-      correction.sigma[k] = std::sqrt(variance * variance_scale);
-      correction.correlation_with_n[k] =
-          n_rotation[k] / std::sqrt(n_variance * variance);
+      correction.sigma[k] =
+          std::sqrt(std::max(0.0, propagation->rotation_covariance(k, k)));
     }
-    correction.cam1_from_cam0 = final_extrinsics;
-    const double bound_ratio = summary.crlb / summary.sigma_n;
+    correction.correlation_with_n = propagation->rotation_correlation_with_n;
     correction.multiple_correlation_with_n =
-        std::sqrt(std::max(0.0, 1.0 - bound_ratio * bound_ratio));
+        propagation->rotation_multiple_correlation;
+    correction.with_prior = mode == RotationMode::kPrior;
+    correction.cam1_from_cam0 = final_extrinsics;
     summary.rotation = correction;
+  }
+  if (rig.calibration_uncertainty()) summary.calibration = *propagation;
+
+  // An estimate pinned at the upper bound is a failure, not a number.
+  if (summary.n >= kUpperBound - kPinnedTolerance) {
+    std::ostringstream message;
+    message << "n = " << std::fixed << std::setprecision(4) << summary.n
+            << " is at the upper bound of [1, 2], which no medium reaches: "
+               "the rig has likely moved since its calibration (cam1 turned "
+               "by a few tenths of a degree) or the rig file is not this "
+               "rig's; calibrate in the water (rcm calibrate --underwater) "
+               "or estimate the rotation with n (--refine-rotation)";
+    return Status::Error(message.str());
   }
 
   summary.inliers.reserve(inliers.size());

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 namespace rcm {
 
@@ -49,6 +50,18 @@ StatusOr<StereoRig> StereoRig::WithCam1Moved(
   StatusOr<StereoRig> rig = Create(left_, right_, moved);
   if (!rig.ok()) return rig.status();
   rig->ports_ = ports_;
+  rig->calibration_uncertainty_ = calibration_uncertainty_;
+  return rig;
+}
+
+StatusOr<StereoRig> StereoRig::WithCalibrationUncertainty(
+    std::optional<CalibrationUncertainty> uncertainty) const {
+  if (uncertainty) {
+    RCM_RETURN_IF_ERROR(
+        uncertainty->Check(left_.num_params(), right_.num_params()));
+  }
+  StereoRig rig = *this;
+  rig.calibration_uncertainty_ = std::move(uncertainty);
   return rig;
 }
 

@@ -1,9 +1,11 @@
 #include "rcm/io/stereo_rig_file.h"
 
+#include <filesystem>
 #include <optional>
 #include <utility>
 
 #include "rcm/io/atomic_file.h"
+#include "rcm/io/calibration_covariance_file.h"
 #include "rcm/io/camchain.h"
 #include "rcm/io/camera_file.h"
 #include "rcm/io/camera_info.h"
@@ -26,10 +28,27 @@ StatusOr<RigFile> ReadRigFile(const std::string& path) {
   return RigFile{std::move(text).value(), *format};
 }
 
+// The default drift prior, or the one of `options`.
+CalibrationUncertainty DriftOnly(const RigFileOptions& options) {
+  if (!options.drift_prior) return CalibrationUncertainty::DefaultDriftPrior();
+  return CalibrationUncertainty::DriftPrior(options.drift_prior->first,
+                                            options.drift_prior->second);
+}
+
+StatusOr<StereoRig> WithUncertainty(const StereoRig& rig,
+                                    CalibrationUncertainty uncertainty,
+                                    const std::string& source) {
+  StatusOr<StereoRig> with =
+      rig.WithCalibrationUncertainty(std::move(uncertainty));
+  if (!with.ok()) return with.status().WithContext(source);
+  return with;
+}
+
 StatusOr<StereoRig> ReadCamchainRig(const std::string& path,
                                     const std::string& text,
                                     const std::string& left,
-                                    const std::string& right) {
+                                    const std::string& right,
+                                    const RigFileOptions& options) {
   const StatusOr<Camchain> camchain = ParseCamchain(text, path);
   if (!camchain.ok()) return camchain.status();
   int indices[2];
@@ -42,7 +61,25 @@ StatusOr<StereoRig> ReadCamchainRig(const std::string& path,
   const StatusOr<StereoRig> rig =
       StereoRigFromCamchain(*camchain, indices[0], indices[1]);
   if (!rig.ok()) return rig.status().WithContext(path);
-  return rig;
+
+  const std::string sidecar = CovarianceSidecarPath(path);
+  std::error_code error;
+  if (!std::filesystem::exists(sidecar, error)) {
+    return WithUncertainty(*rig, DriftOnly(options), path);
+  }
+  const StatusOr<CalibrationCovarianceFile> covariance =
+      ReadCalibrationCovariance(sidecar);
+  if (!covariance.ok()) return covariance.status();
+  if (covariance->cameras.size() != camchain->cameras.size()) {
+    return Status::Error(sidecar + ": has " +
+                         std::to_string(covariance->cameras.size()) +
+                         " cameras, " + path + " has " +
+                         std::to_string(camchain->cameras.size()));
+  }
+  StatusOr<CalibrationUncertainty> uncertainty = PairCalibrationUncertainty(
+      *covariance, indices[0], indices[1], sidecar, options.drift_prior);
+  if (!uncertainty.ok()) return uncertainty.status();
+  return WithUncertainty(*rig, std::move(uncertainty).value(), sidecar);
 }
 
 // True when `text` parses as YAML and holds a document.
@@ -83,7 +120,8 @@ StatusOr<StereoRig> ReadCameraInfoPair(const std::string& left_path,
 
 StatusOr<StereoRig> ReadStereoRig(const std::string& spec,
                                   const std::string& left,
-                                  const std::string& right) {
+                                  const std::string& right,
+                                  const RigFileOptions& options) {
   const size_t comma = spec.find(',');
   if (comma != std::string::npos) {
     const std::string left_path = spec.substr(0, comma);
@@ -101,7 +139,9 @@ StatusOr<StereoRig> ReadStereoRig(const std::string& spec,
           "files '" +
           spec + "' the first is the left camera and the second the right");
     }
-    return ReadCameraInfoPair(left_path, right_path);
+    const StatusOr<StereoRig> rig = ReadCameraInfoPair(left_path, right_path);
+    if (!rig.ok()) return rig.status();
+    return WithUncertainty(*rig, DriftOnly(options), spec);
   }
 
   const StatusOr<RigFile> file = ReadRigFile(spec);
@@ -112,7 +152,7 @@ StatusOr<StereoRig> ReadStereoRig(const std::string& spec,
                          "give the left and right files as "
                          "'left.yaml,right.yaml'");
   }
-  return ReadCamchainRig(spec, file->text, left, right);
+  return ReadCamchainRig(spec, file->text, left, right, options);
 }
 
 }  // namespace rcm

@@ -40,6 +40,7 @@
 #include <optional>
 #include <vector>
 
+#include "rcm/estimation/calibration_propagation.h"
 #include "rcm/estimation/refinement_options.h"
 #include "rcm/geometry/stereo_correspondence.h"
 #include "rcm/geometry/stereo_rig.h"
@@ -58,13 +59,23 @@ struct RotationCorrection {
   // sqrt(1 - (crlb / sigma_n)^2): sigma_n = crlb / sqrt(1 - R^2). Near 1,
   // the data cannot tell a rotation from a change of n.
   double multiple_correlation_with_n = 0.0;
+  // Estimated with the calibration's rotation covariance as prior
+  // (self-calibration), not freely (refine_rotation).
+  bool with_prior = false;
   // The corrected extrinsics.
   Rigid3d cam1_from_cam0;
 };
 
 struct RefinementSummary {
   double n = 0.0;
-  double sigma_n = 0.0;   // standard deviation, from the covariance
+  // Standard deviation of n, the total: pixel noise (sigma_n_noise, after
+  // the frames' consistency test) and the rig's calibration uncertainty
+  // (sigma_n_calibration), sqrt(noise^2 + calibration^2); see
+  // calibration_propagation.h. A rig made in code has no calibration
+  // uncertainty: then sigma_n = sigma_n_noise.
+  double sigma_n = 0.0;
+  double sigma_n_noise = 0.0;
+  double sigma_n_calibration = 0.0;
   double crlb = 0.0;      // Cramer-Rao bound of n (standard deviation)
   double sigma_px = 0.0;  // estimated pixel noise of the inliers
   // The seeds: the closed-form median (nullopt when no match passes the
@@ -80,7 +91,13 @@ struct RefinementSummary {
   int64_t num_correspondences = 0;  // input size
   int64_t num_invalid = 0;          // pixels that could not be undistorted
   int num_iterations = 0;           // solver iterations, both stages
-  std::optional<RotationCorrection> rotation;  // with refine_rotation
+  // With refine_rotation, or self-calibration with a rotation prior.
+  std::optional<RotationCorrection> rotation;
+  // The propagation of the calibration's uncertainty, when the rig has one
+  // (sensitivities, shares, observability of the rotation).
+  std::optional<CalibrationPropagation> calibration;
+  // The frames' agreement, with two or more frames.
+  std::optional<FrameConsistency> consistency;
 };
 
 // A rig with a thick port (StereoRig::HasThickPort, from a camchain's port

@@ -61,9 +61,18 @@ struct RefinementOptions {
   // from air (1.0) at 3 sigma; matches on the image axes, or few and far
   // away, are refused with a message instead of giving a number. > 0.
   double max_crlb_per_px = 0.1;
-  // Also estimate a small rotation correction of cam1_from_cam0 (batch
-  // only; see batch_refinement.h for when it is identifiable).
+  // Also estimate a small rotation correction of cam1_from_cam0 without a
+  // prior (batch only; see batch_refinement.h for when it is
+  // identifiable).
   bool refine_rotation = false;
+  // Self-calibration of the drift (batch_refinement.h): when the rig's
+  // calibration uncertainty (StereoRig::calibration_uncertainty) gives
+  // cam1's rotation a covariance, estimate that rotation with n, with the
+  // covariance as its prior. Where the data separate the rotation from n
+  // they decide it; where they do not, the prior does, and sigma_n carries
+  // it. false: the rotation is held at the calibration's and its
+  // uncertainty only propagated into sigma_n. Ignored with refine_rotation.
+  bool self_calibrate_rotation = true;
   // Solver iterations per stage; >= 1.
   int max_num_iterations = 100;
   // Threads for evaluating residuals; >= 1.

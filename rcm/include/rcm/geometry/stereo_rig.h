@@ -8,6 +8,7 @@
 
 #include "rcm/camera/camera.h"
 #include "rcm/camera/flat_port_geometry.h"
+#include "rcm/geometry/calibration_uncertainty.h"
 #include "rcm/geometry/rigid3d.h"
 #include "rcm/geometry/stereo_correspondence.h"
 #include "rcm/util/status.h"
@@ -41,6 +42,18 @@ class StereoRig {
   // that fails FlatPort::Check, prefixed "left port: " or "right port: ".
   StatusOr<StereoRig> WithPorts(const FlatPort& left, const FlatPort& right) const;
 
+  // How well the calibration is known (calibration_uncertainty.h): read
+  // with the rig from a file (stereo_rig_file.h: the calibration's
+  // covariance sidecar, or the default drift prior), nullopt for a rig made
+  // in code, whose calibration the estimators then take as exact.
+  const std::optional<CalibrationUncertainty>& calibration_uncertainty() const {
+    return calibration_uncertainty_;
+  }
+  // A copy of the rig with `uncertainty` (nullopt: exact). Fails when it
+  // fails CalibrationUncertainty::Check for these cameras.
+  StatusOr<StereoRig> WithCalibrationUncertainty(
+      std::optional<CalibrationUncertainty> uncertainty) const;
+
   // A copy of the rig with cam1 moved relative to cam0: cam1_from_cam0 =
   // (R, t) becomes
   //
@@ -50,7 +63,7 @@ class StereoRig {
   // the cam1 frame), then cam1_from_cam0's translation changed by dt
   // (meters, cam1 frame). The convention of the rotation correction
   // (sampson_coplanarity_error.h) and of `rcm simulate --extrinsic-drift`.
-  // Ports are kept. Fails as Create does (non-finite, zero baseline).
+  // Ports and the calibration uncertainty are kept. Fails as Create does (non-finite, zero baseline).
   StatusOr<StereoRig> WithCam1Moved(const Eigen::Vector3d& rotation,
                                     const Eigen::Vector3d& translation =
                                         Eigen::Vector3d::Zero()) const;
@@ -82,6 +95,7 @@ class StereoRig {
   Camera right_;
   Rigid3d right_from_left_;
   std::optional<Ports> ports_;
+  std::optional<CalibrationUncertainty> calibration_uncertainty_;
 };
 
 }  // namespace rcm

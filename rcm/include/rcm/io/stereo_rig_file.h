@@ -11,19 +11,34 @@
 // The format of each file is recognised by its top-level keys: `cam0` for a
 // camchain, `camera_matrix` for a camera_info. A path that contains a comma
 // is always taken as a pair.
+//
+// The rig comes with its CalibrationUncertainty (calibration_uncertainty.h):
+// a camchain's covariance sidecar (rig-covariance.yaml next to rig.yaml,
+// calibration_covariance_file.h, written by rcm calibrate) with its drift
+// prior when the sidecar exists; otherwise, and for camera_info files, the
+// default drift prior (0.1 degree, 0.1 mm per axis). `drift_prior`
+// replaces the drift prior by (rotation sigma in radians, translation
+// sigma in meters) in either case.
 #ifndef RCM_IO_STEREO_RIG_FILE_H_
 #define RCM_IO_STEREO_RIG_FILE_H_
 
+#include <optional>
 #include <string>
+#include <utility>
 
 #include "rcm/geometry/stereo_rig.h"
 #include "rcm/util/status.h"
 
 namespace rcm {
 
+struct RigFileOptions {
+  std::optional<std::pair<double, double>> drift_prior;
+};
+
 StatusOr<StereoRig> ReadStereoRig(const std::string& spec,
                                   const std::string& left = "cam0",
-                                  const std::string& right = "cam1");
+                                  const std::string& right = "cam1",
+                                  const RigFileOptions& options = {});
 
 }  // namespace rcm
 

@@ -1,0 +1,181 @@
+// What the calibration's uncertainty does to n: the linearized error
+// propagation shared by the estimators of record (batch_refinement.h,
+// online_estimator.h, sliding_window_estimator.h), so that sigma_n counts
+// the rig's calibration (calibration_uncertainty.h) and not only pixel
+// noise.
+//
+// At the solution the Sampson residuals (pixels) are linearized in
+//
+//   n,  w  (3, a turn of cam1 about its center, radians, cam1 frame),
+//   dt (3, a change of cam1_from_cam0's translation, meters),
+//   the lens parameters of each camera (Camera::params order), when the
+//   calibration measured their covariance,
+//
+// (StereoRig::WithCam1Moved's convention), one row j_i = dr_i / d(n, w, dt,
+// lenses) per inlier. n and w come from ceres::Jet, dt and the lenses from
+// central differences (steps 1e-6 m and 1e-6 (1 + |p|); the residuals are
+// smooth and the truncation error is ~1e-12 relative). The estimators keep
+// the sums
+//
+//   M = sum_i j_i j_i^T,   g = sum_i r_i j_i,   C = sum_i r_i^2,
+//
+// which add over frames (LocusNormalEquations).
+//
+// Estimated x = [n] or [n, w], the rest p held at the calibration and
+// perturbed by its covariance Sigma_p; with A = M_xx, B = M_xp, pixel noise
+// sigma and, when w is estimated with the drift prior, P = Sigma_ww^-1
+// (P = 0 when w is free, --refine-rotation):
+//
+//   H        = A / sigma^2 + diag(0, P)          posterior information
+//   S        = H^-1 B / sigma^2                  d x_hat / d p
+//   cov(x)   = H^-1 A / sigma^2 H^-1             pixel noise
+//            + H^-1 diag(0, P) H^-1              the prior's share of w
+//            + S Sigma_p S^T                     the calibration held fixed
+//
+// (for a w drawn from the prior the first two sum to H^-1, the Bayesian
+// posterior covariance: MAP estimation, Kay, Fundamentals of Statistical
+// Signal Processing I, ch. 10-11). sigma_n is the square root of the (n, n)
+// entry; sigma_n_noise of the first term's, sigma_n_calibration of the
+// other two. With w held (online estimators without self-calibration),
+// w is part of p.
+//
+// Sensitivities with everything but n held: dn/dq = -M_nq / M_nn for each
+// q of w and dt (what a stale calibration does to an n estimated alone).
+// Observability of w from the data alone: the multiple correlation R of n
+// with w, R^2 = 1 - 1 / (M_nn [M_{n,w}^-1]_nn), and the inflation of
+// sigma_n when w is estimated without a prior, 1 / sqrt(1 - R^2).
+//
+// Consistency of frames: with s_f = sum_{i in f} r_i dr_i/dn and
+// G_f = sum_{i in f} (dr_i/dn)^2, frame f's own n is n_hat - s_f / G_f to
+// first order, with variance sigma^2 / G_f, so
+//
+//   chi^2 = sum_f s_f^2 / (sigma^2 G_f),   F - 1 degrees of freedom
+//
+// tests whether the frames agree within their sigmas. Its upper tail
+// probability is from the Wilson-Hilferty cube-root approximation (a few
+// percent of the probability itself for 2 or more degrees of freedom, ample
+// for a 1 % test). When p < 1 %, the frames disagree beyond pixel noise
+// (correlated matches, a calibration error that acts differently at other
+// depths) and the pixel-noise share of sigma_n is scaled by the Birge ratio
+// sqrt(chi^2 / (F - 1)).
+#ifndef RCM_ESTIMATION_CALIBRATION_PROPAGATION_H_
+#define RCM_ESTIMATION_CALIBRATION_PROPAGATION_H_
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rcm/estimation/prepared_correspondence.h"
+#include "rcm/geometry/calibration_uncertainty.h"
+#include "rcm/geometry/stereo_correspondence.h"
+#include "rcm/geometry/stereo_rig.h"
+#include "rcm/util/status.h"
+
+namespace rcm {
+
+// Columns of j_i: n, w (3), dt (3), then the lens parameters of each camera
+// whose covariance the rig's calibration uncertainty has.
+struct CalibrationParameterLayout {
+  static constexpr int kN = 0;
+  static constexpr int kRotation = 1;
+  static constexpr int kTranslation = 4;
+  int num_left_lens = 0;
+  int num_right_lens = 0;
+
+  // The layout of `rig`: lens columns for the lens covariances it has.
+  static CalibrationParameterLayout Of(const StereoRig& rig);
+  int LeftLens() const { return 7; }
+  int RightLens() const { return 7 + num_left_lens; }
+  int Size() const { return 7 + num_left_lens + num_right_lens; }
+};
+
+// The sums M, g, C above, of a set of residuals.
+struct LocusNormalEquations {
+  Eigen::MatrixXd information;  // M
+  Eigen::VectorXd gradient;     // g
+  double squared_residuals = 0.0;  // C
+  int64_t count = 0;
+
+  explicit LocusNormalEquations(int size = 7)
+      : information(Eigen::MatrixXd::Zero(size, size)),
+        gradient(Eigen::VectorXd::Zero(size)) {}
+  void Add(const LocusNormalEquations& other);
+  void Subtract(const LocusNormalEquations& other);
+};
+
+// Adds the rows j_i of `matches[indices]` at (n, w) for `rig`
+// (`raw` the correspondences they were prepared from, same indexing, for
+// the lens columns). Residuals that are undefined at (n, w) or at a
+// difference step are skipped. Per-frame sums (for the consistency test)
+// go to `per_frame` when it is not null: one entry per distinct
+// raw[i].frame, in order of first appearance.
+void AccumulateLocusNormalEquations(
+    const StereoRig& rig, const std::vector<StereoCorrespondence>& raw,
+    const std::vector<PreparedCorrespondence>& matches,
+    const std::vector<int64_t>& indices, double n,
+    const Eigen::Vector3d& rotation, LocusNormalEquations* equations,
+    std::vector<LocusNormalEquations>* per_frame = nullptr);
+
+// How cam1's rotation w is treated.
+enum class RotationMode {
+  kHeld,   // w = 0, its uncertainty propagated
+  kPrior,  // estimated with the calibration's rotation covariance as prior
+  kFree,   // estimated without a prior (--refine-rotation)
+};
+
+// The frames' agreement (the file comment).
+struct FrameConsistency {
+  int frames = 0;           // with information on n
+  double chi_squared = 0.0;
+  int dof = 0;              // frames - 1
+  double p_value = 1.0;     // upper tail probability of chi_squared
+  // sqrt(chi^2 / dof) when p_value < kInflationP, else 1.
+  double inflation = 1.0;
+  static constexpr double kInflationP = 0.01;
+};
+// From the per-frame sums of AccumulateLocusNormalEquations at the
+// solution; nullopt for fewer than two frames with information on n.
+std::optional<FrameConsistency> FrameConsistencyOf(
+    const std::vector<LocusNormalEquations>& per_frame, double sigma_px);
+// P(chi^2_dof > chi_squared), Wilson-Hilferty; dof >= 1.
+double ChiSquaredUpperTail(double chi_squared, int dof);
+
+struct CalibrationPropagation {
+  RotationMode mode = RotationMode::kHeld;
+  std::string source;  // CalibrationUncertainty::source
+  // sigma_n = sqrt(noise^2 + calibration^2); noise after the consistency
+  // test's inflation.
+  double sigma_n = 0.0;
+  double sigma_n_noise = 0.0;
+  double sigma_n_calibration = 0.0;
+  // Of sigma_n_calibration^2: the estimated rotation's prior share and the
+  // held parameters' (w when held, dt, lenses).
+  double variance_rotation = 0.0;
+  double variance_translation = 0.0;
+  double variance_lenses = 0.0;
+  // dn/dw and dn/dt with everything but n held (per radian, per meter).
+  Eigen::Vector3d dn_drotation = Eigen::Vector3d::Zero();
+  Eigen::Vector3d dn_dtranslation = Eigen::Vector3d::Zero();
+  // Observability of w from the data alone (the file comment).
+  double rotation_multiple_correlation = 0.0;
+  double rotation_sigma_inflation = 1.0;
+  // With w estimated: its covariance (radians^2; every term above) and the
+  // correlation of each component with n.
+  Eigen::Matrix3d rotation_covariance = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d rotation_correlation_with_n = Eigen::Vector3d::Zero();
+};
+
+// The propagation above from the sums at the solution. `noise_inflation`
+// (>= 1) scales the pixel-noise share. Fails when the information on the
+// estimated parameters is singular (w free and not separable from n).
+StatusOr<CalibrationPropagation> PropagateCalibration(
+    const LocusNormalEquations& equations,
+    const CalibrationParameterLayout& layout,
+    const CalibrationUncertainty& uncertainty, RotationMode mode,
+    double sigma_px, double noise_inflation = 1.0);
+
+}  // namespace rcm
+
+#endif  // RCM_ESTIMATION_CALIBRATION_PROPAGATION_H_

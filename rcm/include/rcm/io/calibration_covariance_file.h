@@ -1,0 +1,90 @@
+// The covariance sidecar of a camchain: how well the calibration in
+// camchain.yaml is known, in camchain-covariance.yaml next to it (rcm's
+// own file; Kalibr knows nothing of it). `rcm calibrate` writes it with the
+// camchain (in air, and with --underwater); ReadStereoRig (stereo_rig_file.h)
+// reads it with the camchain and hands the estimators the rig's
+// CalibrationUncertainty (calibration_uncertainty.h).
+//
+//   # rcm: covariance of the calibration in camchain.yaml
+//   medium: air                  # where it was calibrated: air | water
+//   drift_prior:                 # what the rig may drift after it, per axis
+//     rotation_deg: 0.1          #   (the estimators add it to the
+//     translation_mm: 0.1        #   covariance below)
+//   cam0:
+//     intrinsics_covariance:     # of [fx, fy, cx, cy, d...] (Camera::params)
+//     - [0.137, 0.13, ...]       # rows, as many as the camera has parameters
+//     ...
+//   cam1:
+//     intrinsics_covariance: ...
+//     T_cn_cnm1_covariance:      # 6x6, of [w; dt] of T_cn_cnm1 = cam1_from_cam0:
+//     - [...]                    # (exp([w]x) R, exp([w]x) t + dt), w in
+//     ...                        # radians and dt in meters, cam1 frame
+//
+// Every key but `medium` is optional (a camera without intrinsics_covariance
+// has lenses taken as exact; cam0 never has T_cn_cnm1_covariance). Numbers
+// are written as the shortest text that reads back to the same double, so
+// that a file reads back bit for bit. Reading never throws; errors are one
+// line, "SOURCE[:LINE]: FIELD: MESSAGE" as for the camchain (yaml_fields.h).
+#ifndef RCM_IO_CALIBRATION_COVARIANCE_FILE_H_
+#define RCM_IO_CALIBRATION_COVARIANCE_FILE_H_
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rcm/geometry/calibration_uncertainty.h"
+#include "rcm/util/status.h"
+
+namespace rcm {
+
+struct CalibrationCovarianceFile {
+  struct Camera {
+    // Of Camera::params(); empty when absent.
+    Eigen::MatrixXd intrinsics_covariance;
+    // Of [w; dt] of T_cn_cnm1; absent on cam0.
+    std::optional<Eigen::Matrix<double, 6, 6>> from_previous_covariance;
+  };
+  // "air" or "water".
+  std::string medium = "air";
+  // The drift prior's per-axis standard deviations, radians and meters.
+  double drift_rotation_sigma = 0.0;
+  double drift_translation_sigma = 0.0;
+  // cameras[k] is camk.
+  std::vector<Camera> cameras;
+};
+
+// camchain.yaml -> camchain-covariance.yaml (same folder, the camchain's
+// name without its extension, then "-covariance.yaml").
+std::string CovarianceSidecarPath(const std::string& camchain_path);
+
+// Parses the text; `source_name` prefixes every error. Fails on a missing
+// or unknown medium, an unknown key, a matrix that is not square (or not
+// 6x6), not finite, not symmetric or not positive semi-definite, a drift
+// prior that is negative, and cameras that are not cam0, cam1, ...
+// consecutively.
+StatusOr<CalibrationCovarianceFile> ParseCalibrationCovariance(
+    const std::string& text, const std::string& source_name);
+StatusOr<CalibrationCovarianceFile> ReadCalibrationCovariance(
+    const std::string& path);
+
+std::string FormatCalibrationCovariance(const CalibrationCovarianceFile& file);
+// Writes atomically (atomic_file.h).
+Status WriteCalibrationCovariance(const std::string& path,
+                                  const CalibrationCovarianceFile& file);
+
+// The uncertainty of the stereo pair (cam<left_index>, cam<right_index>):
+// the two cameras' intrinsics covariances, and the extrinsics' covariance
+// of T_cn_cnm1 when right_index = left_index + 1 (other pairs chain several
+// transforms: their extrinsics get the drift prior alone), plus the file's
+// drift prior, or `drift_override` (rotation, translation sigmas) when
+// given. `source` names the file in CalibrationUncertainty::source.
+// Fails on an index beyond the file's cameras.
+StatusOr<CalibrationUncertainty> PairCalibrationUncertainty(
+    const CalibrationCovarianceFile& file, int left_index, int right_index,
+    const std::string& source,
+    std::optional<std::pair<double, double>> drift_override = std::nullopt);
+
+}  // namespace rcm
+
+#endif  // RCM_IO_CALIBRATION_COVARIANCE_FILE_H_

@@ -1,0 +1,371 @@
+#include "rcm/estimation/calibration_propagation.h"
+
+#include <ceres/jet.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <utility>
+
+#include "rcm/estimation/sampson_coplanarity_error.h"
+#include "rcm/geometry/epipolar.h"
+
+namespace rcm {
+namespace {
+
+// Central-difference steps (see the header).
+constexpr double kTranslationStep = 1e-6;  // meters
+constexpr double kLensStepScale = 1e-6;    // times (1 + |p|)
+
+// The camera with parameter `index` of params() moved by `step`; nullopt
+// when the moved camera is invalid (a parameter at the edge of its range).
+std::optional<Camera> MovedCamera(const Camera& camera, int index,
+                                  double step) {
+  std::vector<double> params(camera.params(),
+                             camera.params() + camera.num_params());
+  params[index] += step;
+  StatusOr<Camera> moved = Camera::Create(
+      camera.model(), camera.width(), camera.height(),
+      {params[0], params[1], params[2], params[3]},
+      std::vector<double>(params.begin() + 4, params.end()));
+  if (!moved.ok()) return std::nullopt;
+  return *moved;
+}
+
+// One finite-difference column: the rig moved both ways and the step.
+struct Difference {
+  std::optional<StereoRig> plus;
+  std::optional<StereoRig> minus;
+  double step = 0.0;
+};
+
+std::vector<Difference> LensDifferences(const StereoRig& rig,
+                                        const CalibrationParameterLayout& layout) {
+  std::vector<Difference> differences;
+  for (int c = 0; c < 2; ++c) {
+    const Camera& camera = c == 0 ? rig.left() : rig.right();
+    const int count = c == 0 ? layout.num_left_lens : layout.num_right_lens;
+    for (int j = 0; j < count; ++j) {
+      Difference difference;
+      difference.step = kLensStepScale * (1.0 + std::abs(camera.params()[j]));
+      for (const double sign : {1.0, -1.0}) {
+        const std::optional<Camera> moved =
+            MovedCamera(camera, j, sign * difference.step);
+        if (!moved) continue;
+        StatusOr<StereoRig> moved_rig =
+            c == 0 ? StereoRig::Create(*moved, rig.right(), rig.right_from_left())
+                   : StereoRig::Create(rig.left(), *moved, rig.right_from_left());
+        if (!moved_rig.ok()) continue;
+        (sign > 0.0 ? difference.plus : difference.minus) = *moved_rig;
+      }
+      differences.push_back(std::move(difference));
+    }
+  }
+  return differences;
+}
+
+}  // namespace
+
+CalibrationParameterLayout CalibrationParameterLayout::Of(const StereoRig& rig) {
+  CalibrationParameterLayout layout;
+  if (const std::optional<CalibrationUncertainty>& uncertainty =
+          rig.calibration_uncertainty()) {
+    if (uncertainty->left_lens_covariance.size() > 0) {
+      layout.num_left_lens = rig.left().num_params();
+    }
+    if (uncertainty->right_lens_covariance.size() > 0) {
+      layout.num_right_lens = rig.right().num_params();
+    }
+  }
+  return layout;
+}
+
+void LocusNormalEquations::Add(const LocusNormalEquations& other) {
+  information += other.information;
+  gradient += other.gradient;
+  squared_residuals += other.squared_residuals;
+  count += other.count;
+}
+
+void LocusNormalEquations::Subtract(const LocusNormalEquations& other) {
+  information -= other.information;
+  gradient -= other.gradient;
+  squared_residuals -= other.squared_residuals;
+  count -= other.count;
+}
+
+void AccumulateLocusNormalEquations(
+    const StereoRig& rig, const std::vector<StereoCorrespondence>& raw,
+    const std::vector<PreparedCorrespondence>& matches,
+    const std::vector<int64_t>& indices, double n,
+    const Eigen::Vector3d& rotation, LocusNormalEquations* equations,
+    std::vector<LocusNormalEquations>* per_frame) {
+  const CalibrationParameterLayout layout = CalibrationParameterLayout::Of(rig);
+  const int size = layout.Size();
+  CHECK_EQ(equations->information.rows(), size);
+  const Eigen::Matrix3d essential = EssentialMatrix(rig.right_from_left());
+  // The essential matrices of the rotated rig with its translation moved.
+  std::array<std::optional<Eigen::Matrix3d>, 6> moved_essential;
+  for (int k = 0; k < 3; ++k) {
+    for (int s = 0; s < 2; ++s) {
+      Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+      shift[k] = s == 0 ? kTranslationStep : -kTranslationStep;
+      const StatusOr<StereoRig> moved = rig.WithCam1Moved(rotation, shift);
+      if (moved.ok()) {
+        moved_essential[2 * k + s] = EssentialMatrix(moved->right_from_left());
+      }
+    }
+  }
+  const std::vector<Difference> lens = LensDifferences(rig, layout);
+
+  using Jet = ceres::Jet<double, 4>;
+  const Jet n_jet(n, 0);
+  const Jet rotation_jet[3] = {Jet(rotation[0], 1), Jet(rotation[1], 2),
+                               Jet(rotation[2], 3)};
+  std::map<int64_t, size_t> frame_slot;
+  Eigen::VectorXd row(size);
+  for (const int64_t i : indices) {
+    const PreparedCorrespondence& match = matches[i];
+    Jet residual;
+    if (!SampsonCoplanarityResidual<Jet>(essential, match, n_jet, rotation_jet,
+                                         &residual) ||
+        !ceres::isfinite(residual)) {
+      continue;
+    }
+    for (int k = 0; k < 4; ++k) row[k] = residual.v[k];
+    bool defined = true;
+    for (int k = 0; k < 3 && defined; ++k) {
+      double values[2];
+      for (int s = 0; s < 2 && defined; ++s) {
+        defined = moved_essential[2 * k + s].has_value() &&
+                  SampsonCoplanarityResidual<double>(
+                      *moved_essential[2 * k + s], match, n, nullptr,
+                      &values[s]);
+      }
+      if (defined) {
+        row[CalibrationParameterLayout::kTranslation + k] =
+            (values[0] - values[1]) / (2.0 * kTranslationStep);
+      }
+    }
+    for (size_t j = 0; j < lens.size() && defined; ++j) {
+      double values[2];
+      for (int s = 0; s < 2 && defined; ++s) {
+        const std::optional<StereoRig>& moved =
+            s == 0 ? lens[j].plus : lens[j].minus;
+        const std::optional<PreparedCorrespondence> prepared =
+            moved ? PrepareCorrespondence(*moved, raw[i]) : std::nullopt;
+        defined = prepared.has_value() &&
+                  SampsonCoplanarityResidual<double>(
+                      essential, *prepared, n, rotation.data(), &values[s]);
+      }
+      if (defined) {
+        row[layout.LeftLens() + static_cast<int>(j)] =
+            (values[0] - values[1]) / (2.0 * lens[j].step);
+      }
+    }
+    if (!defined || !row.allFinite()) continue;
+    const double r = residual.a;
+    equations->information.selfadjointView<Eigen::Lower>().rankUpdate(row);
+    equations->gradient += r * row;
+    equations->squared_residuals += r * r;
+    ++equations->count;
+    if (per_frame != nullptr) {
+      const auto [slot, inserted] =
+          frame_slot.emplace(raw[i].frame, per_frame->size());
+      if (inserted) per_frame->emplace_back(size);
+      LocusNormalEquations& frame = (*per_frame)[slot->second];
+      frame.information.selfadjointView<Eigen::Lower>().rankUpdate(row);
+      frame.gradient += r * row;
+      frame.squared_residuals += r * r;
+      ++frame.count;
+    }
+  }
+  // rankUpdate fills the lower triangle only.
+  const auto symmetrize = [](Eigen::MatrixXd* matrix) {
+    *matrix = matrix->selfadjointView<Eigen::Lower>();
+  };
+  symmetrize(&equations->information);
+  if (per_frame != nullptr) {
+    for (LocusNormalEquations& frame : *per_frame) {
+      symmetrize(&frame.information);
+    }
+  }
+}
+
+double ChiSquaredUpperTail(double chi_squared, int dof) {
+  CHECK_GE(dof, 1);
+  if (!(chi_squared > 0.0)) return 1.0;
+  const double k = static_cast<double>(dof);
+  const double scale = 2.0 / (9.0 * k);
+  const double z = (std::cbrt(chi_squared / k) - (1.0 - scale)) /
+                   std::sqrt(scale);
+  return 0.5 * std::erfc(z / std::sqrt(2.0));
+}
+
+std::optional<FrameConsistency> FrameConsistencyOf(
+    const std::vector<LocusNormalEquations>& per_frame, double sigma_px) {
+  FrameConsistency consistency;
+  for (const LocusNormalEquations& frame : per_frame) {
+    const double information = frame.information(0, 0);
+    if (!(information > 0.0)) continue;
+    const double score = frame.gradient[0];
+    consistency.chi_squared +=
+        score * score / (sigma_px * sigma_px * information);
+    ++consistency.frames;
+  }
+  if (consistency.frames < 2 || !(sigma_px > 0.0)) return std::nullopt;
+  consistency.dof = consistency.frames - 1;
+  consistency.p_value =
+      ChiSquaredUpperTail(consistency.chi_squared, consistency.dof);
+  if (consistency.p_value < FrameConsistency::kInflationP &&
+      consistency.chi_squared > consistency.dof) {
+    consistency.inflation = std::sqrt(consistency.chi_squared / consistency.dof);
+  }
+  return consistency;
+}
+
+StatusOr<CalibrationPropagation> PropagateCalibration(
+    const LocusNormalEquations& equations,
+    const CalibrationParameterLayout& layout,
+    const CalibrationUncertainty& uncertainty, RotationMode mode,
+    double sigma_px, double noise_inflation) {
+  const int size = layout.Size();
+  CHECK_EQ(equations.information.rows(), size);
+  CHECK(sigma_px >= 0.0 && noise_inflation >= 1.0);
+  const Eigen::MatrixXd& m = equations.information;
+  CalibrationPropagation result;
+  result.mode = mode;
+  result.source = uncertainty.source;
+
+  // The calibration's covariance in the layout's columns (n's is 0).
+  Eigen::MatrixXd calibration = Eigen::MatrixXd::Zero(size, size);
+  calibration.block<6, 6>(1, 1) = uncertainty.extrinsics_covariance;
+  if (layout.num_left_lens > 0) {
+    calibration.block(layout.LeftLens(), layout.LeftLens(),
+                      layout.num_left_lens, layout.num_left_lens) =
+        uncertainty.left_lens_covariance;
+  }
+  if (layout.num_right_lens > 0) {
+    calibration.block(layout.RightLens(), layout.RightLens(),
+                      layout.num_right_lens, layout.num_right_lens) =
+        uncertainty.right_lens_covariance;
+  }
+
+  const double m_nn = m(0, 0);
+  if (!(m_nn > 0.0)) {
+    return Status::Error("the correspondences carry no information on n");
+  }
+  for (int k = 0; k < 3; ++k) {
+    result.dn_drotation[k] = -m(0, 1 + k) / m_nn;
+    result.dn_dtranslation[k] = -m(0, 4 + k) / m_nn;
+  }
+  // Observability of w from the data alone.
+  {
+    const Eigen::Matrix4d joint = m.topLeftCorner<4, 4>();
+    const Eigen::FullPivLU<Eigen::Matrix4d> lu(joint);
+    if (lu.isInvertible()) {
+      const double joint_nn = lu.inverse()(0, 0);
+      const double ratio = 1.0 / (m_nn * joint_nn);  // 1 - R^2
+      result.rotation_multiple_correlation =
+          std::sqrt(std::clamp(1.0 - ratio, 0.0, 1.0));
+      result.rotation_sigma_inflation =
+          ratio > 0.0 ? 1.0 / std::sqrt(ratio) : INFINITY;
+    } else {
+      result.rotation_multiple_correlation = 1.0;
+      result.rotation_sigma_inflation = INFINITY;
+    }
+  }
+
+  // Estimated and held columns.
+  std::vector<int> estimated = {0};
+  std::vector<int> held;
+  const bool rotation_estimated = mode != RotationMode::kHeld;
+  for (int k = 1; k < size; ++k) {
+    (rotation_estimated && k <= 3 ? estimated : held).push_back(k);
+  }
+  const int nx = static_cast<int>(estimated.size());
+  const int np = static_cast<int>(held.size());
+  const double variance = sigma_px * sigma_px;
+  Eigen::MatrixXd a(nx, nx), b(nx, np), sigma_p(np, np);
+  for (int r = 0; r < nx; ++r) {
+    for (int c = 0; c < nx; ++c) a(r, c) = m(estimated[r], estimated[c]);
+    for (int c = 0; c < np; ++c) b(r, c) = m(estimated[r], held[c]);
+  }
+  for (int r = 0; r < np; ++r) {
+    for (int c = 0; c < np; ++c) sigma_p(r, c) = calibration(held[r], held[c]);
+  }
+  Eigen::MatrixXd prior = Eigen::MatrixXd::Zero(nx, nx);
+  if (mode == RotationMode::kPrior) {
+    const Eigen::Matrix3d rotation_covariance = uncertainty.RotationCovariance();
+    const Eigen::LDLT<Eigen::Matrix3d> ldlt(rotation_covariance);
+    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) {
+      return Status::Error(
+          "the rotation prior is singular: give every axis a drift sigma > 0");
+    }
+    prior.bottomRightCorner<3, 3>() = ldlt.solve(Eigen::Matrix3d::Identity());
+  }
+  // In the sigma^2-scaled form, stable down to exact data (sigma = 0):
+  // H' = sigma^2 H = A + sigma^2 P, S = H'^-1 B.
+  const Eigen::MatrixXd h = a + variance * prior;
+  const Eigen::FullPivLU<Eigen::MatrixXd> lu(h);
+  if (!lu.isInvertible()) {
+    return Status::Error(
+        "the rotation correction cannot be separated from n with these "
+        "correspondences (singular information); estimate n alone");
+  }
+  const Eigen::MatrixXd h_inverse = lu.inverse();
+  const Eigen::MatrixXd noise = variance * h_inverse * a * h_inverse;
+  const Eigen::MatrixXd from_prior =
+      variance * variance * h_inverse * prior * h_inverse;
+  const Eigen::MatrixXd s = h_inverse * b;
+  const Eigen::MatrixXd from_held = s * sigma_p * s.transpose();
+
+  // The held parameters' share, split by kind for the report: rotation
+  // (when held), translation, lenses; cross-covariances between kinds (a
+  // measured covariance of rotation with translation) go with the
+  // translation.
+  const auto group_of = [](int column) {
+    return column <= 3 ? 0 : column <= 6 ? 1 : 2;
+  };
+  double shares[3] = {0.0, 0.0, 0.0};
+  for (int g = 0; g < 3; ++g) {
+    Eigen::MatrixXd part = Eigen::MatrixXd::Zero(np, np);
+    for (int r = 0; r < np; ++r) {
+      for (int c = 0; c < np; ++c) {
+        if (group_of(held[r]) == g && group_of(held[c]) == g) {
+          part(r, c) = sigma_p(r, c);
+        }
+      }
+    }
+    shares[g] = (s.row(0) * part * s.row(0).transpose())(0, 0);
+  }
+  result.variance_rotation = shares[0];
+  result.variance_lenses = shares[2];
+  result.variance_translation = from_held(0, 0) - shares[0] - shares[2];
+  result.variance_rotation += from_prior(0, 0);
+
+  const double noise_variance =
+      noise(0, 0) * noise_inflation * noise_inflation;
+  const double calibration_variance =
+      std::max(0.0, from_prior(0, 0) + from_held(0, 0));
+  result.sigma_n_noise = std::sqrt(std::max(0.0, noise_variance));
+  result.sigma_n_calibration = std::sqrt(calibration_variance);
+  result.sigma_n = std::sqrt(std::max(0.0, noise_variance) + calibration_variance);
+
+  if (rotation_estimated) {
+    const Eigen::MatrixXd total =
+        noise * noise_inflation * noise_inflation + from_prior + from_held;
+    result.rotation_covariance = total.bottomRightCorner<3, 3>();
+    for (int k = 0; k < 3; ++k) {
+      const double denominator = std::sqrt(total(0, 0) * total(1 + k, 1 + k));
+      result.rotation_correlation_with_n[k] =
+          denominator > 0.0 ? total(0, 1 + k) / denominator : 0.0;
+    }
+  }
+  return result;
+}
+
+}  // namespace rcm

@@ -1,0 +1,98 @@
+#include "rcm/geometry/calibration_uncertainty.h"
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <sstream>
+
+namespace rcm {
+namespace {
+
+constexpr double kDegree = M_PI / 180.0;
+
+}  // namespace
+
+// Tolerances: the round-off of a covariance computed as J C J^T or read
+// from 17-digit text.
+Status CheckCovarianceMatrix(const Eigen::MatrixXd& matrix,
+                             const std::string& name) {
+  if (matrix.rows() != matrix.cols()) {
+    return Status::Error(name + " is not square");
+  }
+  if (!matrix.allFinite()) return Status::Error(name + " is not finite");
+  const double scale = matrix.cwiseAbs().maxCoeff();
+  if (scale == 0.0) return Status::Ok();
+  if ((matrix - matrix.transpose()).cwiseAbs().maxCoeff() > 1e-9 * scale) {
+    return Status::Error(name + " is not symmetric");
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(
+      0.5 * (matrix + matrix.transpose()), Eigen::EigenvaluesOnly);
+  if (solver.eigenvalues().minCoeff() < -1e-9 * scale) {
+    return Status::Error(name + " is not positive semi-definite");
+  }
+  return Status::Ok();
+}
+
+CalibrationUncertainty CalibrationUncertainty::DriftPrior(
+    double rotation_sigma, double translation_sigma) {
+  CalibrationUncertainty uncertainty;
+  uncertainty.AddDrift(rotation_sigma, translation_sigma);
+  uncertainty.source = DescribeDriftPrior(rotation_sigma, translation_sigma);
+  return uncertainty;
+}
+
+CalibrationUncertainty CalibrationUncertainty::DefaultDriftPrior() {
+  CalibrationUncertainty uncertainty =
+      DriftPrior(kDefaultDriftDegrees * kDegree, 1e-3 * kDefaultDriftMillimeters);
+  uncertainty.source = "default " + uncertainty.source;
+  return uncertainty;
+}
+
+std::string CalibrationUncertainty::DescribeDriftPrior(
+    double rotation_sigma, double translation_sigma) {
+  std::ostringstream text;
+  text.precision(3);
+  text << "drift prior " << rotation_sigma / kDegree << " deg, "
+       << 1e3 * translation_sigma << " mm per axis";
+  return text.str();
+}
+
+void CalibrationUncertainty::AddDrift(double rotation_sigma,
+                                      double translation_sigma) {
+  for (int k = 0; k < 3; ++k) {
+    extrinsics_covariance(k, k) += rotation_sigma * rotation_sigma;
+    extrinsics_covariance(3 + k, 3 + k) += translation_sigma * translation_sigma;
+  }
+}
+
+bool CalibrationUncertainty::IsZero() const {
+  return extrinsics_covariance.isZero(0.0) &&
+         (left_lens_covariance.size() == 0 ||
+          left_lens_covariance.isZero(0.0)) &&
+         (right_lens_covariance.size() == 0 ||
+          right_lens_covariance.isZero(0.0));
+}
+
+Status CalibrationUncertainty::Check(int left_num_params,
+                                     int right_num_params) const {
+  RCM_RETURN_IF_ERROR(
+      CheckCovarianceMatrix(extrinsics_covariance, "cam1_from_cam0 covariance"));
+  const Eigen::MatrixXd* lenses[2] = {&left_lens_covariance,
+                                      &right_lens_covariance};
+  const int sizes[2] = {left_num_params, right_num_params};
+  for (int c = 0; c < 2; ++c) {
+    const std::string name =
+        std::string(c == 0 ? "left" : "right") + " lens covariance";
+    if (lenses[c]->size() == 0) continue;
+    if (lenses[c]->rows() != sizes[c] || lenses[c]->cols() != sizes[c]) {
+      std::ostringstream message;
+      message << name << " is " << lenses[c]->rows() << "x"
+              << lenses[c]->cols() << ", the camera has " << sizes[c]
+              << " parameters";
+      return Status::Error(message.str());
+    }
+    RCM_RETURN_IF_ERROR(CheckCovarianceMatrix(*lenses[c], name));
+  }
+  return Status::Ok();
+}
+
+}  // namespace rcm

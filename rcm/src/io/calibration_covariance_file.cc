@@ -1,0 +1,239 @@
+#include "rcm/io/calibration_covariance_file.h"
+
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+#include <utility>
+
+#include "rcm/io/atomic_file.h"
+#include "rcm/io/camchain.h"
+#include "rcm/io/number_format.h"
+#include "rcm/io/yaml_fields.h"
+
+namespace rcm {
+namespace {
+
+constexpr double kDegree = M_PI / 180.0;
+
+// A square matrix written as a list of rows of numbers, `size` of them
+// (or any size for size < 0), checked by CheckCovarianceMatrix.
+StatusOr<Eigen::MatrixXd> ReadCovariance(const YamlReader& reader,
+                                         const YAML::Node& node,
+                                         const std::string& field, int size) {
+  if (!node.IsSequence() || node.size() == 0) {
+    return reader.Error(node, field,
+                        "expected a square matrix (a list of rows), got " +
+                            DescribeYamlNode(node));
+  }
+  const int rows = static_cast<int>(node.size());
+  if (size >= 0 && rows != size) {
+    return reader.Error(node, field,
+                        "expected " + std::to_string(size) + " rows, got " +
+                            std::to_string(rows));
+  }
+  Eigen::MatrixXd matrix(rows, rows);
+  for (int r = 0; r < rows; ++r) {
+    const StatusOr<std::vector<double>> row = reader.NumberList(
+        node[r], field + " row " + std::to_string(r + 1), rows);
+    if (!row.ok()) return row.status();
+    for (int c = 0; c < rows; ++c) matrix(r, c) = (*row)[c];
+  }
+  const Status valid = CheckCovarianceMatrix(matrix, "the matrix");
+  if (!valid.ok()) {
+    // "the matrix is not symmetric" -> "is not symmetric".
+    return reader.Error(node, field, valid.message().substr(11));
+  }
+  return matrix;
+}
+
+StatusOr<CalibrationCovarianceFile> ReadDocument(const YamlReader& reader,
+                                                 const YAML::Node& root) {
+  const StatusOr<YamlEntries> entries =
+      reader.RootEntries(root, "expected medium, drift_prior, cam0, ...");
+  if (!entries.ok()) return entries.status();
+  CalibrationCovarianceFile file;
+  const YamlEntry* medium = FindYamlEntry(*entries, "medium");
+  if (medium == nullptr) return reader.MissingKey("", "medium");
+  const StatusOr<std::string> medium_name =
+      reader.String(medium->value, "medium");
+  if (!medium_name.ok()) return medium_name.status();
+  if (*medium_name != "air" && *medium_name != "water") {
+    return reader.Error(medium->value, "medium",
+                        "expected air or water, got '" + *medium_name + "'");
+  }
+  file.medium = *medium_name;
+
+  int num_cameras = 0;
+  for (const auto& [key, entry] : *entries) {
+    if (key == "medium" || key == "drift_prior") continue;
+    const std::optional<int> index = CamchainCameraIndex(key);
+    if (!index) {
+      return reader.Error(entry.key, key,
+                          "unknown key (expected medium, drift_prior, cam0, "
+                          "cam1, ...)");
+    }
+    num_cameras = std::max(num_cameras, *index + 1);
+  }
+  if (const YamlEntry* drift = FindYamlEntry(*entries, "drift_prior")) {
+    const StatusOr<YamlEntries> fields =
+        reader.Entries(drift->value, "drift_prior");
+    if (!fields.ok()) return fields.status();
+    for (const auto& [key, entry] : *fields) {
+      if (key != "rotation_deg" && key != "translation_mm") {
+        return reader.Error(entry.key, "drift_prior." + key,
+                            "unknown key (expected rotation_deg, "
+                            "translation_mm)");
+      }
+      const StatusOr<double> value =
+          reader.Number(entry.value, "drift_prior." + key);
+      if (!value.ok()) return value.status();
+      if (*value < 0.0) {
+        return reader.Error(entry.value, "drift_prior." + key,
+                            "must be >= 0");
+      }
+      if (key == "rotation_deg") {
+        file.drift_rotation_sigma = *value * kDegree;
+      } else {
+        file.drift_translation_sigma = 1e-3 * *value;
+      }
+    }
+  }
+  file.cameras.resize(num_cameras);
+  for (int k = 0; k < num_cameras; ++k) {
+    const std::string name = "cam" + std::to_string(k);
+    const YamlEntry* camera = FindYamlEntry(*entries, name);
+    if (camera == nullptr) {
+      return reader.Error(name, "missing (cameras must be cam0, cam1, ... "
+                                "without gaps)");
+    }
+    const StatusOr<YamlEntries> fields = reader.Entries(camera->value, name);
+    if (!fields.ok()) return fields.status();
+    for (const auto& [key, entry] : *fields) {
+      const std::string field = name + "." + key;
+      if (key == "intrinsics_covariance") {
+        StatusOr<Eigen::MatrixXd> matrix =
+            ReadCovariance(reader, entry.value, field, -1);
+        if (!matrix.ok()) return matrix.status();
+        file.cameras[k].intrinsics_covariance = std::move(matrix).value();
+      } else if (key == "T_cn_cnm1_covariance" && k > 0) {
+        const StatusOr<Eigen::MatrixXd> matrix =
+            ReadCovariance(reader, entry.value, field, 6);
+        if (!matrix.ok()) return matrix.status();
+        file.cameras[k].from_previous_covariance = *matrix;
+      } else {
+        return reader.Error(entry.key, field,
+                            k == 0 ? "unknown key (cam0 has "
+                                     "intrinsics_covariance)"
+                                   : "unknown key (expected "
+                                     "intrinsics_covariance, "
+                                     "T_cn_cnm1_covariance)");
+      }
+    }
+  }
+  return file;
+}
+
+void AppendMatrix(const Eigen::MatrixXd& matrix, std::ostringstream* out) {
+  for (int r = 0; r < matrix.rows(); ++r) {
+    *out << "    - [";
+    for (int c = 0; c < matrix.cols(); ++c) {
+      *out << (c ? ", " : "") << FormatDouble(matrix(r, c));
+    }
+    *out << "]\n";
+  }
+}
+
+}  // namespace
+
+std::string CovarianceSidecarPath(const std::string& camchain_path) {
+  const std::filesystem::path path(camchain_path);
+  return (path.parent_path() / (path.stem().string() + "-covariance.yaml"))
+      .string();
+}
+
+StatusOr<CalibrationCovarianceFile> ParseCalibrationCovariance(
+    const std::string& text, const std::string& source_name) {
+  const YamlReader reader(source_name);
+  return reader.ReadDocument(
+      text, "the calibration covariance",
+      [&](const YAML::Node& root) { return ReadDocument(reader, root); });
+}
+
+StatusOr<CalibrationCovarianceFile> ReadCalibrationCovariance(
+    const std::string& path) {
+  const StatusOr<std::string> text = ReadFileToString(path);
+  if (!text.ok()) return text.status();
+  return ParseCalibrationCovariance(*text, path);
+}
+
+std::string FormatCalibrationCovariance(const CalibrationCovarianceFile& file) {
+  std::ostringstream out;
+  out << "# rcm: covariance of the calibration in the camchain next to this "
+         "file\n"
+      << "# intrinsics_covariance: of [fx, fy, cx, cy, d...]; "
+         "T_cn_cnm1_covariance: of [w; dt],\n"
+      << "# T_cn_cnm1 = (exp([w]x) R, exp([w]x) t + dt), w radians, dt "
+         "meters, camn frame\n";
+  out << "medium: " << file.medium << "\n";
+  out << "drift_prior:\n"
+      << "  rotation_deg: " << FormatDouble(file.drift_rotation_sigma / kDegree)
+      << "\n"
+      << "  translation_mm: "
+      << FormatDouble(1e3 * file.drift_translation_sigma) << "\n";
+  for (size_t k = 0; k < file.cameras.size(); ++k) {
+    const CalibrationCovarianceFile::Camera& camera = file.cameras[k];
+    out << "cam" << k << ":";
+    if (camera.intrinsics_covariance.size() == 0 &&
+        !camera.from_previous_covariance) {
+      out << " {}\n";
+      continue;
+    }
+    out << "\n";
+    if (camera.intrinsics_covariance.size() > 0) {
+      out << "  intrinsics_covariance:\n";
+      AppendMatrix(camera.intrinsics_covariance, &out);
+    }
+    if (camera.from_previous_covariance && k > 0) {
+      out << "  T_cn_cnm1_covariance:\n";
+      AppendMatrix(*camera.from_previous_covariance, &out);
+    }
+  }
+  return out.str();
+}
+
+Status WriteCalibrationCovariance(const std::string& path,
+                                  const CalibrationCovarianceFile& file) {
+  return WriteFileAtomically(path, FormatCalibrationCovariance(file));
+}
+
+StatusOr<CalibrationUncertainty> PairCalibrationUncertainty(
+    const CalibrationCovarianceFile& file, int left_index, int right_index,
+    const std::string& source,
+    std::optional<std::pair<double, double>> drift_override) {
+  const int num_cameras = static_cast<int>(file.cameras.size());
+  for (const int index : {left_index, right_index}) {
+    if (index < 0 || index >= num_cameras) {
+      return Status::Error(source + ": has no cam" + std::to_string(index));
+    }
+  }
+  CalibrationUncertainty uncertainty;
+  uncertainty.left_lens_covariance =
+      file.cameras[left_index].intrinsics_covariance;
+  uncertainty.right_lens_covariance =
+      file.cameras[right_index].intrinsics_covariance;
+  if (right_index == left_index + 1 &&
+      file.cameras[right_index].from_previous_covariance) {
+    uncertainty.extrinsics_covariance =
+        *file.cameras[right_index].from_previous_covariance;
+  }
+  const auto [rotation, translation] = drift_override.value_or(
+      std::pair<double, double>{file.drift_rotation_sigma,
+                                file.drift_translation_sigma});
+  uncertainty.AddDrift(rotation, translation);
+  uncertainty.source =
+      source + " (" + file.medium + " calibration) + " +
+      CalibrationUncertainty::DescribeDriftPrior(rotation, translation);
+  return uncertainty;
+}
+
+}  // namespace rcm
