@@ -47,6 +47,24 @@ StereoRig AlphasenseIdealRig() { return AlphasenseFrontRectifiedRig(); }
 
 StereoRig AlphasenseRealisticRig() { return AlphasenseFrontUnrectifiedRig(); }
 
+StereoRig NarrowRadtanRig() {
+  const Camera left = Camera::Create(LensModelId::kRadTan, 640, 480,
+                                     {500.0, 500.0, 322.0, 238.0},
+                                     {-0.12, 0.05, 1e-4, -2e-4})
+                          .value();
+  const Camera right = Camera::Create(LensModelId::kRadTan, 640, 480,
+                                      {503.0, 502.0, 317.0, 243.0},
+                                      {-0.11, 0.04, -1e-4, 1e-4})
+                           .value();
+  const double toe_in = 2.5 * M_PI / 180.0;
+  Rigid3d right_from_left;
+  right_from_left.rotation =
+      Eigen::AngleAxisd(toe_in, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  right_from_left.translation =
+      -(right_from_left.rotation * Eigen::Vector3d(0.065, 0.0, 0.0));
+  return StereoRig::Create(left, right, right_from_left).value();
+}
+
 std::vector<StereoCorrespondence> ExactMatches(const StereoRig& rig, double n,
                                                int count, uint64_t seed) {
   StereoSamplerOptions options;

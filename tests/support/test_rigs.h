@@ -35,6 +35,11 @@ StereoRig AlphasenseIdealRig();
 // a baseline slightly off the x axis: a real, unrectified rig.
 StereoRig AlphasenseRealisticRig();
 
+// A hand-built narrow-field housing (the rig of the drifting-rig issue):
+// two 640x480 radtan cameras, f ~ 500 px, 65 mm baseline, 2.5 degrees of
+// toe-in (cam1 turned about y, the axes converging ~1.5 m ahead).
+StereoRig NarrowRadtanRig();
+
 // `count` exact correspondences of `rig` in a medium of index n, one frame,
 // depths 0.6-6 m (rcm/sim/stereo_sampler.h).
 std::vector<StereoCorrespondence> ExactMatches(const StereoRig& rig, double n,

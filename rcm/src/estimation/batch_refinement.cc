@@ -6,7 +6,6 @@
 
 #include <Eigen/Cholesky>
 #include <algorithm>
-#include <iomanip>
 #include <limits>
 #include <cmath>
 #include <memory>
@@ -28,9 +27,7 @@ namespace {
 
 // The paper's mask threshold, for the closed-form seed.
 constexpr double kSeedMaskEta = 0.3;
-// n's upper bound, and how close to it an estimate counts as pinned there.
-constexpr double kUpperBound = 2.0;
-constexpr double kPinnedTolerance = 1e-6;
+
 
 // The median of eq. 14 over the matches that pass the paper's mask.
 std::optional<double> ClosedFormSeed(
@@ -350,16 +347,7 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
   if (rig.calibration_uncertainty()) summary.calibration = *propagation;
 
   // An estimate pinned at the upper bound is a failure, not a number.
-  if (summary.n >= kUpperBound - kPinnedTolerance) {
-    std::ostringstream message;
-    message << "n = " << std::fixed << std::setprecision(4) << summary.n
-            << " is at the upper bound of [1, 2], which no medium reaches: "
-               "the rig has likely moved since its calibration (cam1 turned "
-               "by a few tenths of a degree) or the rig file is not this "
-               "rig's; calibrate in the water (rcm calibrate --underwater) "
-               "or estimate the rotation with n (--refine-rotation)";
-    return Status::Error(message.str());
-  }
+  RCM_RETURN_IF_ERROR(CheckNotPinnedAtUpperBound(summary.n));
 
   summary.inliers.reserve(inliers.size());
   for (const int64_t i : inliers) {

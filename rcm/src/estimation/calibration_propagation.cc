@@ -10,6 +10,7 @@
 #include <map>
 #include <utility>
 
+#include "rcm/estimation/generalized_epipolar_error.h"
 #include "rcm/estimation/sampson_coplanarity_error.h"
 #include "rcm/geometry/epipolar.h"
 
@@ -17,6 +18,7 @@ namespace rcm {
 namespace {
 
 // Central-difference steps (see the header).
+constexpr double kRotationStep = 1e-6;     // radians
 constexpr double kTranslationStep = 1e-6;  // meters
 constexpr double kLensStepScale = 1e-6;    // times (1 + |p|)
 
@@ -97,6 +99,47 @@ void LocusNormalEquations::Subtract(const LocusNormalEquations& other) {
   count -= other.count;
 }
 
+namespace {
+
+// The locus residual of a prepared match for extrinsics `cam1_from_cam0`
+// and its derivative in n: the Sampson coplanarity residual of the thin
+// port, or the generalized epipolar residual of the rig's thick ports.
+class LocusResidualModel {
+ public:
+  LocusResidualModel(const StereoRig& rig, const Rigid3d& cam1_from_cam0)
+      : thick_(rig.HasThickPort()) {
+    if (thick_) {
+      stereo_.left_port = rig.ports()->left;
+      stereo_.right_port = rig.ports()->right;
+      stereo_.cam1_from_cam0 = cam1_from_cam0;
+    } else {
+      essential_ = EssentialMatrix(cam1_from_cam0);
+    }
+  }
+
+  bool Residual(const PreparedCorrespondence& match, double n, double* r,
+                double* dr_dn) const {
+    using Jet = ceres::Jet<double, 1>;
+    Jet residual;
+    const bool ok =
+        thick_ ? GeneralizedEpipolarResidual<Jet>(stereo_, match, Jet(n, 0),
+                                                  Jet(0.0), &residual)
+               : SampsonCoplanarityResidual<Jet>(essential_, match, Jet(n, 0),
+                                                 nullptr, &residual);
+    if (!ok || !ceres::isfinite(residual)) return false;
+    *r = residual.a;
+    if (dr_dn != nullptr) *dr_dn = residual.v[0];
+    return true;
+  }
+
+ private:
+  bool thick_;
+  Eigen::Matrix3d essential_ = Eigen::Matrix3d::Zero();
+  ThickPortStereo stereo_;
+};
+
+}  // namespace
+
 void AccumulateLocusNormalEquations(
     const StereoRig& rig, const std::vector<StereoCorrespondence>& raw,
     const std::vector<PreparedCorrespondence>& matches,
@@ -106,60 +149,54 @@ void AccumulateLocusNormalEquations(
   const CalibrationParameterLayout layout = CalibrationParameterLayout::Of(rig);
   const int size = layout.Size();
   CHECK_EQ(equations->information.rows(), size);
-  const Eigen::Matrix3d essential = EssentialMatrix(rig.right_from_left());
-  // The essential matrices of the rotated rig with its translation moved.
-  std::array<std::optional<Eigen::Matrix3d>, 6> moved_essential;
-  for (int k = 0; k < 3; ++k) {
+  // The rig at the solution, and moved both ways along each of w and dt.
+  const StatusOr<StereoRig> at = rig.WithCam1Moved(rotation);
+  if (!at.ok()) return;
+  const LocusResidualModel model(*at, at->right_from_left());
+  std::array<std::optional<LocusResidualModel>, 12> moved;
+  for (int k = 0; k < 6; ++k) {
     for (int s = 0; s < 2; ++s) {
-      Eigen::Vector3d shift = Eigen::Vector3d::Zero();
-      shift[k] = s == 0 ? kTranslationStep : -kTranslationStep;
-      const StatusOr<StereoRig> moved = rig.WithCam1Moved(rotation, shift);
-      if (moved.ok()) {
-        moved_essential[2 * k + s] = EssentialMatrix(moved->right_from_left());
+      Eigen::Vector3d w = rotation;
+      Eigen::Vector3d dt = Eigen::Vector3d::Zero();
+      const double step = (s == 0 ? 1.0 : -1.0) *
+                          (k < 3 ? kRotationStep : kTranslationStep);
+      (k < 3 ? w[k] : dt[k - 3]) += step;
+      const StatusOr<StereoRig> shifted = rig.WithCam1Moved(w, dt);
+      if (shifted.ok()) {
+        moved[2 * k + s].emplace(*shifted, shifted->right_from_left());
       }
     }
   }
-  const std::vector<Difference> lens = LensDifferences(rig, layout);
+  const std::vector<Difference> lens = LensDifferences(*at, layout);
 
-  using Jet = ceres::Jet<double, 4>;
-  const Jet n_jet(n, 0);
-  const Jet rotation_jet[3] = {Jet(rotation[0], 1), Jet(rotation[1], 2),
-                               Jet(rotation[2], 3)};
   std::map<int64_t, size_t> frame_slot;
-  Eigen::VectorXd row(size);
+  LocusNormalEquations::Vector row(size);
   for (const int64_t i : indices) {
     const PreparedCorrespondence& match = matches[i];
-    Jet residual;
-    if (!SampsonCoplanarityResidual<Jet>(essential, match, n_jet, rotation_jet,
-                                         &residual) ||
-        !ceres::isfinite(residual)) {
-      continue;
-    }
-    for (int k = 0; k < 4; ++k) row[k] = residual.v[k];
+    double r = 0.0;
+    if (!model.Residual(match, n, &r, &row[0])) continue;
     bool defined = true;
-    for (int k = 0; k < 3 && defined; ++k) {
+    for (int k = 0; k < 6 && defined; ++k) {
       double values[2];
       for (int s = 0; s < 2 && defined; ++s) {
-        defined = moved_essential[2 * k + s].has_value() &&
-                  SampsonCoplanarityResidual<double>(
-                      *moved_essential[2 * k + s], match, n, nullptr,
-                      &values[s]);
+        defined = moved[2 * k + s].has_value() &&
+                  moved[2 * k + s]->Residual(match, n, &values[s], nullptr);
       }
       if (defined) {
-        row[CalibrationParameterLayout::kTranslation + k] =
-            (values[0] - values[1]) / (2.0 * kTranslationStep);
+        row[1 + k] = (values[0] - values[1]) /
+                     (2.0 * (k < 3 ? kRotationStep : kTranslationStep));
       }
     }
     for (size_t j = 0; j < lens.size() && defined; ++j) {
       double values[2];
       for (int s = 0; s < 2 && defined; ++s) {
-        const std::optional<StereoRig>& moved =
+        const std::optional<StereoRig>& moved_rig =
             s == 0 ? lens[j].plus : lens[j].minus;
         const std::optional<PreparedCorrespondence> prepared =
-            moved ? PrepareCorrespondence(*moved, raw[i]) : std::nullopt;
+            moved_rig ? PrepareCorrespondence(*moved_rig, raw[i])
+                      : std::nullopt;
         defined = prepared.has_value() &&
-                  SampsonCoplanarityResidual<double>(
-                      essential, *prepared, n, rotation.data(), &values[s]);
+                  model.Residual(*prepared, n, &values[s], nullptr);
       }
       if (defined) {
         row[layout.LeftLens() + static_cast<int>(j)] =
@@ -167,7 +204,6 @@ void AccumulateLocusNormalEquations(
       }
     }
     if (!defined || !row.allFinite()) continue;
-    const double r = residual.a;
     equations->information.selfadjointView<Eigen::Lower>().rankUpdate(row);
     equations->gradient += r * row;
     equations->squared_residuals += r * r;
@@ -184,7 +220,7 @@ void AccumulateLocusNormalEquations(
     }
   }
   // rankUpdate fills the lower triangle only.
-  const auto symmetrize = [](Eigen::MatrixXd* matrix) {
+  const auto symmetrize = [](LocusNormalEquations::Matrix* matrix) {
     *matrix = matrix->selfadjointView<Eigen::Lower>();
   };
   symmetrize(&equations->information);
@@ -205,6 +241,27 @@ double ChiSquaredUpperTail(double chi_squared, int dof) {
   return 0.5 * std::erfc(z / std::sqrt(2.0));
 }
 
+namespace {
+
+// p-value and inflation of a consistency with chi_squared and frames set.
+std::optional<FrameConsistency> Finish(FrameConsistency consistency,
+                                       double sigma_px) {
+  if (consistency.frames < 2 || !(sigma_px > 0.0) ||
+      !std::isfinite(consistency.chi_squared)) {
+    return std::nullopt;
+  }
+  consistency.dof = consistency.frames - 1;
+  consistency.p_value =
+      ChiSquaredUpperTail(consistency.chi_squared, consistency.dof);
+  if (consistency.p_value < FrameConsistency::kInflationP &&
+      consistency.chi_squared > consistency.dof) {
+    consistency.inflation = std::sqrt(consistency.chi_squared / consistency.dof);
+  }
+  return consistency;
+}
+
+}  // namespace
+
 std::optional<FrameConsistency> FrameConsistencyOf(
     const std::vector<LocusNormalEquations>& per_frame, double sigma_px) {
   FrameConsistency consistency;
@@ -216,15 +273,18 @@ std::optional<FrameConsistency> FrameConsistencyOf(
         score * score / (sigma_px * sigma_px * information);
     ++consistency.frames;
   }
-  if (consistency.frames < 2 || !(sigma_px > 0.0)) return std::nullopt;
-  consistency.dof = consistency.frames - 1;
-  consistency.p_value =
-      ChiSquaredUpperTail(consistency.chi_squared, consistency.dof);
-  if (consistency.p_value < FrameConsistency::kInflationP &&
-      consistency.chi_squared > consistency.dof) {
-    consistency.inflation = std::sqrt(consistency.chi_squared / consistency.dof);
-  }
-  return consistency;
+  return Finish(consistency, sigma_px);
+}
+
+std::optional<FrameConsistency> FrameConsistencyOf(
+    const FrameEstimateSums& sums, double n, double sigma_px) {
+  FrameConsistency consistency;
+  consistency.frames = sums.frames;
+  // Rounding can take the difference of large sums a little below zero.
+  consistency.chi_squared =
+      std::max(0.0, sums.s2 - 2.0 * n * sums.s1 + n * n * sums.s0) /
+      (sigma_px * sigma_px);
+  return Finish(consistency, sigma_px);
 }
 
 StatusOr<CalibrationPropagation> PropagateCalibration(
@@ -235,7 +295,7 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
   const int size = layout.Size();
   CHECK_EQ(equations.information.rows(), size);
   CHECK(sigma_px >= 0.0 && noise_inflation >= 1.0);
-  const Eigen::MatrixXd& m = equations.information;
+  const Eigen::MatrixXd m = equations.information;
   CalibrationPropagation result;
   result.mode = mode;
   result.source = uncertainty.source;

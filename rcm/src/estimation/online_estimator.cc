@@ -88,12 +88,65 @@ FrameFit FitFrame(const StereoRig& rig,
     fit.inliers.push_back(inlier_sources[i]);
   }
   fit.estimate = EstimateFromLocusCost(fit.cost, options);
+
+  // The calibration's share needs the inliers' normal equations.
+  if (rig.calibration_uncertainty()) {
+    const CalibrationParameterLayout layout = CalibrationParameterLayout::Of(rig);
+    fit.normal_equations = LocusNormalEquations(layout.Size());
+    std::vector<StereoCorrespondence> raw;
+    raw.reserve(fit.inliers.size());
+    for (const int64_t i : fit.inliers) raw.push_back(frame_matches[i]);
+    std::vector<PreparedCorrespondence> kept;
+    kept.reserve(fit.inliers.size());
+    for (size_t i = 0, r = 0; i < inlier_matches.size(); ++i) {
+      if (r < rejected.size() && rejected[r] == static_cast<int64_t>(i)) {
+        ++r;
+        continue;
+      }
+      kept.push_back(inlier_matches[i]);
+    }
+    std::vector<int64_t> all(kept.size());
+    for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int64_t>(i);
+    AccumulateLocusNormalEquations(
+        rig, raw, kept, all, fit.estimate.ok() ? fit.estimate->n : fit.n_robust,
+        Eigen::Vector3d::Zero(), &fit.normal_equations);
+  }
   return fit;
+}
+
+StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
+    const StereoRig& rig, const LocusCostFunction& cost,
+    const LocusNormalEquations& normal_equations,
+    const FrameEstimateSums& frame_estimates,
+    const RefinementOptions& options) {
+  const StatusOr<LocusEstimate> locus = EstimateFromLocusCost(cost, options);
+  if (!locus.ok()) return locus.status();
+  CalibratedLocusEstimate estimate;
+  estimate.locus = *locus;
+  estimate.consistency =
+      FrameConsistencyOf(frame_estimates, locus->n, locus->sigma_px);
+  const double inflation =
+      estimate.consistency ? estimate.consistency->inflation : 1.0;
+  estimate.sigma_n_noise = locus->sigma_n * inflation;
+  if (rig.calibration_uncertainty()) {
+    StatusOr<CalibrationPropagation> propagation = PropagateCalibration(
+        normal_equations, CalibrationParameterLayout::Of(rig),
+        *rig.calibration_uncertainty(), RotationMode::kHeld, locus->sigma_px,
+        inflation);
+    if (!propagation.ok()) return propagation.status();
+    estimate.sigma_n_calibration = propagation->sigma_n_calibration;
+    estimate.calibration = *propagation;
+  }
+  estimate.sigma_n =
+      std::hypot(estimate.sigma_n_noise, estimate.sigma_n_calibration);
+  return estimate;
 }
 
 OnlineRefractiveIndexEstimator::OnlineRefractiveIndexEstimator(
     const StereoRig& rig, const RefinementOptions& options)
-    : rig_(rig), options_(options) {}
+    : rig_(rig),
+      options_(options),
+      normal_equations_(CalibrationParameterLayout::Of(rig).Size()) {}
 
 StatusOr<OnlineRefractiveIndexEstimator> OnlineRefractiveIndexEstimator::Create(
     const StereoRig& rig, const RefinementOptions& options) {
@@ -120,6 +173,12 @@ OnlineRefractiveIndexEstimator::AddFrame(
     ++num_skipped_frames_;
   } else {
     cost_.Add(fit.cost);
+    if (rig_.calibration_uncertainty()) {
+      normal_equations_.Add(fit.normal_equations);
+    }
+    if (fit.estimate.ok()) {
+      frame_estimates_.Add(fit.estimate->n, fit.cost.Information(fit.estimate->n));
+    }
     update.inliers = std::move(fit.inliers);
   }
   update.frame_estimate = std::move(fit.estimate);
@@ -129,14 +188,20 @@ OnlineRefractiveIndexEstimator::AddFrame(
 
 StatusOr<OnlineRefractiveIndexEstimator::Estimate>
 OnlineRefractiveIndexEstimator::Current() const {
-  const StatusOr<LocusEstimate> locus = EstimateFromLocusCost(cost_, options_);
-  if (!locus.ok()) return locus.status();
+  const StatusOr<CalibratedLocusEstimate> calibrated = EstimateWithCalibration(
+      rig_, cost_, normal_equations_, frame_estimates_, options_);
+  if (!calibrated.ok()) return calibrated.status();
+  const LocusEstimate& locus = calibrated->locus;
   Estimate estimate;
-  estimate.n = locus->n;
-  estimate.sigma_n = locus->sigma_n;
-  estimate.crlb = locus->crlb;
-  estimate.sigma_px = locus->sigma_px;
-  estimate.inliers = locus->inliers;
+  estimate.n = locus.n;
+  estimate.sigma_n = calibrated->sigma_n;
+  estimate.sigma_n_noise = calibrated->sigma_n_noise;
+  estimate.sigma_n_calibration = calibrated->sigma_n_calibration;
+  estimate.crlb = locus.crlb;
+  estimate.sigma_px = locus.sigma_px;
+  estimate.consistency = calibrated->consistency;
+  estimate.calibration = calibrated->calibration;
+  estimate.inliers = locus.inliers;
   estimate.correspondences = num_correspondences_;
   estimate.frames = num_frames_;
   return estimate;

@@ -69,6 +69,22 @@ Status RefinementOptions::Check() const {
   return Status::Error(error.str());
 }
 
+Status CheckNotPinnedAtUpperBound(double n) {
+  constexpr double kUpperBound = 2.0;
+  constexpr double kPinnedTolerance = 1e-6;
+  if (!(n >= kUpperBound - kPinnedTolerance)) return Status::Ok();
+  std::ostringstream message;
+  message.setf(std::ios::fixed);
+  message.precision(4);
+  message << "n = " << n
+          << " is at the upper bound of [1, 2], which no medium reaches: the "
+             "rig has likely moved since its calibration (cam1 turned by a "
+             "few tenths of a degree) or the rig file is not this rig's; "
+             "calibrate in the water (rcm calibrate --underwater) or "
+             "estimate the rotation with n (--refine-rotation)";
+  return Status::Error(message.str());
+}
+
 ceres::Solver::Options RefinementSolverOptions(
     const RefinementOptions& options) {
   ceres::Solver::Options solver_options;

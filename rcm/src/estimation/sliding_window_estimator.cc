@@ -43,7 +43,8 @@ SlidingWindowRefractiveIndexEstimator::SlidingWindowRefractiveIndexEstimator(
     : rig_(rig),
       options_(options),
       window_options_(window_options),
-      window_(window_options.window_frames) {
+      window_(window_options.window_frames),
+      window_normal_equations_(CalibrationParameterLayout::Of(rig).Size()) {
   pending_.reserve(window_options.confirm_frames);
 }
 
@@ -64,8 +65,16 @@ SlidingWindowRefractiveIndexEstimator::Create(
 
 void SlidingWindowRefractiveIndexEstimator::ResumWindow() {
   window_cost_.Clear();
+  window_normal_equations_ =
+      LocusNormalEquations(window_normal_equations_.size());
+  window_estimates_ = FrameEstimateSums();
   for (int k = 0; k < window_count_; ++k) {
-    window_cost_.Add(window_[(window_begin_ + k) % window_.size()].cost);
+    const FrameCost& frame = window_[(window_begin_ + k) % window_.size()];
+    window_cost_.Add(frame.cost);
+    if (rig_.calibration_uncertainty()) {
+      window_normal_equations_.Add(frame.normal_equations);
+    }
+    window_estimates_.Add(frame.estimate.n, frame.information);
   }
 }
 
@@ -101,10 +110,13 @@ SlidingWindowRefractiveIndexEstimator::AddFrame(
   frame_cost.frame = frame;
   frame_cost.estimate = *fit.estimate;
   frame_cost.cost = fit.cost;
+  frame_cost.normal_equations = fit.normal_equations;
+  frame_cost.information = fit.cost.Information(fit.estimate->n);
 
   const StatusOr<Estimate> window = Current();
   if (window.ok()) {
-    update.z = ChangeStatistic(frame_cost.estimate, window->n, window->sigma_n);
+    update.z =
+        ChangeStatistic(frame_cost.estimate, window->n, window->sigma_n_noise);
   }
   if (!update.z || *update.z <= window_options_.change_threshold) {
     num_dropped_frames_ += static_cast<int64_t>(pending_.size());
@@ -151,18 +163,24 @@ SlidingWindowRefractiveIndexEstimator::AddFrame(
 
 StatusOr<SlidingWindowRefractiveIndexEstimator::Estimate>
 SlidingWindowRefractiveIndexEstimator::Current() const {
-  const StatusOr<LocusEstimate> locus =
-      EstimateFromLocusCost(window_cost_, options_);
-  if (!locus.ok()) {
-    return locus.status().WithContext(
+  const StatusOr<CalibratedLocusEstimate> calibrated =
+      EstimateWithCalibration(rig_, window_cost_, window_normal_equations_,
+                              window_estimates_, options_);
+  if (!calibrated.ok()) {
+    return calibrated.status().WithContext(
         "window of " + std::to_string(window_count_) + " frames");
   }
+  const LocusEstimate& locus = calibrated->locus;
   Estimate estimate;
-  estimate.n = locus->n;
-  estimate.sigma_n = locus->sigma_n;
-  estimate.crlb = locus->crlb;
-  estimate.sigma_px = locus->sigma_px;
-  estimate.inliers = locus->inliers;
+  estimate.n = locus.n;
+  estimate.sigma_n = calibrated->sigma_n;
+  estimate.sigma_n_noise = calibrated->sigma_n_noise;
+  estimate.sigma_n_calibration = calibrated->sigma_n_calibration;
+  estimate.crlb = locus.crlb;
+  estimate.sigma_px = locus.sigma_px;
+  estimate.consistency = calibrated->consistency;
+  estimate.calibration = calibrated->calibration;
+  estimate.inliers = locus.inliers;
   estimate.frames = window_count_;
   estimate.first_frame = window_[window_begin_].frame;
   estimate.last_frame =

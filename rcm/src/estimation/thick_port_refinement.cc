@@ -7,6 +7,7 @@
 #include <sstream>
 #include <utility>
 
+#include "rcm/estimation/calibration_propagation.h"
 #include "rcm/estimation/generalized_epipolar_error.h"
 #include "rcm/estimation/prepared_correspondence.h"
 
@@ -227,6 +228,48 @@ StatusOr<ThickPortRefinementSummary> RefineRefractiveIndexThickPort(
     gap.correlation_with_n = n_gap / std::sqrt(n_variance * gap_variance);
     result.air_gap = gap;
   }
+  summary.sigma_n_noise = summary.sigma_n;
+
+  // The frames' consistency and the calibration's uncertainty
+  // (calibration_propagation.h), with cam1's rotation and the ports held at
+  // the solution's.
+  StatusOr<StereoRig> at = rig.WithPorts(
+      [&] {
+        FlatPort port = stereo.left_port;
+        port.air_gap += parameters.gap_delta;
+        return port;
+      }(),
+      [&] {
+        FlatPort port = stereo.right_port;
+        port.air_gap += parameters.gap_delta;
+        return port;
+      }());
+  if (!at.ok()) return at.status();
+  std::vector<StereoCorrespondence> raw;
+  raw.reserve(matches.size());
+  for (const int64_t i : prepared.source_index) raw.push_back(correspondences[i]);
+  const CalibrationParameterLayout layout = CalibrationParameterLayout::Of(*at);
+  LocusNormalEquations equations(layout.Size());
+  std::vector<LocusNormalEquations> per_frame;
+  AccumulateLocusNormalEquations(*at, raw, matches, inliers, parameters.n,
+                                 Eigen::Vector3d::Zero(), &equations,
+                                 &per_frame);
+  summary.consistency = FrameConsistencyOf(per_frame, summary.sigma_px);
+  if (summary.consistency) {
+    summary.sigma_n_noise *= summary.consistency->inflation;
+  }
+  if (at->calibration_uncertainty()) {
+    StatusOr<CalibrationPropagation> propagation = PropagateCalibration(
+        equations, layout, *at->calibration_uncertainty(), RotationMode::kHeld,
+        summary.sigma_px);
+    if (!propagation.ok()) return propagation.status();
+    summary.sigma_n_calibration = propagation->sigma_n_calibration;
+    summary.calibration = *propagation;
+  }
+  summary.sigma_n =
+      std::hypot(summary.sigma_n_noise, summary.sigma_n_calibration);
+  RCM_RETURN_IF_ERROR(CheckNotPinnedAtUpperBound(summary.n));
+
   summary.inliers.reserve(inliers.size());
   for (const int64_t i : inliers) {
     summary.inliers.push_back(prepared.source_index[i]);

@@ -12,9 +12,12 @@
 //   calibration measured their covariance,
 //
 // (StereoRig::WithCam1Moved's convention), one row j_i = dr_i / d(n, w, dt,
-// lenses) per inlier. n and w come from ceres::Jet, dt and the lenses from
-// central differences (steps 1e-6 m and 1e-6 (1 + |p|); the residuals are
-// smooth and the truncation error is ~1e-12 relative). The estimators keep
+// lenses) per inlier: the Sampson coplanarity residual of a thin port
+// (sampson_coplanarity_error.h), or the generalized epipolar residual of a
+// thick one (generalized_epipolar_error.h). dr/dn comes from ceres::Jet,
+// the rest from central differences (steps 1e-6 rad, 1e-6 m and
+// 1e-6 (1 + |p|); the residuals are smooth and the truncation error is
+// ~1e-12 relative). The estimators keep
 // the sums
 //
 //   M = sum_i j_i j_i^T,   g = sum_i r_i j_i,   C = sum_i r_i^2,
@@ -67,6 +70,7 @@
 #include <string>
 #include <vector>
 
+#include "rcm/camera/lens_models.h"
 #include "rcm/estimation/prepared_correspondence.h"
 #include "rcm/geometry/calibration_uncertainty.h"
 #include "rcm/geometry/stereo_correspondence.h"
@@ -91,18 +95,52 @@ struct CalibrationParameterLayout {
   int Size() const { return 7 + num_left_lens + num_right_lens; }
 };
 
-// The sums M, g, C above, of a set of residuals.
+// The sums M, g, C above, of a set of residuals. Fixed-capacity storage
+// (no heap), so that the online estimators' memory stays constant.
 struct LocusNormalEquations {
-  Eigen::MatrixXd information;  // M
-  Eigen::VectorXd gradient;     // g
+  static constexpr int kMaxSize = 7 + 2 * kMaxLensParams;
+  using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0,
+                               kMaxSize, kMaxSize>;
+  using Vector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxSize, 1>;
+
+  Matrix information;  // M
+  Vector gradient;     // g
   double squared_residuals = 0.0;  // C
   int64_t count = 0;
 
   explicit LocusNormalEquations(int size = 7)
-      : information(Eigen::MatrixXd::Zero(size, size)),
-        gradient(Eigen::VectorXd::Zero(size)) {}
+      : information(Matrix::Zero(size, size)),
+        gradient(Vector::Zero(size)) {}
+  int size() const { return static_cast<int>(gradient.size()); }
   void Add(const LocusNormalEquations& other);
   void Subtract(const LocusNormalEquations& other);
+};
+
+// Sums over frames of G_f, G_f n_f and G_f n_f^2 for the frames' own
+// estimates n_f (G_f = sum (dr/dn)^2 of the frame's inliers): the
+// consistency test of frames whose residuals are no longer at hand,
+//
+//   chi^2 = sum_f G_f (n_f - n)^2 / sigma^2
+//         = (S2 - 2 n S1 + n^2 S0) / sigma^2,
+//
+// the same test as FrameConsistencyOf to first order.
+struct FrameEstimateSums {
+  double s0 = 0.0;
+  double s1 = 0.0;
+  double s2 = 0.0;
+  int frames = 0;
+  void Add(double n_f, double information) {
+    s0 += information;
+    s1 += information * n_f;
+    s2 += information * n_f * n_f;
+    ++frames;
+  }
+  void Add(const FrameEstimateSums& other) {
+    s0 += other.s0;
+    s1 += other.s1;
+    s2 += other.s2;
+    frames += other.frames;
+  }
 };
 
 // Adds the rows j_i of `matches[indices]` at (n, w) for `rig`
@@ -139,6 +177,10 @@ struct FrameConsistency {
 // solution; nullopt for fewer than two frames with information on n.
 std::optional<FrameConsistency> FrameConsistencyOf(
     const std::vector<LocusNormalEquations>& per_frame, double sigma_px);
+// From the frames' own estimates at the pooled n; nullopt for fewer than
+// two frames.
+std::optional<FrameConsistency> FrameConsistencyOf(
+    const FrameEstimateSums& sums, double n, double sigma_px);
 // P(chi^2_dof > chi_squared), Wilson-Hilferty; dof >= 1.
 double ChiSquaredUpperTail(double chi_squared, int dof);
 

@@ -19,7 +19,10 @@
 //   sigma_px^2 = C(n) / (N - 1)          (N inliers, one parameter)
 //   sigma_n    = sigma_px / sqrt(G(n))   (= crlb for n alone)
 //
-// the same formulas as the batch's stage 2 and covariance. Each frame's own
+// the same formulas as the batch's stage 2 and covariance (sigma_n then
+// grows by the frames' consistency test and the calibration's uncertainty,
+// as the batch's does, but with cam1's rotation held at the calibration's:
+// calibration_propagation.h). Each frame's own
 // estimate (n_f, sigma_f) is the same computed on C_f, G_f alone; a frame
 // with too few inliers or too little information for an estimate of its
 // own still adds its inliers to the running sums, as the batch would.
@@ -46,8 +49,10 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
+#include "rcm/estimation/calibration_propagation.h"
 #include "rcm/estimation/locus_cost_function.h"
 #include "rcm/estimation/refinement_options.h"
 #include "rcm/geometry/stereo_correspondence.h"
@@ -56,7 +61,8 @@
 
 namespace rcm {
 
-// The stage-2 estimate of a LocusCostFunction (formulas above).
+// The stage-2 estimate of a LocusCostFunction (formulas above), for n
+// alone with the calibration exact.
 struct LocusEstimate {
   double n = 0.0;
   double sigma_n = 0.0;   // standard deviation
@@ -72,6 +78,27 @@ struct LocusEstimate {
 StatusOr<LocusEstimate> EstimateFromLocusCost(const LocusCostFunction& cost,
                                               const RefinementOptions& options);
 
+// A LocusEstimate with the uncertainty of the calibration and the frames'
+// consistency (calibration_propagation.h), shared by the online and the
+// sliding-window estimators: sigma_n = hypot(sigma_px / sqrt(G(n))
+// inflated by the consistency test, the calibration's share with cam1's
+// rotation held).
+struct CalibratedLocusEstimate {
+  LocusEstimate locus;
+  double sigma_n = 0.0;
+  double sigma_n_noise = 0.0;
+  double sigma_n_calibration = 0.0;
+  std::optional<FrameConsistency> consistency;
+  std::optional<CalibrationPropagation> calibration;
+};
+// `normal_equations` and `frame_estimates` sum the frames of `cost`; a rig
+// without a calibration uncertainty ignores the former.
+StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
+    const StereoRig& rig, const LocusCostFunction& cost,
+    const LocusNormalEquations& normal_equations,
+    const FrameEstimateSums& frame_estimates,
+    const RefinementOptions& options);
+
 // Steps 1-4 for one frame.
 struct FrameFit {
   int64_t correspondences = 0;   // the frame's size
@@ -82,6 +109,10 @@ struct FrameFit {
   LocusCostFunction cost;        // C_f, G_f of the inliers
   // n_f, sigma_f from C_f, G_f alone; the error says why there is none.
   StatusOr<LocusEstimate> estimate = Status::Error("frame not fitted");
+  // With a rig that has a calibration uncertainty: the inliers' normal
+  // equations (calibration_propagation.h) at n_f (n_robust without an own
+  // estimate) and cam1's rotation held; empty (all zero) otherwise.
+  LocusNormalEquations normal_equations;
 };
 FrameFit FitFrame(const StereoRig& rig,
                   const std::vector<StereoCorrespondence>& frame_matches,
@@ -97,9 +128,16 @@ class OnlineRefractiveIndexEstimator {
   // The estimate of all frames so far.
   struct Estimate {
     double n = 0.0;
-    double sigma_n = 0.0;  // standard deviation
-    double crlb = 0.0;     // equals sigma_n (n alone), as in the batch
+    // The total standard deviation, as the batch's: pixel noise (after the
+    // frames' consistency test) and the calibration's uncertainty with
+    // cam1's rotation held (calibration_propagation.h).
+    double sigma_n = 0.0;
+    double sigma_n_noise = 0.0;
+    double sigma_n_calibration = 0.0;
+    double crlb = 0.0;     // of n alone with the calibration known
     double sigma_px = 0.0;
+    std::optional<FrameConsistency> consistency;
+    std::optional<CalibrationPropagation> calibration;
     int64_t inliers = 0;          // in the running sums
     int64_t correspondences = 0;  // every correspondence of every frame
     int64_t frames = 0;           // frames added, skipped ones included
@@ -137,6 +175,9 @@ class OnlineRefractiveIndexEstimator {
   StereoRig rig_;
   RefinementOptions options_;
   LocusCostFunction cost_;
+  // The frames' normal equations and own estimates, summed.
+  LocusNormalEquations normal_equations_;
+  FrameEstimateSums frame_estimates_;
   int64_t num_frames_ = 0;
   int64_t num_skipped_frames_ = 0;
   int64_t num_correspondences_ = 0;

@@ -87,6 +87,13 @@ struct RefinementOptions {
 // iterations, and the noise-free case must reach 1e-9 in n.
 ceres::Solver::Options RefinementSolverOptions(const RefinementOptions& options);
 
+// Ok unless n is pinned at the upper bound of [1, 2] (within 1e-6),
+// which no medium reaches: then the one-line failure that names the likely
+// causes (the rig moved since its calibration, a wrong rig file) and the
+// remedies (rcm calibrate --underwater, --refine-rotation). The lower
+// bound stays a valid answer (air).
+Status CheckNotPinnedAtUpperBound(double n);
+
 // A new Ceres loss of `loss` with scale `scale_px` (owned by the problem
 // it is given to); nullptr for kNone (least squares).
 ceres::LossFunction* NewLossFunction(RobustLoss loss, double scale_px);

@@ -48,6 +48,13 @@
 // steps below ~0.05 are not declared as switches but tracked by the window
 // as a gradual change, with a lag of about half a window.
 //
+// The window estimate's sigma_n is the total, as the online estimator's:
+// pixel noise inflated when the window's frames disagree (the consistency
+// test of calibration_propagation.h) and the calibration's uncertainty with
+// cam1's rotation held. The change test uses the frames' own sigma and the
+// window's pixel-noise share (a calibration error is common to both and
+// cancels from their difference).
+//
 // Memory: window_frames + confirm_frames cost functions (each
 // LocusCostFunction::kNumNodes x 3 doubles), allocated at Create, plus one
 // MediumSwitch per switch. Time per frame: the frame's fit (online
@@ -100,9 +107,16 @@ class SlidingWindowRefractiveIndexEstimator {
 
   struct Estimate {
     double n = 0.0;
-    double sigma_n = 0.0;  // standard deviation
-    double crlb = 0.0;     // equals sigma_n (n alone)
+    // The total standard deviation of the window's n, as the online
+    // estimator's (pixel noise after the window frames' consistency test,
+    // and the calibration's uncertainty with cam1's rotation held).
+    double sigma_n = 0.0;
+    double sigma_n_noise = 0.0;
+    double sigma_n_calibration = 0.0;
+    double crlb = 0.0;     // of n alone with the calibration known
     double sigma_px = 0.0;
+    std::optional<FrameConsistency> consistency;
+    std::optional<CalibrationPropagation> calibration;
     int64_t inliers = 0;      // in the window
     int frames = 0;           // frames in the window
     int64_t first_frame = 0;  // oldest frame in the window
@@ -158,6 +172,8 @@ class SlidingWindowRefractiveIndexEstimator {
     int64_t frame = 0;
     LocusEstimate estimate;  // the frame's own
     LocusCostFunction cost;
+    LocusNormalEquations normal_equations;  // FrameFit's
+    double information = 0.0;  // G_f(n_f)
   };
 
   // Appends to the ring buffer (dropping the oldest when full) and
@@ -174,6 +190,8 @@ class SlidingWindowRefractiveIndexEstimator {
   int window_begin_ = 0;
   int window_count_ = 0;
   LocusCostFunction window_cost_;
+  LocusNormalEquations window_normal_equations_;
+  FrameEstimateSums window_estimates_;
   // Pending frames, oldest first; capacity confirm_frames.
   std::vector<FrameCost> pending_;
 

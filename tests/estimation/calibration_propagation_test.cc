@@ -1,0 +1,452 @@
+#include "rcm/estimation/calibration_propagation.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include "rcm/estimation/batch_refinement.h"
+#include "rcm/estimation/online_estimator.h"
+#include "rcm/estimation/sampson_coplanarity_error.h"
+#include "rcm/estimation/sliding_window_estimator.h"
+#include "rcm/geometry/epipolar.h"
+#include "rcm/sim/stereo_sampler.h"
+#include "support/test_rigs.h"
+
+namespace rcm {
+namespace {
+
+constexpr double kDegree = M_PI / 180.0;
+constexpr double kTrueN = 1.342;
+// Exact correspondences have residuals below 1e-12 px and the solver's
+// tolerances carry that to n (batch_refinement_test.cc).
+constexpr double kExactTolerance = 1e-9;
+
+// Frames of exact correspondences at depths [min_depth, max_depth].
+std::vector<StereoCorrespondence> Frames(const StereoRig& rig, double n,
+                                         double min_depth, double max_depth,
+                                         int frames, int per_frame,
+                                         uint64_t seed) {
+  StereoSamplerOptions options;
+  options.n = n;
+  options.min_depth = min_depth;
+  options.max_depth = max_depth;
+  options.num_frames = frames;
+  options.per_frame = per_frame;
+  options.seed = seed;
+  return SampleStereoCorrespondences(rig, options).value();
+}
+
+StereoRig WithDefaultPrior(const StereoRig& rig) {
+  return rig
+      .WithCalibrationUncertainty(CalibrationUncertainty::DefaultDriftPrior())
+      .value();
+}
+
+// The rows' rotation columns (central differences) against ceres::Jet
+// through the residual's own rotation correction.
+TEST(CalibrationPropagation, RotationColumnsMatchJets) {
+  const StereoRig rig = WithDefaultPrior(test::AlphasenseRealisticRig());
+  const std::vector<StereoCorrespondence> raw =
+      test::ExactMatches(rig, kTrueN, 50, 3);
+  const PreparedCorrespondences prepared = PrepareCorrespondences(rig, raw);
+  std::vector<StereoCorrespondence> aligned;
+  for (const int64_t i : prepared.source_index) aligned.push_back(raw[i]);
+  const Eigen::Vector3d rotation(0.002, -0.001, 0.0005);
+  std::vector<int64_t> all(prepared.prepared.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int64_t>(i);
+  LocusNormalEquations equations(CalibrationParameterLayout::Of(rig).Size());
+  AccumulateLocusNormalEquations(rig, aligned, prepared.prepared, all, 1.3,
+                                 rotation, &equations);
+  ASSERT_EQ(equations.count, static_cast<int64_t>(all.size()));
+
+  using Jet = ceres::Jet<double, 4>;
+  const Eigen::Matrix3d essential = EssentialMatrix(rig.right_from_left());
+  Eigen::Matrix4d expected = Eigen::Matrix4d::Zero();
+  const Jet w[3] = {Jet(rotation[0], 1), Jet(rotation[1], 2),
+                    Jet(rotation[2], 3)};
+  for (const PreparedCorrespondence& match : prepared.prepared) {
+    Jet r;
+    ASSERT_TRUE(SampsonCoplanarityResidual<Jet>(essential, match, Jet(1.3, 0),
+                                                w, &r));
+    expected += r.v * r.v.transpose();
+  }
+  // Central differences of step 1e-6 rad: truncation ~1e-12 and rounding
+  // ~1e-10 relative.
+  const Eigen::Matrix4d actual = equations.information.topLeftCorner(4, 4);
+  EXPECT_LT((actual - expected).norm(), 1e-7 * expected.norm());
+}
+
+// The implicit-function sensitivities against the estimator itself: n
+// estimated alone (calibration held) on exact data with the calibration
+// moved by +-h, by central differences.
+TEST(CalibrationPropagation, SensitivitiesMatchTheEstimatorsResponse) {
+  const StereoRig truth = test::AlphasenseRealisticRig();
+  const std::vector<StereoCorrespondence> data =
+      Frames(truth, kTrueN, 0.6, 6.0, 2, 300, 5);
+  // The lenses' share needs their covariance: unit variance on every
+  // parameter of the left lens gives variance_lenses = |dn/dp_left|^2.
+  CalibrationUncertainty uncertainty =
+      CalibrationUncertainty::DriftPrior(1e-3, 1e-4);
+  uncertainty.left_lens_covariance =
+      Eigen::MatrixXd::Identity(truth.left().num_params(),
+                                truth.left().num_params());
+  RefinementOptions options;
+  options.self_calibrate_rotation = false;
+  const RefinementSummary summary =
+      RefineRefractiveIndex(
+          truth.WithCalibrationUncertainty(uncertainty).value(), data, options)
+          .value();
+  ASSERT_TRUE(summary.calibration.has_value());
+  EXPECT_NEAR(summary.n, kTrueN, kExactTolerance);
+
+  const auto n_alone = [&](const StereoRig& rig) {
+    return RefineRefractiveIndex(rig, data, RefinementOptions()).value().n;
+  };
+  // Steps: the response is smooth; 1e-5 rad and 1e-5 m keep the central
+  // difference's truncation below 1e-6 relative and the solver's 1e-12
+  // noise in n far below the difference.
+  constexpr double kStep = 1e-5;
+  for (int k = 0; k < 3; ++k) {
+    Eigen::Vector3d w = Eigen::Vector3d::Zero();
+    w[k] = kStep;
+    const double rotation_response =
+        (n_alone(truth.WithCam1Moved(w).value()) -
+         n_alone(truth.WithCam1Moved(-w).value())) /
+        (2.0 * kStep);
+    const double translation_response =
+        (n_alone(truth.WithCam1Moved(Eigen::Vector3d::Zero(), w).value()) -
+         n_alone(truth.WithCam1Moved(Eigen::Vector3d::Zero(), -w).value())) /
+        (2.0 * kStep);
+    std::printf("axis %d: dn/dw %.6g (estimator %.6g), dn/dt %.6g (%.6g)\n", k,
+                summary.calibration->dn_drotation[k], rotation_response,
+                summary.calibration->dn_dtranslation[k], translation_response);
+    EXPECT_NEAR(summary.calibration->dn_drotation[k], rotation_response,
+                1e-4 * std::abs(rotation_response) + 1e-6);
+    EXPECT_NEAR(summary.calibration->dn_dtranslation[k], translation_response,
+                1e-4 * std::abs(translation_response) + 1e-6);
+  }
+  // The lenses' share: sum over the left lens' parameters of the squared
+  // responses.
+  double lens_variance = 0.0;
+  for (int j = 0; j < truth.left().num_params(); ++j) {
+    const double step = 1e-6 * (1.0 + std::abs(truth.left().params()[j]));
+    double responses[2];
+    for (int s = 0; s < 2; ++s) {
+      std::vector<double> params(truth.left().params(),
+                                 truth.left().params() + truth.left().num_params());
+      params[j] += s == 0 ? step : -step;
+      const Camera moved =
+          Camera::Create(truth.left().model(), truth.left().width(),
+                         truth.left().height(),
+                         {params[0], params[1], params[2], params[3]},
+                         std::vector<double>(params.begin() + 4, params.end()))
+              .value();
+      responses[s] = n_alone(
+          StereoRig::Create(moved, truth.right(), truth.right_from_left())
+              .value());
+    }
+    const double response = (responses[0] - responses[1]) / (2.0 * step);
+    lens_variance += response * response;
+  }
+  EXPECT_NEAR(summary.calibration->variance_lenses, lens_variance,
+              1e-4 * lens_variance);
+}
+
+// Noise-free, a rig with the drift prior gives n exactly: on the true rig,
+// and on a rig that drifted 0.5 degrees, whose rotation the
+// self-calibration then recovers exactly (with no noise the prior weighs
+// nothing against the data).
+TEST(CalibrationPropagation, SelfCalibrationIsExactOnExactData) {
+  const struct {
+    const char* name;
+    StereoRig rig;
+    double min_depth, max_depth;
+  } scenes[] = {{"pool", test::AlphasenseRealisticRig(), 0.5, 8.0},
+                {"board", test::NarrowRadtanRig(), 0.9, 1.1}};
+  const Eigen::Vector3d drift = Eigen::Vector3d(0.25, 0.41, 0.08) * kDegree;
+  for (const auto& scene : scenes) {
+    SCOPED_TRACE(scene.name);
+    for (const bool drifted : {false, true}) {
+      const StereoRig truth =
+          drifted ? scene.rig.WithCam1Moved(drift).value() : scene.rig;
+      const std::vector<StereoCorrespondence> data = Frames(
+          truth, kTrueN, scene.min_depth, scene.max_depth, 4, 200, 7);
+      const RefinementSummary summary =
+          RefineRefractiveIndex(WithDefaultPrior(scene.rig), data,
+                                RefinementOptions())
+              .value();
+      EXPECT_NEAR(summary.n, kTrueN, kExactTolerance);
+      ASSERT_TRUE(summary.rotation.has_value());
+      EXPECT_TRUE(summary.rotation->with_prior);
+      const Eigen::Vector3d expected =
+          drifted ? drift : Eigen::Vector3d::Zero();
+      EXPECT_LT((summary.rotation->angle_axis - expected).norm(), 1e-9);
+      EXPECT_LT(summary.sigma_px, 1e-9);
+    }
+  }
+}
+
+// Monte Carlo of the self-calibrating refinement on rigs whose drift is
+// drawn from the stated prior (0.1 degree, 0.1 mm per axis) and with 0.3 px
+// of pixel noise: z = (n - n_true) / sigma_n must have a standard
+// deviation within [0.7, 1.3] (the sd of 100 draws of N(0, 1) is within
+// 1 +- 0.15 at 2 sigma), for a wide-field pool scene (the dataset rig,
+// depths 0.5-8 m) and a narrow-field board scene at near-constant depth
+// (0.9-1.1 m), where the rotation and n are nearly collinear.
+struct DriftScene {
+  const char* name;
+  StereoRig rig;
+  double min_depth;
+  double max_depth;
+  int frames;
+  int per_frame;
+};
+
+std::vector<DriftScene> DriftScenes() {
+  return {{"pool", test::AlphasenseIdealRig(), 0.5, 8.0, 10, 150},
+          {"board", test::NarrowRadtanRig(), 0.9, 1.1, 10, 150}};
+}
+
+// A drifted rig drawn from the default prior.
+StereoRig DrawDrift(const StereoRig& rig, std::mt19937_64* rng) {
+  std::normal_distribution<double> gaussian(0.0, 1.0);
+  Eigen::Vector3d rotation;
+  Eigen::Vector3d translation;
+  for (int k = 0; k < 3; ++k) {
+    rotation[k] =
+        CalibrationUncertainty::kDefaultDriftDegrees * kDegree * gaussian(*rng);
+  }
+  for (int k = 0; k < 3; ++k) {
+    translation[k] =
+        1e-3 * CalibrationUncertainty::kDefaultDriftMillimeters * gaussian(*rng);
+  }
+  return rig.WithCam1Moved(rotation, translation).value();
+}
+
+struct ZStatistics {
+  int trials = 0;
+  int failed = 0;
+  double mean = 0.0;
+  double sd = 0.0;
+  double mean_sigma = 0.0;
+};
+
+template <typename Estimate>
+ZStatistics MonteCarloWithDrift(const DriftScene& scene, int trials,
+                                uint64_t seed, Estimate estimate) {
+  std::mt19937_64 rng(seed);
+  const StereoRig calibrated = WithDefaultPrior(scene.rig);
+  double sum = 0.0;
+  double sum2 = 0.0;
+  ZStatistics statistics;
+  for (int t = 0; t < trials; ++t) {
+    const StereoRig truth = DrawDrift(scene.rig, &rng);
+    std::vector<StereoCorrespondence> data =
+        Frames(truth, kTrueN, scene.min_depth, scene.max_depth, scene.frames,
+               scene.per_frame, seed + 100 + t);
+    AddPixelNoise(0.3, seed + 1000 + t, &data);
+    double n = 0.0;
+    double sigma = 0.0;
+    if (!estimate(calibrated, data, &n, &sigma)) {
+      ++statistics.failed;
+      continue;
+    }
+    const double z = (n - kTrueN) / sigma;
+    sum += z;
+    sum2 += z * z;
+    statistics.mean_sigma += sigma;
+    ++statistics.trials;
+  }
+  statistics.mean = sum / statistics.trials;
+  statistics.sd =
+      std::sqrt(sum2 / statistics.trials - statistics.mean * statistics.mean);
+  statistics.mean_sigma /= statistics.trials;
+  return statistics;
+}
+
+TEST(CalibrationPropagation, MonteCarloSelfCalibrationSigmaHonestUnderDrift) {
+  for (const DriftScene& scene : DriftScenes()) {
+    const ZStatistics z = MonteCarloWithDrift(
+        scene, 100, 11,
+        [](const StereoRig& rig, const std::vector<StereoCorrespondence>& data,
+           double* n, double* sigma) {
+          const StatusOr<RefinementSummary> summary =
+              RefineRefractiveIndex(rig, data, RefinementOptions());
+          if (!summary.ok()) return false;
+          *n = summary->n;
+          *sigma = summary->sigma_n;
+          return true;
+        });
+    std::printf("refine, %s: %d trials, %d failed, z mean %.2f sd %.2f, "
+                "mean sigma_n %.5f\n",
+                scene.name, z.trials, z.failed, z.mean, z.sd, z.mean_sigma);
+    EXPECT_EQ(z.failed, 0) << scene.name;
+    EXPECT_GE(z.sd, 0.7) << scene.name;
+    EXPECT_LE(z.sd, 1.3) << scene.name;
+  }
+}
+
+// The online and sliding-window estimators hold cam1's rotation at the
+// calibration's and propagate its uncertainty: honest, though larger than
+// the self-calibrating batch's. A drift that pins n at 2 is refused (a
+// failure, counted; at most a few percent of draws from the prior).
+TEST(CalibrationPropagation, MonteCarloOnlineAndWindowSigmaHonestUnderDrift) {
+  for (const DriftScene& scene : DriftScenes()) {
+    for (const bool window : {false, true}) {
+      const ZStatistics z = MonteCarloWithDrift(
+          scene, 100, 21,
+          [&](const StereoRig& rig,
+              const std::vector<StereoCorrespondence>& data, double* n,
+              double* sigma) {
+            std::vector<std::vector<StereoCorrespondence>> frames(
+                scene.frames);
+            for (const StereoCorrespondence& match : data) {
+              frames[match.frame].push_back(match);
+            }
+            double value = 0.0;
+            double deviation = 0.0;
+            if (window) {
+              SlidingWindowOptions window_options;
+              window_options.window_frames = scene.frames;
+              SlidingWindowRefractiveIndexEstimator estimator =
+                  SlidingWindowRefractiveIndexEstimator::Create(
+                      rig, RefinementOptions(), window_options)
+                      .value();
+              for (int f = 0; f < scene.frames; ++f) {
+                estimator.AddFrame(f, frames[f]);
+              }
+              const auto current = estimator.Current();
+              if (!current.ok() || !CheckNotPinnedAtUpperBound(current->n).ok())
+                return false;
+              value = current->n;
+              deviation = current->sigma_n;
+            } else {
+              OnlineRefractiveIndexEstimator estimator =
+                  OnlineRefractiveIndexEstimator::Create(rig,
+                                                         RefinementOptions())
+                      .value();
+              for (const auto& frame : frames) estimator.AddFrame(frame);
+              const auto current = estimator.Current();
+              if (!current.ok() || !CheckNotPinnedAtUpperBound(current->n).ok())
+                return false;
+              value = current->n;
+              deviation = current->sigma_n;
+            }
+            *n = value;
+            *sigma = deviation;
+            return true;
+          });
+      std::printf("%s, %s: %d trials, %d refused, z mean %.2f sd %.2f, mean "
+                  "sigma_n %.5f\n",
+                  window ? "window" : "online", scene.name, z.trials, z.failed,
+                  z.mean, z.sd, z.mean_sigma);
+      EXPECT_LE(z.failed, 10) << scene.name;
+      EXPECT_GE(z.sd, 0.7) << scene.name;
+      EXPECT_LE(z.sd, 1.3) << scene.name;
+    }
+  }
+}
+
+// A drifted rig whose n, estimated with the rotation held, is pinned at the
+// upper bound: an error naming the causes and remedies, never a number.
+// (0.15 degrees about x on the narrow rig at 1 m: n alone goes from 1.342
+// to the bound; 0.1 degree moves it by +0.011.)
+TEST(CalibrationPropagation, EstimatePinnedAtTheUpperBoundIsAnError) {
+  const StereoRig nominal = test::NarrowRadtanRig();
+  const StereoRig truth =
+      nominal.WithCam1Moved(Eigen::Vector3d(0.15, 0.0, 0.0) * kDegree).value();
+  const std::vector<StereoCorrespondence> data =
+      Frames(truth, kTrueN, 0.9, 1.1, 2, 300, 9);
+  RefinementOptions held;
+  held.self_calibrate_rotation = false;
+  const StatusOr<RefinementSummary> summary =
+      RefineRefractiveIndex(WithDefaultPrior(nominal), data, held);
+  ASSERT_FALSE(summary.ok());
+  const std::string message = summary.status().message();
+  EXPECT_NE(message.find("upper bound"), std::string::npos) << message;
+  EXPECT_NE(message.find("rcm calibrate --underwater"), std::string::npos);
+  EXPECT_EQ(message.find('\n'), std::string::npos);
+  // Self-calibration recovers it.
+  const RefinementSummary calibrated =
+      RefineRefractiveIndex(WithDefaultPrior(nominal), data,
+                            RefinementOptions())
+          .value();
+  EXPECT_NEAR(calibrated.n, kTrueN, kExactTolerance);
+}
+
+// Air (n = 1, the lower bound) is an answer, with the calibration's share
+// in its sigma.
+TEST(CalibrationPropagation, AirAtTheLowerBoundIsAValidAnswer) {
+  const StereoRig rig = test::AlphasenseRealisticRig();
+  std::vector<StereoCorrespondence> data = Frames(rig, 1.0, 0.6, 6.0, 2, 300, 4);
+  AddPixelNoise(0.3, 5, &data);
+  const RefinementSummary summary =
+      RefineRefractiveIndex(WithDefaultPrior(rig), data, RefinementOptions())
+          .value();
+  EXPECT_LE(std::abs(summary.n - 1.0), 3.0 * summary.sigma_n);
+  EXPECT_GT(summary.sigma_n_calibration, 0.0);
+  EXPECT_NEAR(summary.sigma_n,
+              std::hypot(summary.sigma_n_noise, summary.sigma_n_calibration),
+              1e-12);
+}
+
+// Frames that disagree beyond their sigmas (two media mixed in one run,
+// 0.027 apart where a frame's sigma is ~0.005)
+// fail the chi-square test and inflate the noise share by the Birge ratio;
+// frames of one medium pass it.
+TEST(CalibrationPropagation, FramesThatDisagreeInflateSigma) {
+  const StereoRig rig = test::AlphasenseRealisticRig();
+  std::vector<StereoCorrespondence> data;
+  for (int f = 0; f < 10; ++f) {
+    std::vector<StereoCorrespondence> frame =
+        Frames(rig, f % 2 == 0 ? 1.333 : 1.36, 0.6, 6.0, 1, 200, 30 + f);
+    for (StereoCorrespondence& match : frame) match.frame = f;
+    data.insert(data.end(), frame.begin(), frame.end());
+  }
+  std::vector<StereoCorrespondence> noisy = data;
+  AddPixelNoise(0.3, 3, &noisy);
+  const RefinementSummary mixed =
+      RefineRefractiveIndex(rig, noisy, RefinementOptions()).value();
+  ASSERT_TRUE(mixed.consistency.has_value());
+  EXPECT_EQ(mixed.consistency->frames, 10);
+  EXPECT_LT(mixed.consistency->p_value, FrameConsistency::kInflationP);
+  EXPECT_GT(mixed.consistency->inflation, 2.0);
+  EXPECT_NEAR(mixed.sigma_n, mixed.consistency->inflation * mixed.crlb,
+              1e-9 * mixed.sigma_n);
+
+  std::vector<StereoCorrespondence> one_medium =
+      Frames(rig, 1.338, 0.6, 6.0, 10, 200, 40);
+  AddPixelNoise(0.3, 4, &one_medium);
+  const RefinementSummary consistent =
+      RefineRefractiveIndex(rig, one_medium, RefinementOptions()).value();
+  ASSERT_TRUE(consistent.consistency.has_value());
+  std::printf("mixed chi2 %.1f (p %.2g), one medium chi2 %.1f (p %.2g)\n",
+              mixed.consistency->chi_squared, mixed.consistency->p_value,
+              consistent.consistency->chi_squared,
+              consistent.consistency->p_value);
+  EXPECT_GT(consistent.consistency->p_value, FrameConsistency::kInflationP);
+  EXPECT_EQ(consistent.consistency->inflation, 1.0);
+  EXPECT_NEAR(consistent.sigma_n, consistent.crlb, 1e-12 * consistent.crlb);
+}
+
+// Wilson-Hilferty against tabulated chi-square quantiles (99 % and 95 %):
+// within 5 % of the probability for 2 or more degrees of freedom.
+TEST(CalibrationPropagation, ChiSquaredUpperTailMatchesTables) {
+  const struct {
+    int dof;
+    double quantile;
+    double p;
+  } table[] = {{2, 9.2103, 0.01},  {3, 7.8147, 0.05},  {10, 23.2093, 0.01},
+               {19, 30.1435, 0.05}, {30, 50.8922, 0.01}, {100, 135.807, 0.01}};
+  for (const auto& row : table) {
+    EXPECT_NEAR(ChiSquaredUpperTail(row.quantile, row.dof), row.p,
+                0.05 * row.p)
+        << row.dof;
+  }
+  EXPECT_EQ(ChiSquaredUpperTail(0.0, 5), 1.0);
+}
+
+}  // namespace
+}  // namespace rcm
