@@ -1,0 +1,186 @@
+#include "rcm/io/calibration_covariance_file.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "rcm/io/camchain.h"
+#include "rcm/io/stereo_rig_file.h"
+#include "support/temp_file.h"
+#include "support/test_rigs.h"
+
+namespace rcm {
+namespace {
+
+using ::testing::HasSubstr;
+
+constexpr double kDegree = M_PI / 180.0;
+
+// A positive-definite n x n matrix with entries that do not print short.
+Eigen::MatrixXd Covariance(int size, double scale, int seed) {
+  Eigen::MatrixXd a(size, size);
+  for (int r = 0; r < size; ++r) {
+    for (int c = 0; c < size; ++c) {
+      a(r, c) = std::sin(1.7 * (r + 1) * (c + 2) + seed) / 3.0;
+    }
+  }
+  return scale * (a * a.transpose() +
+                  0.1 * Eigen::MatrixXd::Identity(size, size));
+}
+
+CalibrationCovarianceFile SampleFile() {
+  CalibrationCovarianceFile file;
+  file.medium = "water";
+  file.drift_rotation_sigma = 0.05 * kDegree;
+  file.drift_translation_sigma = 2e-4;
+  file.cameras.resize(2);
+  file.cameras[0].intrinsics_covariance = Covariance(8, 0.3, 1);
+  file.cameras[1].intrinsics_covariance = Covariance(8, 0.2, 2);
+  file.cameras[1].from_previous_covariance = Covariance(6, 1e-8, 3);
+  return file;
+}
+
+TEST(CalibrationCovarianceFile, SidecarPathIsNextToTheCamchain) {
+  EXPECT_EQ(CovarianceSidecarPath("out/camchain.yaml"),
+            "out/camchain-covariance.yaml");
+  EXPECT_EQ(CovarianceSidecarPath("rig.yml"), "rig-covariance.yaml");
+}
+
+TEST(CalibrationCovarianceFile, RoundTripIsBitExact) {
+  const CalibrationCovarianceFile file = SampleFile();
+  const std::string text = FormatCalibrationCovariance(file);
+  const CalibrationCovarianceFile read =
+      ParseCalibrationCovariance(text, "c.yaml").value();
+  EXPECT_EQ(read.medium, "water");
+  EXPECT_EQ(read.drift_rotation_sigma, file.drift_rotation_sigma);
+  EXPECT_EQ(read.drift_translation_sigma, file.drift_translation_sigma);
+  ASSERT_EQ(read.cameras.size(), 2u);
+  EXPECT_EQ(read.cameras[0].intrinsics_covariance,
+            file.cameras[0].intrinsics_covariance);
+  EXPECT_FALSE(read.cameras[0].from_previous_covariance.has_value());
+  EXPECT_EQ(read.cameras[1].intrinsics_covariance,
+            file.cameras[1].intrinsics_covariance);
+  ASSERT_TRUE(read.cameras[1].from_previous_covariance.has_value());
+  EXPECT_EQ(*read.cameras[1].from_previous_covariance,
+            *file.cameras[1].from_previous_covariance);
+  EXPECT_EQ(FormatCalibrationCovariance(read), text);
+}
+
+TEST(CalibrationCovarianceFile, PairUncertaintyAddsTheDriftPrior) {
+  const CalibrationCovarianceFile file = SampleFile();
+  const CalibrationUncertainty uncertainty =
+      PairCalibrationUncertainty(file, 0, 1, "c.yaml").value();
+  Eigen::Matrix<double, 6, 6> expected = *file.cameras[1].from_previous_covariance;
+  for (int k = 0; k < 3; ++k) {
+    expected(k, k) += std::pow(file.drift_rotation_sigma, 2);
+    expected(3 + k, 3 + k) += std::pow(file.drift_translation_sigma, 2);
+  }
+  EXPECT_LT((uncertainty.extrinsics_covariance - expected).norm(),
+            1e-15 * expected.norm());
+  EXPECT_EQ(uncertainty.left_lens_covariance,
+            file.cameras[0].intrinsics_covariance);
+  EXPECT_THAT(uncertainty.source, HasSubstr("c.yaml (water calibration)"));
+  EXPECT_THAT(uncertainty.source, HasSubstr("drift prior 0.05 deg, 0.2 mm"));
+  // An override replaces the file's drift prior.
+  const CalibrationUncertainty overridden =
+      PairCalibrationUncertainty(file, 0, 1, "c.yaml",
+                                 std::pair<double, double>{0.0, 0.0})
+          .value();
+  EXPECT_EQ(overridden.extrinsics_covariance,
+            *file.cameras[1].from_previous_covariance);
+  // Reversed or non-adjacent pairs have no measured extrinsics.
+  const CalibrationUncertainty reversed =
+      PairCalibrationUncertainty(file, 1, 0, "c.yaml").value();
+  EXPECT_TRUE((reversed.extrinsics_covariance.topRightCorner<3, 3>().isZero()));
+  EXPECT_NEAR(reversed.extrinsics_covariance(0, 0),
+              std::pow(file.drift_rotation_sigma, 2), 1e-24);
+  EXPECT_FALSE(PairCalibrationUncertainty(file, 0, 2, "c.yaml").ok());
+}
+
+TEST(CalibrationCovarianceFile, BadFilesGiveOneLineErrors) {
+  const std::string good = FormatCalibrationCovariance(SampleFile());
+  const struct {
+    std::string text;
+    std::string message;
+  } cases[] = {
+      {"", "empty file"},
+      {"cam0: {}\n", "missing key 'medium'"},
+      {"medium: vacuum\n", "expected air or water"},
+      {"medium: air\nfoo: 1\n", "unknown key"},
+      {"medium: air\ndrift_prior: {rotation_deg: -1}\n", "must be >= 0"},
+      {"medium: air\ncam1: {}\n", "cam0"},
+      {"medium: air\ncam0:\n  intrinsics_covariance:\n  - [1, 2]\n  - [3, "
+       "4]\n",
+       "is not symmetric"},
+      {"medium: air\ncam0:\n  intrinsics_covariance:\n  - [1, 0]\n  - [0, "
+       "-1]\n",
+       "is not positive semi-definite"},
+      {"medium: air\ncam0:\n  intrinsics_covariance:\n  - [1, 0]\n  - [0]\n",
+       "expected 2 numbers, got 1"},
+      {"medium: air\ncam0:\n  intrinsics_covariance:\n  - [.nan]\n",
+       "not a finite number"},
+      {"medium: air\ncam0: {}\ncam1:\n  T_cn_cnm1_covariance:\n  - [1]\n",
+       "expected 6 rows, got 1"},
+      {"medium: air\ncam0:\n  T_cn_cnm1_covariance: []\n", "unknown key"},
+  };
+  for (const auto& c : cases) {
+    const StatusOr<CalibrationCovarianceFile> read =
+        ParseCalibrationCovariance(c.text, "side.yaml");
+    ASSERT_FALSE(read.ok()) << c.text;
+    EXPECT_THAT(read.status().message(), HasSubstr(c.message)) << c.text;
+    EXPECT_THAT(read.status().message(), ::testing::StartsWith("side.yaml"));
+    EXPECT_EQ(read.status().message().find('\n'), std::string::npos);
+  }
+  EXPECT_TRUE(ParseCalibrationCovariance(good, "side.yaml").ok());
+}
+
+// ReadStereoRig attaches the sidecar when there is one, and the default
+// drift prior otherwise; a camera count that differs from the camchain's,
+// or a lens covariance of the wrong size, is an error naming the sidecar.
+TEST(CalibrationCovarianceFile, ReadStereoRigAttachesTheSidecar) {
+  const StereoRig rig = test::AlphasenseRealisticRig();
+  const std::string camchain =
+      test::WriteTempFile("rig.yaml", FormatCamchain(CamchainFromStereoRig(rig)));
+  const StereoRig without = ReadStereoRig(camchain).value();
+  ASSERT_TRUE(without.calibration_uncertainty().has_value());
+  EXPECT_THAT(without.calibration_uncertainty()->source,
+              HasSubstr("default drift prior 0.1 deg, 0.1 mm per axis"));
+  EXPECT_NEAR(without.calibration_uncertainty()->extrinsics_covariance(0, 0),
+              std::pow(0.1 * kDegree, 2), 1e-20);
+
+  const std::string sidecar = CovarianceSidecarPath(camchain);
+  ASSERT_TRUE(WriteCalibrationCovariance(sidecar, SampleFile()).ok());
+  const StereoRig with = ReadStereoRig(camchain).value();
+  ASSERT_TRUE(with.calibration_uncertainty().has_value());
+  EXPECT_EQ(with.calibration_uncertainty()->left_lens_covariance,
+            SampleFile().cameras[0].intrinsics_covariance);
+  EXPECT_THAT(with.calibration_uncertainty()->source, HasSubstr(sidecar));
+  RigFileOptions no_drift;
+  no_drift.drift_prior = std::pair<double, double>{0.0, 0.0};
+  EXPECT_EQ(ReadStereoRig(camchain, "cam0", "cam1", no_drift)
+                .value()
+                .calibration_uncertainty()
+                ->extrinsics_covariance,
+            *SampleFile().cameras[1].from_previous_covariance);
+
+  CalibrationCovarianceFile three = SampleFile();
+  three.cameras.resize(3);
+  ASSERT_TRUE(WriteCalibrationCovariance(sidecar, three).ok());
+  const StatusOr<StereoRig> mismatch = ReadStereoRig(camchain);
+  ASSERT_FALSE(mismatch.ok());
+  EXPECT_THAT(mismatch.status().message(), HasSubstr("has 3 cameras"));
+
+  CalibrationCovarianceFile small = SampleFile();
+  small.cameras[0].intrinsics_covariance = Covariance(4, 1.0, 4);
+  ASSERT_TRUE(WriteCalibrationCovariance(sidecar, small).ok());
+  const StatusOr<StereoRig> wrong_size = ReadStereoRig(camchain);
+  ASSERT_FALSE(wrong_size.ok());
+  EXPECT_THAT(wrong_size.status().message(),
+              HasSubstr("left lens covariance is 4x4, the camera has 8"));
+  EXPECT_THAT(wrong_size.status().message(), HasSubstr(sidecar));
+}
+
+}  // namespace
+}  // namespace rcm
