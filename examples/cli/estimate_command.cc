@@ -2,6 +2,7 @@
 #include <gflags/gflags.h>
 #include <unistd.h>
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -22,6 +23,7 @@
 #include "progress.h"
 #include "rig_flags.h"
 #include "rcm/estimation/batch_refinement.h"
+#include "rcm/estimation/calibration_propagation.h"
 #include "rcm/estimation/match_refractive_index.h"
 #include "rcm/estimation/prepared_correspondence.h"
 #include "rcm/frontend/stereo_front_end.h"
@@ -93,6 +95,17 @@ DEFINE_bool(estimate_air_gap, false,
             "refine: also estimate the ports' air gap (one offset for both "
             "cameras, from the camchain's port blocks or 0), reported with "
             "its sigma and its correlation with n");
+DEFINE_string(drift_prior, "",
+              "DEG[,MM]: how far the rig may have drifted since its "
+              "calibration, per axis (cam1's rotation in degrees, its "
+              "translation in millimetres), carried into sigma_n; default: "
+              "the camchain's covariance sidecar (rcm calibrate writes it) "
+              "or 0.1,0.1; MM left out is DEG (0 = the calibration exact)");
+DEFINE_bool(self_calibrate, true,
+            "refine: estimate cam1's rotation with n, with the drift prior "
+            "as its prior (the data decide it where they separate it from "
+            "n); --noself-calibrate holds it at the calibration's and only "
+            "propagates its uncertainty");
 DEFINE_double(mask_eta, 0.3,
               "closed-form: use a match when sqrt|u| sqrt|v| > eta, (u, v) "
               "its normalized left coordinates");
@@ -180,7 +193,12 @@ std::string FormatFrameRows(const std::vector<FrameRow>& rows) {
 struct Report {
   std::string method;  // one line for the text report
   double n = NAN;
-  double sigma_n = NAN;
+  double sigma_n = NAN;  // the total, as the estimators report it
+  double sigma_n_noise = NAN;
+  double sigma_n_calibration = NAN;
+  std::optional<CalibrationPropagation> calibration;
+  std::optional<FrameConsistency> consistency;
+  std::optional<RotationCorrection> rotation;  // refine
   double crlb = NAN;
   double sigma_px = NAN;
   std::optional<double> n_closed_form;
@@ -316,7 +334,40 @@ RefinementOptions RefinementOptionsFromFlags() {
   options.loss_scale_px = FLAGS_loss_scale;
   options.inlier_threshold_px = FLAGS_inlier_threshold;
   options.refine_rotation = FLAGS_refine_rotation;
+  options.self_calibrate_rotation = FLAGS_self_calibrate;
   return options;
+}
+
+// --drift-prior DEG[,MM] as (radians, meters); nullopt when not given.
+StatusOr<std::optional<std::pair<double, double>>> DriftPriorFromFlag() {
+  if (FLAGS_drift_prior.empty()) return std::optional<std::pair<double, double>>();
+  double degrees = 0.0;
+  double millimeters = NAN;
+  char tail = 0;
+  const int read = std::sscanf(FLAGS_drift_prior.c_str(), "%lf,%lf%c",
+                               &degrees, &millimeters, &tail);
+  // MM left out: the same number as DEG (as in the default 0.1,0.1).
+  if (read == 1) millimeters = degrees;
+  if ((read != 1 && read != 2) || !std::isfinite(degrees) ||
+      !std::isfinite(millimeters) || degrees < 0.0 || millimeters < 0.0 ||
+      degrees > 10.0 || millimeters > 100.0) {
+    return Status::Error(
+        "--drift-prior must be DEG[,MM] with 0 <= DEG <= 10 and 0 <= MM <= "
+        "100, got '" +
+        FLAGS_drift_prior + "'");
+  }
+  return std::optional<std::pair<double, double>>(
+      std::pair<double, double>{degrees * M_PI / 180.0, 1e-3 * millimeters});
+}
+
+// The estimators' shared uncertainty fields.
+template <typename Estimate>
+void CopyUncertainty(const Estimate& estimate, Report* report) {
+  report->sigma_n = estimate.sigma_n;
+  report->sigma_n_noise = estimate.sigma_n_noise;
+  report->sigma_n_calibration = estimate.sigma_n_calibration;
+  report->calibration = estimate.calibration;
+  report->consistency = estimate.consistency;
 }
 
 std::string LossDescription(const RefinementOptions& options) {
@@ -361,7 +412,8 @@ StatusOr<Report> RunRefine(const StereoRig& rig,
       " (loss " + LossDescription(options) + ", inliers within " +
       FormatFixed(options.inlier_threshold_px, 2) + " px)";
   report.n = summary->n;
-  report.sigma_n = summary->sigma_n;
+  CopyUncertainty(*summary, &report);
+  report.rotation = summary->rotation;
   report.crlb = summary->crlb;
   report.sigma_px = summary->sigma_px;
   report.n_closed_form = summary->n_closed_form;
@@ -404,14 +456,19 @@ StatusOr<Report> RunRefine(const StereoRig& rig,
         {"correlation_with_n",
          {rotation.correlation_with_n.x(), rotation.correlation_with_n.y(),
           rotation.correlation_with_n.z()}},
-        {"multiple_correlation_with_n", rotation.multiple_correlation_with_n}};
+        {"multiple_correlation_with_n", rotation.multiple_correlation_with_n},
+        {"with_prior", rotation.with_prior}};
     std::ostringstream line;
-    line << "  rotation   cam1 corrected by (" << FormatFixed(degrees.x(), 4)
-         << ", " << FormatFixed(degrees.y(), 4) << ", "
-         << FormatFixed(degrees.z(), 4) << ") deg +- ("
+    line << "  rotation   cam1 "
+         << (rotation.with_prior ? "self-calibrated: turned by ("
+                                 : "corrected by (")
+         << FormatFixed(degrees.x(), 4) << ", " << FormatFixed(degrees.y(), 4)
+         << ", " << FormatFixed(degrees.z(), 4) << ") deg +- ("
          << FormatFixed(sigma_degrees.x(), 4) << ", "
          << FormatFixed(sigma_degrees.y(), 4) << ", "
-         << FormatFixed(sigma_degrees.z(), 4) << "); correlation with n R = "
+         << FormatFixed(sigma_degrees.z(), 4)
+         << (rotation.with_prior ? ") since the calibration" : ")")
+         << "; correlation with n R = "
          << FormatFixed(rotation.multiple_correlation_with_n, 2);
     report.text_lines.push_back(line.str());
   }
@@ -442,7 +499,7 @@ StatusOr<Report> RunRefine(const StereoRig& rig,
 template <typename Estimate>
 void CopyEstimate(const Estimate& estimate, Report* report) {
   report->n = estimate.n;
-  report->sigma_n = estimate.sigma_n;
+  CopyUncertainty(estimate, report);
   report->crlb = estimate.crlb;
   report->sigma_px = estimate.sigma_px;
   report->inliers = estimate.inliers;
@@ -614,6 +671,146 @@ StatusOr<Report> RunClosedForm(const StereoRig& rig,
   return report;
 }
 
+constexpr double kDegreesPerRadian = 180.0 / M_PI;
+
+// The calibration's uncertainty as the JSON reports it (null without one).
+nlohmann::json CalibrationJson(const Report& report, const StereoRig& rig) {
+  if (!report.calibration || !rig.calibration_uncertainty()) return nullptr;
+  const CalibrationPropagation& p = *report.calibration;
+  const Eigen::Vector3d per_degree = p.dn_drotation / kDegreesPerRadian;
+  const Eigen::Vector3d per_mm = 1e-3 * p.dn_dtranslation;
+  const Eigen::Matrix3d rotation =
+      rig.calibration_uncertainty()->RotationCovariance();
+  const char* mode = p.mode == RotationMode::kPrior  ? "self-calibrated"
+                     : p.mode == RotationMode::kFree ? "free"
+                                                     : "held";
+  return {
+      {"source", p.source},
+      {"rotation", mode},
+      {"prior_sigma_deg",
+       {std::sqrt(rotation(0, 0)) * kDegreesPerRadian,
+        std::sqrt(rotation(1, 1)) * kDegreesPerRadian,
+        std::sqrt(rotation(2, 2)) * kDegreesPerRadian}},
+      {"sensitivity_per_deg", {per_degree.x(), per_degree.y(), per_degree.z()}},
+      {"sensitivity_per_mm", {per_mm.x(), per_mm.y(), per_mm.z()}},
+      {"sigma_n_rotation", std::sqrt(std::max(0.0, p.variance_rotation))},
+      {"sigma_n_translation", std::sqrt(std::max(0.0, p.variance_translation))},
+      {"sigma_n_lenses", std::sqrt(std::max(0.0, p.variance_lenses))},
+      {"rotation_multiple_correlation", p.rotation_multiple_correlation},
+      {"sigma_inflation_if_free", JsonNumber(p.rotation_sigma_inflation)}};
+}
+
+nlohmann::json ConsistencyJson(const std::optional<FrameConsistency>& c) {
+  if (!c) return nullptr;
+  return {{"frames", c->frames},
+          {"chi_squared", c->chi_squared},
+          {"dof", c->dof},
+          {"p_value", c->p_value},
+          {"inflation", c->inflation}};
+}
+
+// Beyond this many prior sigmas the self-calibrated rotation says the
+// camchain is stale (3: a 0.3 % tail of the prior in one dimension).
+constexpr double kStaleRotationSigmas = 3.0;
+// Above this multiple correlation a free rotation is hardly separable
+// from n (sigma_n more than 3.2x its value with the rotation known).
+constexpr double kHardlySeparableCorrelation = 0.95;
+
+// Warnings about the estimate's uncertainty: a stale calibration, a free
+// rotation the data hardly separate from n, frames that disagree.
+std::vector<std::string> UncertaintyWarnings(const Report& report,
+                                             const StereoRig& rig) {
+  std::vector<std::string> warnings;
+  if (report.rotation && report.calibration && rig.calibration_uncertainty()) {
+    const RotationCorrection& rotation = *report.rotation;
+    const Eigen::Matrix3d prior =
+        rig.calibration_uncertainty()->RotationCovariance();
+    const Eigen::LDLT<Eigen::Matrix3d> ldlt(prior);
+    if (rotation.with_prior && ldlt.info() == Eigen::Success) {
+      const double sigmas =
+          std::sqrt(rotation.angle_axis.dot(ldlt.solve(rotation.angle_axis)));
+      if (sigmas > kStaleRotationSigmas) {
+        warnings.push_back(
+            "the calibration is stale: cam1 has turned by " +
+            FormatFixed(rotation.angle_axis.norm() * kDegreesPerRadian, 3) +
+            " deg since it was made (" + FormatFixed(sigmas, 1) +
+            " drift-prior sigmas); n is self-calibrated with the rotation, "
+            "but for the best n calibrate in the water (rcm calibrate "
+            "--underwater) and estimate with that camchain");
+      }
+    }
+    if (!rotation.with_prior &&
+        rotation.multiple_correlation_with_n > kHardlySeparableCorrelation) {
+      warnings.push_back(
+          "n and cam1's rotation are hardly separable in these data "
+          "(correlation R = " +
+          FormatFixed(rotation.multiple_correlation_with_n, 3) +
+          "): sigma_n says so, " +
+          FormatFixed(report.calibration->rotation_sigma_inflation, 1) +
+          "x its value with the rotation known; calibrate in the water (rcm "
+          "calibrate --underwater) for a better n");
+    }
+  }
+  if (report.consistency && report.consistency->inflation > 1.0) {
+    warnings.push_back(
+        "the frames disagree beyond their sigmas (chi2 " +
+        FormatFixed(report.consistency->chi_squared, 1) + " for " +
+        std::to_string(report.consistency->dof) +
+        " dof): sigma_n's pixel-noise share is inflated x" +
+        FormatFixed(report.consistency->inflation, 2) +
+        " (matches correlated over frames, or a calibration error that "
+        "acts differently at other depths)");
+  }
+  return warnings;
+}
+
+// A probability to two significant digits ("0.49", "3.4e-05").
+std::string FormatProbability(double p) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.2g", p);
+  return text;
+}
+
+// What the text report says of the calibration and the frames.
+std::vector<std::string> CalibrationLines(const Report& report) {
+  std::vector<std::string> lines;
+  if (report.calibration) {
+    const CalibrationPropagation& p = *report.calibration;
+    const Eigen::Vector3d tenth = 0.1 * p.dn_drotation / kDegreesPerRadian;
+    lines.push_back("  calibration " + p.source + "; n moves by (" +
+                    FormatFixed(tenth.x(), 4) + ", " +
+                    FormatFixed(tenth.y(), 4) + ", " +
+                    FormatFixed(tenth.z(), 4) +
+                    ") per 0.1 deg of cam1 rotation about x, y, z");
+    if (p.mode == RotationMode::kHeld) {
+      lines.push_back(
+          "  rotation   held at the calibration's (its uncertainty is in "
+          "sigma_n)");
+    } else {
+      lines.push_back(
+          "  observability  from the data alone, n and cam1's rotation "
+          "correlate with R = " +
+          FormatFixed(p.rotation_multiple_correlation, 3) +
+          " (a free rotation would multiply sigma_n by " +
+          FormatFixed(p.rotation_sigma_inflation, 1) + ")");
+    }
+  }
+  if (report.consistency) {
+    const FrameConsistency& c = *report.consistency;
+    const bool disagree = c.inflation > 1.0;
+    lines.push_back(
+        "  frames     " + std::to_string(c.frames) +
+        (disagree ? " disagree beyond" : " agree within") +
+        " their sigmas: chi2 " + FormatFixed(c.chi_squared, 1) + " for " +
+        std::to_string(c.dof) + " dof (p " + FormatProbability(c.p_value) +
+        ")" +
+        (disagree ? "; the pixel-noise share of sigma_n is inflated x" +
+                        FormatFixed(c.inflation, 2)
+                  : ""));
+  }
+  return lines;
+}
+
 // n per frame with its 1-sigma band, and the final estimate.
 cv::Mat PlotPerFrame(const Report& report) {
   std::vector<double> x, n, low, high;
@@ -764,8 +961,16 @@ int RunEstimate() {
     front_end_options = *options;
   }
 
-  const StatusOr<StereoRig> rig =
-      ReadStereoRig(FLAGS_calib, FLAGS_left_camera, FLAGS_right_camera);
+  const StatusOr<std::optional<std::pair<double, double>>> drift_prior =
+      DriftPriorFromFlag();
+  if (!drift_prior.ok()) {
+    PrintError(command, drift_prior.status().message());
+    return kExitUsage;
+  }
+  RigFileOptions rig_options;
+  rig_options.drift_prior = *drift_prior;
+  const StatusOr<StereoRig> rig = ReadStereoRig(
+      FLAGS_calib, FLAGS_left_camera, FLAGS_right_camera, rig_options);
   if (!rig.ok()) {
     PrintError(command, rig.status().message());
     return kExitFailure;
@@ -844,6 +1049,9 @@ int RunEstimate() {
     PrintError(command, report.status().message());
     return kExitFailure;
   }
+  for (const std::string& warning : UncertaintyWarnings(*report, *rig)) {
+    PrintWarning(command, warning);
+  }
 
   const StereoRig::RectificationDeviation deviation =
       rig->DeviationFromRectified();
@@ -852,6 +1060,10 @@ int RunEstimate() {
   json["port"] = rig->HasThickPort() ? "thick" : "thin";
   json["n"] = JsonNumber(report->n);
   json["sigma_n"] = JsonNumber(report->sigma_n);
+  json["sigma_n_noise"] = JsonNumber(report->sigma_n_noise);
+  json["sigma_n_calibration"] = JsonNumber(report->sigma_n_calibration);
+  json["calibration"] = CalibrationJson(*report, *rig);
+  json["consistency"] = ConsistencyJson(report->consistency);
   json["n_closed_form"] = JsonNumber(report->n_closed_form);
   json["crlb"] = JsonNumber(report->crlb);
   json["sigma_px"] = JsonNumber(report->sigma_px);
@@ -980,10 +1192,16 @@ int RunEstimate() {
          << FormatFixed(report->sigma_n, 5) << " (standard error)\n";
   } else {
     text << "  n          " << FormatFixed(report->n, 5) << " +- "
-         << FormatFixed(report->sigma_n, 5) << " (1 sigma; Cramer-Rao bound "
-         << FormatFixed(report->crlb, 5) << ")\n"
+         << FormatFixed(report->sigma_n, 5) << " (1 sigma: pixel noise "
+         << FormatFixed(report->sigma_n_noise, 5) << ", calibration "
+         << FormatFixed(report->sigma_n_calibration, 5)
+         << "; Cramer-Rao bound " << FormatFixed(report->crlb, 5)
+         << " with the calibration exact)\n"
          << "  pixel noise " << FormatFixed(report->sigma_px, 3)
          << " px (estimated from the inliers)\n";
+    for (const std::string& line : CalibrationLines(*report)) {
+      text << line << "\n";
+    }
   }
   if (!written.empty()) {
     text << "  wrote     ";

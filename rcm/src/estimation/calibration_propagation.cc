@@ -88,6 +88,8 @@ CalibrationParameterLayout CalibrationParameterLayout::Of(const StereoRig& rig) 
 void LocusNormalEquations::Add(const LocusNormalEquations& other) {
   information += other.information;
   gradient += other.gradient;
+  gradient_intercept += other.gradient_intercept;
+  intercept_squares += other.intercept_squares;
   squared_residuals += other.squared_residuals;
   count += other.count;
 }
@@ -95,6 +97,8 @@ void LocusNormalEquations::Add(const LocusNormalEquations& other) {
 void LocusNormalEquations::Subtract(const LocusNormalEquations& other) {
   information -= other.information;
   gradient -= other.gradient;
+  gradient_intercept -= other.gradient_intercept;
+  intercept_squares -= other.intercept_squares;
   squared_residuals -= other.squared_residuals;
   count -= other.count;
 }
@@ -204,8 +208,11 @@ void AccumulateLocusNormalEquations(
       }
     }
     if (!defined || !row.allFinite()) continue;
+    const double a = r - n * row[0] - rotation.dot(row.segment<3>(1));
     equations->information.selfadjointView<Eigen::Lower>().rankUpdate(row);
     equations->gradient += r * row;
+    equations->gradient_intercept += a * row;
+    equations->intercept_squares += a * a;
     equations->squared_residuals += r * r;
     ++equations->count;
     if (per_frame != nullptr) {
@@ -215,6 +222,8 @@ void AccumulateLocusNormalEquations(
       LocusNormalEquations& frame = (*per_frame)[slot->second];
       frame.information.selfadjointView<Eigen::Lower>().rankUpdate(row);
       frame.gradient += r * row;
+      frame.gradient_intercept += a * row;
+      frame.intercept_squares += a * a;
       frame.squared_residuals += r * r;
       ++frame.count;
     }
@@ -229,6 +238,44 @@ void AccumulateLocusNormalEquations(
       symmetrize(&frame.information);
     }
   }
+}
+
+QuadraticSelfCalibration SelfCalibrateQuadratic(
+    const LocusNormalEquations& equations,
+    const Eigen::Matrix3d& rotation_covariance, double sigma_px) {
+  const Eigen::Matrix4d m = equations.information.topLeftCorner<4, 4>();
+  const Eigen::Vector4d intercept = equations.gradient_intercept.head<4>();
+  const Eigen::Matrix3d prior =
+      rotation_covariance.ldlt().solve(Eigen::Matrix3d::Identity());
+  const double dof =
+      static_cast<double>(std::max<int64_t>(equations.count - 4, 1));
+  constexpr int kMaxPasses = 6;
+  constexpr double kVarianceTolerance = 1e-3;  // relative
+  QuadraticSelfCalibration result;
+  double variance = sigma_px * sigma_px;
+  for (int pass = 0; pass < kMaxPasses; ++pass) {
+    Eigen::Matrix4d h = m;
+    h.bottomRightCorner<3, 3>() += variance * prior;
+    Eigen::Vector4d x = -h.ldlt().solve(intercept);
+    if (!(x[0] >= 1.0 && x[0] <= 2.0)) {
+      // n on its bound, the rotation solved there.
+      x[0] = std::clamp(x[0], 1.0, 2.0);
+      x.tail<3>() = -h.bottomRightCorner<3, 3>().ldlt().solve(
+          intercept.tail<3>() + m.block<3, 1>(1, 0) * x[0]);
+    }
+    const double data = std::max(
+        0.0, equations.intercept_squares + 2.0 * intercept.dot(x) +
+                 x.dot(m * x));
+    const double updated = data / dof;
+    result.n = x[0];
+    result.rotation = x.tail<3>();
+    const bool settled =
+        std::abs(updated - variance) <= kVarianceTolerance * updated;
+    variance = updated;
+    if (settled) break;
+  }
+  result.sigma_px = std::sqrt(variance);
+  return result;
 }
 
 double ChiSquaredUpperTail(double chi_squared, int dof) {
@@ -276,14 +323,44 @@ std::optional<FrameConsistency> FrameConsistencyOf(
   return Finish(consistency, sigma_px);
 }
 
+void FrameEstimateSums::Add(double n_f, double information,
+                            const Eigen::Vector3d& rotation_coupling) {
+  s0 += information;
+  s1 += information * n_f;
+  s2 += information * n_f * n_f;
+  b += rotation_coupling;
+  bn += rotation_coupling * n_f;
+  if (information > 0.0) {
+    bb += rotation_coupling * rotation_coupling.transpose() / information;
+  }
+  ++frames;
+}
+
+void FrameEstimateSums::Add(const FrameEstimateSums& other) {
+  s0 += other.s0;
+  s1 += other.s1;
+  s2 += other.s2;
+  b += other.b;
+  bn += other.bn;
+  bb += other.bb;
+  frames += other.frames;
+}
+
+double FrameEstimateSums::WeightedSquares(double n,
+                                          const Eigen::Vector3d& w) const {
+  // sum G_f (n_f - n)^2 - 2 (n_f - n) b_f . w + (b_f . w)^2 / G_f.
+  return s2 - 2.0 * n * s1 + n * n * s0 - 2.0 * (bn - n * b).dot(w) +
+         w.dot(bb * w);
+}
+
 std::optional<FrameConsistency> FrameConsistencyOf(
-    const FrameEstimateSums& sums, double n, double sigma_px) {
+    const FrameEstimateSums& sums, double n, double sigma_px,
+    const Eigen::Vector3d& rotation) {
   FrameConsistency consistency;
   consistency.frames = sums.frames;
   // Rounding can take the difference of large sums a little below zero.
-  consistency.chi_squared =
-      std::max(0.0, sums.s2 - 2.0 * n * sums.s1 + n * n * sums.s0) /
-      (sigma_px * sigma_px);
+  consistency.chi_squared = std::max(0.0, sums.WeightedSquares(n, rotation)) /
+                            (sigma_px * sigma_px);
   return Finish(consistency, sigma_px);
 }
 

@@ -176,22 +176,44 @@ double LocusCostFunction::Information(double n) const {
   return Interpolate(information_, n);
 }
 
-LocusCostFunction::Minimum LocusCostFunction::Minimize() const {
-  const auto& edges = PanelEdges();
+LocusCostFunction::Minimum LocusCostFunction::Minimize(double linear,
+                                                       double quadratic,
+                                                       double low_bound,
+                                                       double high_bound) const {
+  CHECK(low_bound >= 1.0 && high_bound <= 2.0 && low_bound < high_bound)
+      << low_bound << " " << high_bound;
+  // The function minimized, F = C + linear n + quadratic n^2, and F'.
+  const auto cost = [&](double n) {
+    return Cost(n) + (linear + quadratic * n) * n;
+  };
+  const auto derivative = [&](double n) {
+    return CostDerivative(n) + linear + 2.0 * quadratic * n;
+  };
   // The samples, increasing: each panel's kSamplesPerPanel points from its
-  // left edge, then n = 2.
-  constexpr int kNumSamples = kNumPanels * kSamplesPerPanel + 1;
-  const auto sample = [&](int s) {
-    if (s == kNumSamples - 1) return 2.0;
+  // left edge, then n = 2; of a sub-interval, those inside it and its ends.
+  const auto& edges = PanelEdges();
+  constexpr int kNumGridSamples = kNumPanels * kSamplesPerPanel + 1;
+  const auto grid = [&](int s) {
+    if (s == kNumGridSamples - 1) return 2.0;
     const int panel = s / kSamplesPerPanel;
     const int offset = s % kSamplesPerPanel;
     return edges[panel] + (edges[panel + 1] - edges[panel]) * offset /
                               static_cast<double>(kSamplesPerPanel);
   };
+  std::array<double, kNumGridSamples + 2> samples;
+  int num_samples = 0;
+  if (low_bound > 1.0) samples[num_samples++] = low_bound;
+  for (int s = 0; s < kNumGridSamples; ++s) {
+    const double n = grid(s);
+    if (n >= low_bound && n <= high_bound) samples[num_samples++] = n;
+  }
+  if (high_bound < 2.0) samples[num_samples++] = high_bound;
+  const auto sample = [&](int s) { return samples[s]; };
+
   int best = 0;
   double best_cost = std::numeric_limits<double>::infinity();
-  for (int s = 0; s < kNumSamples; ++s) {
-    const double c = Cost(sample(s));
+  for (int s = 0; s < num_samples; ++s) {
+    const double c = cost(sample(s));
     if (c < best_cost) {
       best_cost = c;
       best = s;
@@ -202,29 +224,29 @@ LocusCostFunction::Minimum LocusCostFunction::Minimize() const {
     return Minimum{n, Cost(n), Information(n)};
   };
   const double at_best = sample(best);
-  const double slope = CostDerivative(at_best);
+  const double slope = derivative(at_best);
   if (slope == 0.0) return result(at_best);
-  if (best == 0 && slope > 0.0) return result(1.0);
-  if (best == kNumSamples - 1 && slope < 0.0) return result(2.0);
-  // The root of C' between the best sample and the neighbour downhill.
+  if (best == 0 && slope > 0.0) return result(low_bound);
+  if (best == num_samples - 1 && slope < 0.0) return result(high_bound);
+  // The root of F' between the best sample and the neighbour downhill.
   double low = slope > 0.0 ? sample(best - 1) : at_best;
   double high = slope > 0.0 ? at_best : sample(best + 1);
-  if (CostDerivative(low) < 0.0 && CostDerivative(high) > 0.0) {
+  if (derivative(low) < 0.0 && derivative(high) > 0.0) {
     while (true) {
       const double middle = 0.5 * (low + high);
       if (!(middle > low && middle < high)) break;
-      (CostDerivative(middle) > 0.0 ? high : low) = middle;
+      (derivative(middle) > 0.0 ? high : low) = middle;
     }
-    return result(CostDerivative(high) < -CostDerivative(low) ? high : low);
+    return result(derivative(high) < -derivative(low) ? high : low);
   }
-  // C' changes sign more than once between two samples (C has a maximum
-  // and a minimum there): golden-section search of C over both neighbours.
+  // F' changes sign more than once between two samples (F has a maximum
+  // and a minimum there): golden-section search of F over both neighbours.
   low = sample(std::max(0, best - 1));
-  high = sample(std::min(kNumSamples - 1, best + 1));
+  high = sample(std::min(num_samples - 1, best + 1));
   const double middle =
-      GoldenSectionMinimize([this](double n) { return Cost(n); }, low, high,
+      GoldenSectionMinimize(cost, low, high,
                             4.0 * std::numeric_limits<double>::epsilon());
-  return result(Cost(middle) <= best_cost ? middle : at_best);
+  return result(cost(middle) <= best_cost ? middle : at_best);
 }
 
 }  // namespace rcm

@@ -1,11 +1,13 @@
 #include "rcm/estimation/online_estimator.h"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
 #include <utility>
 
+#include "rcm/estimation/batch_refinement.h"
 #include "rcm/estimation/prepared_correspondence.h"
 #include "rcm/estimation/robust_locus_fit.h"
 #include "rcm/geometry/epipolar.h"
@@ -65,53 +67,99 @@ FrameFit FitFrame(const StereoRig& rig,
   }
   fit.skipped = false;
 
-  // Stage 1 on the frame alone, and its inliers.
-  fit.n_robust = MinimizeRobustLocusCost(essential, matches, options);
+  // Stage 1 on the frame alone, and its inliers: with self-calibration,
+  // the batch refinement of the frame (robust stage with cam1's rotation
+  // and its prior, inliers classified with the rotation); otherwise, or
+  // when that fails, n alone with the rotation held.
+  Eigen::Vector3d rotation = Eigen::Vector3d::Zero();
+  Rigid3d extrinsics = rig.right_from_left();
+  std::vector<int64_t> chosen;  // indices into `matches`
+  if (SelfCalibrates(rig, options)) {
+    const StatusOr<RefinementSummary> own =
+        RefineRefractiveIndex(rig, frame_matches, options);
+    if (own.ok() && own->rotation) {
+      fit.n_robust = own->n_robust;
+      rotation = own->rotation->angle_axis;
+      extrinsics = own->rotation->cam1_from_cam0;
+      // Its inliers are indices into the frame, increasing, as are
+      // prepared.source_index.
+      for (size_t i = 0, k = 0; i < prepared.source_index.size(); ++i) {
+        while (k < own->inliers.size() &&
+               own->inliers[k] < prepared.source_index[i]) {
+          ++k;
+        }
+        if (k < own->inliers.size() &&
+            own->inliers[k] == prepared.source_index[i]) {
+          chosen.push_back(static_cast<int64_t>(i));
+        }
+      }
+    }
+  }
+  if (chosen.empty()) {
+    rotation.setZero();
+    extrinsics = rig.right_from_left();
+    fit.n_robust = MinimizeRobustLocusCost(essential, matches, options);
+    chosen = ClassifyLocusInliers(extrinsics, matches, fit.n_robust, options);
+  }
   std::vector<PreparedCorrespondence> inlier_matches;
   std::vector<int64_t> inlier_sources;
-  for (const int64_t i : ClassifyLocusInliers(rig.right_from_left(), matches,
-                                              fit.n_robust, options)) {
+  for (const int64_t i : chosen) {
     inlier_matches.push_back(matches[i]);
     inlier_sources.push_back(prepared.source_index[i]);
   }
   std::vector<int64_t> rejected;
-  fit.cost.AddMatches(essential, inlier_matches, options.num_threads,
-                      &rejected);
+  fit.cost.AddMatches(EssentialMatrix(extrinsics), inlier_matches,
+                      options.num_threads, &rejected);
   // Matches whose residual is undefined somewhere in [1, 2] (at an
   // epipole) are left out of C_f; drop them from the reported inliers too.
   fit.inliers.reserve(inlier_sources.size() - rejected.size());
+  std::vector<PreparedCorrespondence> kept;
+  kept.reserve(inlier_sources.size() - rejected.size());
   for (size_t i = 0, r = 0; i < inlier_sources.size(); ++i) {
     if (r < rejected.size() && rejected[r] == static_cast<int64_t>(i)) {
       ++r;
       continue;
     }
     fit.inliers.push_back(inlier_sources[i]);
+    kept.push_back(inlier_matches[i]);
   }
+  // n at the frame's own rotation (the calibration's, or self-calibrated).
   fit.estimate = EstimateFromLocusCost(fit.cost, options);
 
-  // The calibration's share needs the inliers' normal equations.
+  // The calibration's share and the self-calibration need the inliers'
+  // normal equations, taken at the frame's own estimate.
   if (rig.calibration_uncertainty()) {
     const CalibrationParameterLayout layout = CalibrationParameterLayout::Of(rig);
     fit.normal_equations = LocusNormalEquations(layout.Size());
     std::vector<StereoCorrespondence> raw;
     raw.reserve(fit.inliers.size());
     for (const int64_t i : fit.inliers) raw.push_back(frame_matches[i]);
-    std::vector<PreparedCorrespondence> kept;
-    kept.reserve(fit.inliers.size());
-    for (size_t i = 0, r = 0; i < inlier_matches.size(); ++i) {
-      if (r < rejected.size() && rejected[r] == static_cast<int64_t>(i)) {
-        ++r;
-        continue;
-      }
-      kept.push_back(inlier_matches[i]);
-    }
     std::vector<int64_t> all(kept.size());
     for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int64_t>(i);
     AccumulateLocusNormalEquations(
         rig, raw, kept, all, fit.estimate.ok() ? fit.estimate->n : fit.n_robust,
-        Eigen::Vector3d::Zero(), &fit.normal_equations);
+        rotation, &fit.normal_equations);
+  }
+  if (fit.estimate.ok()) {
+    FrameFit::Model model;
+    const double information = fit.normal_equations.information(0, 0);
+    if (rig.calibration_uncertainty() && information > 0.0) {
+      model.information = information;
+      model.rotation_coupling =
+          fit.normal_equations.information.block<3, 1>(1, 0);
+      model.n = -fit.normal_equations.gradient_intercept[0] / information;
+    } else {
+      model.n = fit.estimate->n;
+      model.information = fit.cost.Information(fit.estimate->n);
+    }
+    fit.model = model;
   }
   return fit;
+}
+
+bool SelfCalibrates(const StereoRig& rig, const RefinementOptions& options) {
+  return options.self_calibrate_rotation && rig.calibration_uncertainty() &&
+         !rig.calibration_uncertainty()->RotationCovariance().isZero(0.0);
 }
 
 StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
@@ -119,26 +167,59 @@ StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
     const LocusNormalEquations& normal_equations,
     const FrameEstimateSums& frame_estimates,
     const RefinementOptions& options) {
+  // n alone first: it checks the inliers and the observability of n.
   const StatusOr<LocusEstimate> locus = EstimateFromLocusCost(cost, options);
   if (!locus.ok()) return locus.status();
   CalibratedLocusEstimate estimate;
   estimate.locus = *locus;
+  if (!rig.calibration_uncertainty()) {
+    estimate.consistency =
+        FrameConsistencyOf(frame_estimates, locus->n, locus->sigma_px);
+    const double inflation =
+        estimate.consistency ? estimate.consistency->inflation : 1.0;
+    estimate.sigma_n_noise = estimate.sigma_n = locus->sigma_n * inflation;
+    return estimate;
+  }
+  const CalibrationUncertainty& uncertainty = *rig.calibration_uncertainty();
+  const CalibrationParameterLayout layout = CalibrationParameterLayout::Of(rig);
+  LocusNormalEquations at_solution = normal_equations;
+  const bool self_calibrate = SelfCalibrates(rig, options);
+  Eigen::Vector3d rotation = Eigen::Vector3d::Zero();
+  if (self_calibrate) {
+    const QuadraticSelfCalibration pooled = SelfCalibrateQuadratic(
+        normal_equations, uncertainty.RotationCovariance(), locus->sigma_px);
+    estimate.locus.n = pooled.n;
+    estimate.locus.sigma_px = pooled.sigma_px;
+    rotation = pooled.rotation;
+    estimate.rotation = rotation;
+  } else {
+    // n alone: the information on n at the estimate, from the interpolant.
+    at_solution.information(0, 0) = cost.Information(locus->n);
+  }
+  const double n = estimate.locus.n;
+  const double sigma_px = estimate.locus.sigma_px;
+  estimate.locus.crlb = sigma_px / std::sqrt(cost.Information(n));
   estimate.consistency =
-      FrameConsistencyOf(frame_estimates, locus->n, locus->sigma_px);
+      FrameConsistencyOf(frame_estimates, n, sigma_px, rotation);
   const double inflation =
       estimate.consistency ? estimate.consistency->inflation : 1.0;
-  estimate.sigma_n_noise = locus->sigma_n * inflation;
-  if (rig.calibration_uncertainty()) {
-    StatusOr<CalibrationPropagation> propagation = PropagateCalibration(
-        normal_equations, CalibrationParameterLayout::Of(rig),
-        *rig.calibration_uncertainty(), RotationMode::kHeld, locus->sigma_px,
-        inflation);
-    if (!propagation.ok()) return propagation.status();
-    estimate.sigma_n_calibration = propagation->sigma_n_calibration;
-    estimate.calibration = *propagation;
+  StatusOr<CalibrationPropagation> propagation = PropagateCalibration(
+      at_solution, layout, uncertainty,
+      self_calibrate ? RotationMode::kPrior : RotationMode::kHeld, sigma_px,
+      inflation);
+  if (!propagation.ok()) return propagation.status();
+  if (self_calibrate) {
+    estimate.sigma_n_noise = propagation->sigma_n_noise;
+  } else {
+    // n alone: the pixel-noise share exactly as without a calibration
+    // uncertainty (the interpolant's information at n).
+    estimate.sigma_n_noise = estimate.locus.crlb * inflation;
   }
+  estimate.sigma_n_calibration = propagation->sigma_n_calibration;
   estimate.sigma_n =
       std::hypot(estimate.sigma_n_noise, estimate.sigma_n_calibration);
+  estimate.locus.sigma_n = estimate.sigma_n;
+  estimate.calibration = *propagation;
   return estimate;
 }
 
@@ -176,8 +257,9 @@ OnlineRefractiveIndexEstimator::AddFrame(
     if (rig_.calibration_uncertainty()) {
       normal_equations_.Add(fit.normal_equations);
     }
-    if (fit.estimate.ok()) {
-      frame_estimates_.Add(fit.estimate->n, fit.cost.Information(fit.estimate->n));
+    if (fit.model) {
+      frame_estimates_.Add(fit.model->n, fit.model->information,
+                           fit.model->rotation_coupling);
     }
     update.inliers = std::move(fit.inliers);
   }
@@ -201,6 +283,7 @@ OnlineRefractiveIndexEstimator::Current() const {
   estimate.sigma_px = locus.sigma_px;
   estimate.consistency = calibrated->consistency;
   estimate.calibration = calibrated->calibration;
+  estimate.rotation = calibrated->rotation;
   estimate.inliers = locus.inliers;
   estimate.correspondences = num_correspondences_;
   estimate.frames = num_frames_;

@@ -74,7 +74,8 @@ void SlidingWindowRefractiveIndexEstimator::ResumWindow() {
     if (rig_.calibration_uncertainty()) {
       window_normal_equations_.Add(frame.normal_equations);
     }
-    window_estimates_.Add(frame.estimate.n, frame.information);
+    window_estimates_.Add(frame.model.n, frame.model.information,
+                          frame.model.rotation_coupling);
   }
 }
 
@@ -111,12 +112,15 @@ SlidingWindowRefractiveIndexEstimator::AddFrame(
   frame_cost.estimate = *fit.estimate;
   frame_cost.cost = fit.cost;
   frame_cost.normal_equations = fit.normal_equations;
-  frame_cost.information = fit.cost.Information(fit.estimate->n);
+  frame_cost.model = *fit.model;
 
   const StatusOr<Estimate> window = Current();
   if (window.ok()) {
-    update.z =
-        ChangeStatistic(frame_cost.estimate, window->n, window->sigma_n_noise);
+    // With a self-calibrated window, the frame's own n at the window's
+    // rotation (FrameFit::Model).
+    LocusEstimate own = frame_cost.estimate;
+    if (window->rotation) own.n = frame_cost.model.At(*window->rotation);
+    update.z = ChangeStatistic(own, window->n, window->sigma_n_noise);
   }
   if (!update.z || *update.z <= window_options_.change_threshold) {
     num_dropped_frames_ += static_cast<int64_t>(pending_.size());
@@ -180,6 +184,7 @@ SlidingWindowRefractiveIndexEstimator::Current() const {
   estimate.sigma_px = locus.sigma_px;
   estimate.consistency = calibrated->consistency;
   estimate.calibration = calibrated->calibration;
+  estimate.rotation = calibrated->rotation;
   estimate.inliers = locus.inliers;
   estimate.frames = window_count_;
   estimate.first_frame = window_[window_begin_].frame;

@@ -105,42 +105,50 @@ struct LocusNormalEquations {
 
   Matrix information;  // M
   Vector gradient;     // g
+  // The affine model of each residual about x = (n, w) = 0: with x_i =
+  // (n_i, w_i) where row i was taken, a_i = r_i - j_i[n, w] . x_i, so that
+  // r_i(x) ~ a_i + j_i[n, w] . x. Sums over rows taken at different points
+  // (frames, each linearized at its own estimate) then give the quadratic
+  // model sum_i r_i(x)^2 ~ A + 2 intercept[n, w] . x + x^T M[n, w] x of
+  // all of them (online_estimator.h).
+  Vector gradient_intercept;       // sum_i a_i j_i
+  double intercept_squares = 0.0;  // A = sum_i a_i^2
   double squared_residuals = 0.0;  // C
   int64_t count = 0;
 
   explicit LocusNormalEquations(int size = 7)
       : information(Matrix::Zero(size, size)),
-        gradient(Vector::Zero(size)) {}
+        gradient(Vector::Zero(size)),
+        gradient_intercept(Vector::Zero(size)) {}
   int size() const { return static_cast<int>(gradient.size()); }
   void Add(const LocusNormalEquations& other);
   void Subtract(const LocusNormalEquations& other);
 };
 
-// Sums over frames of G_f, G_f n_f and G_f n_f^2 for the frames' own
-// estimates n_f (G_f = sum (dr/dn)^2 of the frame's inliers): the
-// consistency test of frames whose residuals are no longer at hand,
+// Sums over frames of their own estimates n_f (cam1's rotation held), for
+// the consistency test of frames whose residuals are no longer at hand.
+// With G_f = sum (dr/dn)^2 and b_f = sum dr/dn dr/dw of the frame's
+// inliers, a frame's own estimate at the pooled rotation w is
+// n_f - b_f . w / G_f to first order, and
 //
-//   chi^2 = sum_f G_f (n_f - n)^2 / sigma^2
-//         = (S2 - 2 n S1 + n^2 S0) / sigma^2,
+//   chi^2 = sum_f G_f (n_f - b_f . w / G_f - n)^2 / sigma^2
 //
-// the same test as FrameConsistencyOf to first order.
+// expands into the sums kept here; the same test as the per-frame
+// FrameConsistencyOf to first order.
 struct FrameEstimateSums {
-  double s0 = 0.0;
-  double s1 = 0.0;
-  double s2 = 0.0;
+  double s0 = 0.0;                                  // sum G_f
+  double s1 = 0.0;                                  // sum G_f n_f
+  double s2 = 0.0;                                  // sum G_f n_f^2
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();      // sum b_f
+  Eigen::Vector3d bn = Eigen::Vector3d::Zero();     // sum b_f n_f
+  Eigen::Matrix3d bb = Eigen::Matrix3d::Zero();     // sum b_f b_f^T / G_f
   int frames = 0;
-  void Add(double n_f, double information) {
-    s0 += information;
-    s1 += information * n_f;
-    s2 += information * n_f * n_f;
-    ++frames;
-  }
-  void Add(const FrameEstimateSums& other) {
-    s0 += other.s0;
-    s1 += other.s1;
-    s2 += other.s2;
-    frames += other.frames;
-  }
+
+  void Add(double n_f, double information,
+           const Eigen::Vector3d& rotation_coupling = Eigen::Vector3d::Zero());
+  void Add(const FrameEstimateSums& other);
+  // chi^2 sigma^2 above at (n, w).
+  double WeightedSquares(double n, const Eigen::Vector3d& rotation) const;
 };
 
 // Adds the rows j_i of `matches[indices]` at (n, w) for `rig`
@@ -155,6 +163,26 @@ void AccumulateLocusNormalEquations(
     const std::vector<int64_t>& indices, double n,
     const Eigen::Vector3d& rotation, LocusNormalEquations* equations,
     std::vector<LocusNormalEquations>* per_frame = nullptr);
+
+// The self-calibration of cam1's rotation on the quadratic model of
+// `equations` (their rows' affine models, gradient_intercept): the MAP
+// estimate of x = (n, w) with the prior P = rotation_covariance^-1,
+//
+//   x = -(M[n, w] + diag(0, sigma^2 P))^-1 intercept[n, w],
+//
+// with sigma^2 = (A + 2 intercept . x + x^T M x) / (N - 4) re-estimated
+// from the model's residual (N = equations.count) until it settles (a
+// few passes from `sigma_px`), and n held in [1, 2] (w then solved at the
+// bound). Used by the online estimators (online_estimator.h); the batch
+// refinement solves the nonlinear problem instead.
+struct QuadraticSelfCalibration {
+  double n = 1.0;
+  Eigen::Vector3d rotation = Eigen::Vector3d::Zero();
+  double sigma_px = 0.0;
+};
+QuadraticSelfCalibration SelfCalibrateQuadratic(
+    const LocusNormalEquations& equations,
+    const Eigen::Matrix3d& rotation_covariance, double sigma_px);
 
 // How cam1's rotation w is treated.
 enum class RotationMode {
@@ -173,14 +201,16 @@ struct FrameConsistency {
   double inflation = 1.0;
   static constexpr double kInflationP = 0.01;
 };
+
 // From the per-frame sums of AccumulateLocusNormalEquations at the
 // solution; nullopt for fewer than two frames with information on n.
 std::optional<FrameConsistency> FrameConsistencyOf(
     const std::vector<LocusNormalEquations>& per_frame, double sigma_px);
-// From the frames' own estimates at the pooled n; nullopt for fewer than
-// two frames.
+// From the frames' own estimates at the pooled n and rotation w (zero when
+// it is held); nullopt for fewer than two frames.
 std::optional<FrameConsistency> FrameConsistencyOf(
-    const FrameEstimateSums& sums, double n, double sigma_px);
+    const FrameEstimateSums& sums, double n, double sigma_px,
+    const Eigen::Vector3d& rotation = Eigen::Vector3d::Zero());
 // P(chi^2_dof > chi_squared), Wilson-Hilferty; dof >= 1.
 double ChiSquaredUpperTail(double chi_squared, int dof);
 

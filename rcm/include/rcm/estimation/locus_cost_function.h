@@ -119,7 +119,12 @@ class LocusCostFunction {
     double information = 0.0;  // G(n)
   };
   static constexpr int kSamplesPerPanel = 32;
-  Minimum Minimize() const;
+  // With `linear` and `quadratic`, the same for C(n) + linear n +
+  // quadratic n^2 (a rotation profiled out, online_estimator.h), and over
+  // [low, high] within [1, 2] (the samples inside it and its ends; a
+  // minimum on an end returns it); Minimum's cost is still C(n).
+  Minimum Minimize(double linear = 0.0, double quadratic = 0.0,
+                   double low = 1.0, double high = 2.0) const;
 
  private:
   // Values at Nodes().

@@ -80,11 +80,40 @@ StatusOr<LocusEstimate> EstimateFromLocusCost(const LocusCostFunction& cost,
 
 // A LocusEstimate with the uncertainty of the calibration and the frames'
 // consistency (calibration_propagation.h), shared by the online and the
-// sliding-window estimators: sigma_n = hypot(sigma_px / sqrt(G(n))
-// inflated by the consistency test, the calibration's share with cam1's
-// rotation held).
+// sliding-window estimators.
+//
+// Without a calibration uncertainty: n alone, sigma_n = sigma_px /
+// sqrt(G(n)), inflated by the consistency test. With one whose rotation
+// covariance is nonzero and options.self_calibrate_rotation: cam1's
+// rotation w is self-calibrated as in the batch (batch_refinement.h), from
+// the frames' normal equations. The residuals are linear in w to first
+// order about the calibration's rotation, r_i(n, w) ~ r_i(n, 0) + j_w,i w,
+// so that the cost
+//
+//   C(n) + 2 g(n) . w + w^T H w + sigma^2 w^T P w,
+//   g(n) ~ g0 + b n  (gradient_intercept and M_{w, n} of the frames' sums),
+//
+// is minimized over w in closed form, w(n) = -(H + sigma^2 P)^-1 g(n), and
+// over n by LocusCostFunction::Minimize of C(n) - g(n)^T (H + sigma^2
+// P)^-1 g(n), a quadratic added to C; sigma^2 is refined from the
+// residual at the solution (two or three passes). The linear g(n) holds
+// near the frames' own estimates, not over all of [1, 2] (far away its
+// concave quadratic would win), so the minimum is searched within 0.15
+// of the estimate with the rotation held, the interval moved along (up to
+// three times) while the minimum sits on one of its inner ends. The neglected second
+// order in w is ~f |w|^2 / 2 in pixels (0.002 px at 0.15 degree and
+// f = 500 px). Inliers are the frames' own, classified with the rotation
+// held, so a drift that moves matches beyond the inlier threshold
+// (about inlier_threshold / f radians) loses them: the batch refinement
+// classifies with the rotation estimated. Otherwise the rotation is held
+// and its uncertainty propagated.
 struct CalibratedLocusEstimate {
+  // n, sigma_px and crlb at the solution (n alone, or with the rotation);
+  // locus.sigma_n = sigma_n.
   LocusEstimate locus;
+  // The self-calibrated rotation of cam1 (angle-axis, radians, the
+  // convention of StereoRig::WithCam1Moved), when it is estimated.
+  std::optional<Eigen::Vector3d> rotation;
   double sigma_n = 0.0;
   double sigma_n_noise = 0.0;
   double sigma_n_calibration = 0.0;
@@ -93,6 +122,7 @@ struct CalibratedLocusEstimate {
 };
 // `normal_equations` and `frame_estimates` sum the frames of `cost`; a rig
 // without a calibration uncertainty ignores the former.
+bool SelfCalibrates(const StereoRig& rig, const RefinementOptions& options);
 StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
     const StereoRig& rig, const LocusCostFunction& cost,
     const LocusNormalEquations& normal_equations,
@@ -113,6 +143,22 @@ struct FrameFit {
   // equations (calibration_propagation.h) at n_f (n_robust without an own
   // estimate) and cam1's rotation held; empty (all zero) otherwise.
   LocusNormalEquations normal_equations;
+  // The frame's own n as the consistency test sees it, n_f(w) = n - b .
+  // w / information to first order in cam1's rotation w (FrameEstimateSums,
+  // calibration_propagation.h): from normal_equations' model when there is
+  // one (linearized at the frame's own self-calibrated estimate), else the
+  // own estimate with C_f's information and b = 0. Unset without an own
+  // estimate.
+  struct Model {
+    double n = 0.0;
+    double information = 0.0;
+    Eigen::Vector3d rotation_coupling = Eigen::Vector3d::Zero();
+    double At(const Eigen::Vector3d& rotation) const {
+      return information > 0.0 ? n - rotation_coupling.dot(rotation) / information
+                               : n;
+    }
+  };
+  std::optional<Model> model;
 };
 FrameFit FitFrame(const StereoRig& rig,
                   const std::vector<StereoCorrespondence>& frame_matches,
@@ -138,6 +184,8 @@ class OnlineRefractiveIndexEstimator {
     double sigma_px = 0.0;
     std::optional<FrameConsistency> consistency;
     std::optional<CalibrationPropagation> calibration;
+    // The self-calibrated rotation of cam1 (CalibratedLocusEstimate).
+    std::optional<Eigen::Vector3d> rotation;
     int64_t inliers = 0;          // in the running sums
     int64_t correspondences = 0;  // every correspondence of every frame
     int64_t frames = 0;           // frames added, skipped ones included

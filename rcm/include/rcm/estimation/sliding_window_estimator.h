@@ -117,6 +117,8 @@ class SlidingWindowRefractiveIndexEstimator {
     double sigma_px = 0.0;
     std::optional<FrameConsistency> consistency;
     std::optional<CalibrationPropagation> calibration;
+    // The self-calibrated rotation of cam1 (online_estimator.h).
+    std::optional<Eigen::Vector3d> rotation;
     int64_t inliers = 0;      // in the window
     int frames = 0;           // frames in the window
     int64_t first_frame = 0;  // oldest frame in the window
@@ -173,7 +175,7 @@ class SlidingWindowRefractiveIndexEstimator {
     LocusEstimate estimate;  // the frame's own
     LocusCostFunction cost;
     LocusNormalEquations normal_equations;  // FrameFit's
-    double information = 0.0;  // G_f(n_f)
+    FrameFit::Model model;                  // FrameFit's
   };
 
   // Appends to the ring buffer (dropping the oldest when full) and
