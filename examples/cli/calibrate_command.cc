@@ -19,6 +19,7 @@
 #include "image_input_flags.h"
 #include "lens_model_flag.h"
 #include "progress.h"
+#include "rcm/calib/calibration_covariance.h"
 #include "rcm/calib/calibration_report.h"
 #include "rcm/calib/calibration_target.h"
 #include "rcm/calib/cross_validation.h"
@@ -26,6 +27,7 @@
 #include "rcm/calib/target_detector.h"
 #include "rcm/geometry/stereo_rig.h"
 #include "rcm/io/atomic_file.h"
+#include "rcm/io/calibration_covariance_file.h"
 #include "rcm/io/camchain.h"
 #include "rcm/io/number_format.h"
 
@@ -443,6 +445,7 @@ int RunCalibrate() {
 
   nlohmann::json json;
   json["camchain"] = paths.camchain;
+  json["covariance"] = CovarianceSidecarPath(paths.camchain);
   json["report"] = paths.report;
   json["target"] = calib::DescribeTarget(*target);
   json["source"] = (*source)->Describe();
@@ -512,7 +515,21 @@ int RunCalibrate() {
     PrintError(command, status.message());
     return kExitFailure;
   }
+  // The covariance sidecar, which the estimators read with the camchain
+  // (rcm/io/calibration_covariance_file.h), just before it; removed again
+  // if the camchain cannot be written, so that an older camchain never
+  // gets this calibration's sidecar.
+  const std::string covariance_path = CovarianceSidecarPath(paths.camchain);
+  if (Status status = WriteCalibrationCovariance(
+          covariance_path,
+          calib::AirCalibrationCovariance(*calibration, cross_validation));
+      !status.ok()) {
+    PrintError(command, status.message());
+    return kExitFailure;
+  }
   if (Status status = WriteCamchain(paths.camchain, camchain); !status.ok()) {
+    std::error_code ignored;
+    std::filesystem::remove(covariance_path, ignored);
     PrintError(command, status.message());
     return kExitFailure;
   }
@@ -577,7 +594,9 @@ int RunCalibrate() {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();
-  std::printf("wrote %s and %s/ in %.1f s\n", paths.camchain.c_str(),
+  std::printf("wrote %s (with %s) and %s/ in %.1f s\n",
+              paths.camchain.c_str(),
+              CovarianceSidecarPath(paths.camchain).c_str(),
               paths.report.c_str(), seconds);
   return kExitOk;
 }

@@ -717,6 +717,36 @@ void AddEstimateRows(std::vector<BadInputCase>* rows) {
                        expected, image_outputs});
     }
   }
+  // The calibration's uncertainty: the drift prior flag and the sidecar.
+  for (const auto& [name, value] :
+       std::vector<std::pair<std::string, std::string>>{
+           {"Text", "abc"}, {"Negative", "-0.1"}, {"TooLarge", "20"},
+           {"ThreeNumbers", "0.1,0.1,0.1"}, {"Nan", "nan"}}) {
+    rows->push_back({"EstimateDriftPrior" + name,
+                     Nothing(),
+                     {"estimate", "--calib", kRig, "--matches", kMatches,
+                      "--drift-prior", value, "--out", "$D/out"},
+                     "--drift-prior must be DEG[,MM]",
+                     {"$D/out/estimate.json"}});
+  }
+  rows->push_back(
+      {"EstimateCovarianceSidecarMalformed",
+       Steps({File("rig.yaml", test::ReadWholeFile(kRig)),
+              File("rig-covariance.yaml", "medium: air\ncam0: [1, 2]\n")}),
+       {"estimate", "--calib", "$D/rig.yaml", "--matches", kMatches, "--out",
+        "$D/out"},
+       "$D/rig-covariance.yaml:2: cam0: ",
+       {"$D/out/estimate.json"}});
+  rows->push_back(
+      {"EstimateCovarianceSidecarNotPositive",
+       Steps({File("rig.yaml", test::ReadWholeFile(kRig)),
+              File("rig-covariance.yaml",
+                   "medium: air\ncam0:\n  intrinsics_covariance:\n  - [-1]\n")}),
+       {"estimate", "--calib", "$D/rig.yaml", "--matches", kMatches, "--out",
+        "$D/out"},
+       "$D/rig-covariance.yaml:4: cam0.intrinsics_covariance: is not positive "
+       "semi-definite",
+       {"$D/out/estimate.json"}});
   // Outputs that cannot be written.
   rows->push_back({"EstimateOutBelowAFile",
                    File("file", "a file\n"),
