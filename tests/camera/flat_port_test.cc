@@ -1,5 +1,6 @@
 #include "rcm/camera/flat_port.h"
 
+#include <ceres/jet.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -8,8 +9,6 @@
 #include <optional>
 #include <random>
 #include <vector>
-
-#include <ceres/jet.h>
 
 #include "rcm/camera/flat_port_camera.h"
 #include "rcm/camera/flat_port_projection.h"
@@ -440,9 +439,8 @@ namespace {
 constexpr double kProjectionTolerance = 1e-12;
 
 // FlatPortProjection::NormalizedFromPoint in double for a port.
-std::optional<Eigen::Vector2d> ProjectThroughPort(const FlatPort& port,
-                                                  double n,
-                                                  const Eigen::Vector3d& point) {
+std::optional<Eigen::Vector2d> ProjectThroughPort(
+    const FlatPort& port, double n, const Eigen::Vector3d& point) {
   const Eigen::Vector3d normal = port.normal.normalized();
   Eigen::Vector2d normalized;
   if (!FlatPortProjection::NormalizedFromPoint(
@@ -466,8 +464,8 @@ std::vector<FlatPort> PortsOfEveryKind() {
   FlatPort thick;
   thick.air_gap = 0.008;
   thick.glass_thickness = 0.006;
-  return {FlatPort(), tilted_thin, gap_only, glass_only, thick,
-          ThickTiltedPort()};
+  return {FlatPort(), tilted_thin, gap_only,
+          glass_only, thick,       ThickTiltedPort()};
 }
 
 TEST(FlatPortProjection, ThinPortIsThePapersClosedForm) {
@@ -546,14 +544,13 @@ TEST(FlatPortProjection, InvisiblePointsHaveNoProjection) {
   EXPECT_FALSE(ProjectThroughPort(thick, 1.333, Eigen::Vector3d(0, 0, NAN)));
   // Thin port: past the critical angle of water no ray in air reaches it.
   const double critical = std::asin(1.0 / 1.333);
-  EXPECT_FALSE(ProjectThroughPort(
-      FlatPort(), 1.333,
-      Eigen::Vector3d(std::sin(critical + 1e-3), 0.0,
-                      std::cos(critical + 1e-3))));
-  EXPECT_TRUE(ProjectThroughPort(
-      FlatPort(), 1.333,
-      Eigen::Vector3d(std::sin(critical - 1e-3), 0.0,
-                      std::cos(critical - 1e-3))));
+  EXPECT_FALSE(
+      ProjectThroughPort(FlatPort(), 1.333,
+                         Eigen::Vector3d(std::sin(critical + 1e-3), 0.0,
+                                         std::cos(critical + 1e-3))));
+  EXPECT_TRUE(ProjectThroughPort(FlatPort(), 1.333,
+                                 Eigen::Vector3d(std::sin(critical - 1e-3), 0.0,
+                                                 std::cos(critical - 1e-3))));
   // A port outside the model's domain, as a solver may step to.
   const Eigen::Vector3d point(0.1, 0.2, 1.0);
   FlatPort negative_gap;

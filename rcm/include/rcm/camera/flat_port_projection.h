@@ -74,8 +74,8 @@ struct FlatPortProjection {
                     const T& glass_index, const T& n, T* derivative = nullptr) {
     using std::sqrt;
     const T s2_rho2 = s * s * rho_squared;
-    const T q_glass =
-        glass_index * glass_index + (glass_index * glass_index - T(1.0)) * s2_rho2;
+    const T q_glass = glass_index * glass_index +
+                      (glass_index * glass_index - T(1.0)) * s2_rho2;
     const T q_medium = n * n + (n * n - T(1.0)) * s2_rho2;
     const T h_glass = T(1.0) / sqrt(q_glass);
     const T h_medium = T(1.0) / sqrt(q_medium);
@@ -114,9 +114,9 @@ struct FlatPortProjection {
     double s = 0.0;
     for (int iteration = 0; iteration < kMaxNewtonIterations; ++iteration) {
       double derivative;
-      const double value = Residual(s, rho_squared, last_leg, air_gap,
-                                    glass_thickness, glass_index, n,
-                                    &derivative);
+      const double value =
+          Residual(s, rho_squared, last_leg, air_gap, glass_thickness,
+                   glass_index, n, &derivative);
       if (value >= 0.0) break;
       if (!(derivative > 0.0)) return false;
       const double step = -value / derivative;
@@ -152,8 +152,8 @@ struct FlatPortProjection {
         !std::isfinite(ng + n_value)) {
       return false;
     }
-    const T along = normal[0] * point[0] + normal[1] * point[1] +
-                    normal[2] * point[2];
+    const T along =
+        normal[0] * point[0] + normal[1] * point[1] + normal[2] * point[2];
     const T lateral[3] = {point[0] - along * normal[0],
                           point[1] - along * normal[1],
                           point[2] - along * normal[2]};
