@@ -127,13 +127,19 @@ Status FitWithOutlierRejection(
     add_residuals(options.huber_px, &problem);
     RCM_RETURN_IF_ERROR(Solve(solver_options, &problem));
     std::vector<double> norms;
+    std::vector<double> finite;  // the median skips corners that do not
+                                 // project (NaN): they are outliers
     for (const Corner& corner : *corners) {
       norms.push_back(residual(corner).norm());
+      if (std::isfinite(norms.back())) finite.push_back(norms.back());
     }
-    std::vector<double> sorted = norms;
-    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2,
-                     sorted.end());
-    const double sigma = sorted[sorted.size() / 2] / kRayleighMedian;
+    if (finite.empty()) {
+      return Status::Error(
+          "bundle adjustment failed: no corner projects at the solution");
+    }
+    std::nth_element(finite.begin(), finite.begin() + finite.size() / 2,
+                     finite.end());
+    const double sigma = finite[finite.size() / 2] / kRayleighMedian;
     const double threshold = std::max(options.outlier_sigmas * sigma,
                                       options.min_outlier_threshold_px);
     bool changed = false;
@@ -203,7 +209,11 @@ ResidualStatistics SummarizeResiduals(
     out.pixel = corner.pixel;
     out.residual = residual(corner);
     out.inlier = corner.inlier;
-    sum += out.residual.squaredNorm();
+    if (!out.residual.allFinite()) {
+      ++statistics.num_unprojected;
+    } else {
+      sum += out.residual.squaredNorm();
+    }
     if (corner.inlier) {
       ++statistics.num_inliers;
       statistics.inlier_ssr += out.residual.squaredNorm();
@@ -212,7 +222,9 @@ ResidualStatistics SummarizeResiduals(
     }
     statistics.corners.push_back(out);
   }
-  statistics.rms_px = corners.empty() ? 0.0 : std::sqrt(sum / corners.size());
+  const int num_projected =
+      static_cast<int>(corners.size()) - statistics.num_unprojected;
+  statistics.rms_px = num_projected == 0 ? 0.0 : std::sqrt(sum / num_projected);
   statistics.inlier_rms_px =
       statistics.num_inliers == 0
           ? 0.0

@@ -76,14 +76,15 @@ struct OutlierRejectionOptions {
 //   max_outlier_rounds times: solve with Huber's loss at huber_px over the
 //     inliers, then mark as outliers the corners whose |e| exceeds
 //     max(outlier_sigmas * median|e| / kRayleighMedian,
-//         min_outlier_threshold_px) (a corner that does not project, NaN,
-//     too), stopping early when the set does not change;
+//         min_outlier_threshold_px) (the median over the corners that
+//     project; one that does not, NaN, is an outlier), stopping early when
+//     the set does not change;
 //   then plain least squares over the inliers, in `final_problem`, whose
 //     Jacobian the covariance is computed from.
 // `add_residuals(huber_px, problem)` adds the residuals of the corners
 // marked inlier in `corners` (huber_px 0: no loss function) and sets any
 // bounds; `residual(corner)` evaluates one corner at the current
-// parameters. Fails when a solve fails.
+// parameters. Fails when a solve fails or no corner projects.
 Status FitWithOutlierRejection(
     const OutlierRejectionOptions& options,
     const ceres::Solver::Options& solver_options,
@@ -105,14 +106,17 @@ bool JointCovariance(const std::vector<CovarianceBlockRef>& blocks,
                      bool cross_blocks, int num_threads,
                      ceres::Problem* problem, Eigen::MatrixXd* covariance);
 
-// Every corner's residual at the solution, and their statistics.
+// Every corner's residual at the solution, and their statistics. A corner
+// that does not project (residual NaN, always an outlier) is counted, not
+// summed.
 struct ResidualStatistics {
   std::vector<CornerResidual> corners;
-  double rms_px = 0.0;         // all corners
+  double rms_px = 0.0;         // all corners that project
   double inlier_rms_px = 0.0;  // inliers
   double inlier_ssr = 0.0;     // sum |e|^2 over the inliers
   int num_inliers = 0;
   int num_outliers = 0;
+  int num_unprojected = 0;  // of the outliers
 };
 ResidualStatistics SummarizeResiduals(
     const std::vector<Corner>& corners,

@@ -138,10 +138,9 @@ StatusOr<StereoCalibration> CalibrateStereo(
 
   // Which observations take part: enough corners, and (unless single-
   // camera views are wanted) both cameras.
-  StatusOr<internal::UsedObservations> selected =
-      internal::SelectObservations(views, num_points,
-                                   options.min_corners_per_view,
-                                   options.use_single_camera_views);
+  StatusOr<internal::UsedObservations> selected = internal::SelectObservations(
+      views, num_points, options.min_corners_per_view,
+      options.use_single_camera_views);
   if (!selected.ok()) return selected.status();
   const internal::UsedObservations& used = *selected;
 
@@ -333,9 +332,8 @@ StatusOr<StereoCalibration> CalibrateStereo(
     }
     Eigen::Matrix<double, 6, 6> jacobian =
         Eigen::Matrix<double, 6, 6>::Identity();
-    jacobian.topLeftCorner<3, 3>() =
-        internal::LeftPerturbationFromAngleAxis(
-            parameters.cam1_from_cam0.data());
+    jacobian.topLeftCorner<3, 3>() = internal::LeftPerturbationFromAngleAxis(
+        parameters.cam1_from_cam0.data());
     const Eigen::Matrix<double, 6, 6> extrinsics =
         covariance.bottomRightCorner<6, 6>();
     result.extrinsics_covariance =
