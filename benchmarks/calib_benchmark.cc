@@ -17,13 +17,7 @@ namespace rcm::calib {
 namespace {
 
 CalibrationTarget Checkerboard() {
-  CalibrationTarget target;
-  target.type = TargetType::kCheckerboard;
-  target.cols = 9;
-  target.rows = 6;
-  target.row_spacing = 0.04;
-  target.col_spacing = 0.04;
-  return target;
+  return MakeCheckerboardTarget(9, 6, 0.04).value();
 }
 
 constexpr double kN = 1.342;

@@ -1,6 +1,7 @@
 #include "board_bundle_adjustment.h"
 
 #include <ceres/rotation.h>
+#include <glog/logging.h>
 
 #include <algorithm>
 #include <cmath>
@@ -100,6 +101,33 @@ ceres::Solver::Options BoardSolverOptions(int max_num_iterations,
   solver_options.parameter_tolerance = 1e-14;
   solver_options.logging_type = ceres::SILENT;
   return solver_options;
+}
+
+Status CheckSharedFitSettings(const SharedFitSettings& settings) {
+  if (!(settings.huber_px > 0.0) || !std::isfinite(settings.huber_px)) {
+    return Status::Error("huber_px must be positive and finite");
+  }
+  if (!(settings.outlier_sigmas > 0.0) ||
+      !std::isfinite(settings.outlier_sigmas)) {
+    return Status::Error("outlier_sigmas must be positive and finite");
+  }
+  if (!(settings.min_outlier_threshold_px >= 0.0) ||
+      !std::isfinite(settings.min_outlier_threshold_px)) {
+    return Status::Error("min_outlier_threshold_px must be >= 0 and finite");
+  }
+  if (settings.max_outlier_rounds < 0) {
+    return Status::Error("max_outlier_rounds must be >= 0");
+  }
+  if (settings.max_num_iterations <= 0) {
+    return Status::Error("max_num_iterations must be positive");
+  }
+  if (settings.min_corners_per_view < 4) {
+    return Status::Error("min_corners_per_view must be at least 4");
+  }
+  if (settings.num_threads <= 0) {
+    return Status::Error("num_threads must be positive");
+  }
+  return Status::Ok();
 }
 
 namespace {
@@ -230,6 +258,16 @@ ResidualStatistics SummarizeResiduals(
           ? 0.0
           : std::sqrt(statistics.inlier_ssr / statistics.num_inliers);
   return statistics;
+}
+
+std::vector<std::optional<Rigid3d>> UsedViewPoses(
+    const std::vector<Pose>& poses, const std::vector<bool>& used) {
+  CHECK_EQ(poses.size(), used.size());
+  std::vector<std::optional<Rigid3d>> out(poses.size());
+  for (size_t v = 0; v < poses.size(); ++v) {
+    if (used[v]) out[v] = RigidFromPose(poses[v].data());
+  }
+  return out;
 }
 
 }  // namespace rcm::calib::internal

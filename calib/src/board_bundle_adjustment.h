@@ -19,6 +19,8 @@
 #include <Eigen/Core>
 #include <array>
 #include <functional>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include "rcm/calib/stereo_calibration.h"
@@ -64,6 +66,20 @@ struct Corner {
 // The solver settings of both bundle adjustments.
 ceres::Solver::Options BoardSolverOptions(int max_num_iterations,
                                           int num_threads);
+
+// The settings both bundle adjustments' options share, and their one
+// check: "huber_px must be positive and finite", ... (the field's name
+// first).
+struct SharedFitSettings {
+  double huber_px;
+  double outlier_sigmas;
+  double min_outlier_threshold_px;
+  int max_outlier_rounds;
+  int max_num_iterations;
+  int min_corners_per_view;
+  int num_threads;
+};
+Status CheckSharedFitSettings(const SharedFitSettings& settings);
 
 struct OutlierRejectionOptions {
   double huber_px = 1.0;
@@ -121,6 +137,21 @@ struct ResidualStatistics {
 ResidualStatistics SummarizeResiduals(
     const std::vector<Corner>& corners,
     const std::function<Eigen::Vector2d(const Corner&)>& residual);
+
+// Moves `statistics` into the fields of the same names of a result
+// (StereoCalibration, UnderwaterCalibration).
+template <typename Result>
+void StoreResidualStatistics(ResidualStatistics statistics, Result* result) {
+  result->corners = std::move(statistics.corners);
+  result->rms_px = statistics.rms_px;
+  result->inlier_rms_px = statistics.inlier_rms_px;
+  result->num_inliers = statistics.num_inliers;
+  result->num_outliers = statistics.num_outliers;
+}
+
+// The target poses of the views `used`, nullopt for the others.
+std::vector<std::optional<Rigid3d>> UsedViewPoses(
+    const std::vector<Pose>& poses, const std::vector<bool>& used);
 
 }  // namespace rcm::calib::internal
 

@@ -97,27 +97,9 @@ Status StereoCalibrationOptions::Check() const {
       model != LensModelId::kPinhole) {
     return Status::Error("lens model must be radtan, equidistant or none");
   }
-  if (!(huber_px > 0.0) || !std::isfinite(huber_px)) {
-    return Status::Error("huber_px must be positive and finite");
-  }
-  if (!(outlier_sigmas > 0.0) || !std::isfinite(outlier_sigmas)) {
-    return Status::Error("outlier_sigmas must be positive and finite");
-  }
-  if (!(min_outlier_threshold_px >= 0.0) ||
-      !std::isfinite(min_outlier_threshold_px)) {
-    return Status::Error("min_outlier_threshold_px must be >= 0 and finite");
-  }
-  if (max_outlier_rounds < 0) {
-    return Status::Error("max_outlier_rounds must be >= 0");
-  }
-  if (max_num_iterations <= 0) {
-    return Status::Error("max_num_iterations must be positive");
-  }
-  if (min_corners_per_view < 4) {
-    return Status::Error("min_corners_per_view must be at least 4");
-  }
-  if (num_threads <= 0) return Status::Error("num_threads must be positive");
-  return Status::Ok();
+  return internal::CheckSharedFitSettings(
+      {huber_px, outlier_sigmas, min_outlier_threshold_px, max_outlier_rounds,
+       max_num_iterations, min_corners_per_view, num_threads});
 }
 
 StatusOr<StereoCalibration> CalibrateStereo(
@@ -204,7 +186,6 @@ StatusOr<StereoCalibration> CalibrateStereo(
 
   // Filled with the solution below.
   StereoCalibration result(*cameras[0], *cameras[1]);
-  result.cam0_from_target.resize(num_views);
   std::vector<Corner> corners;
   std::vector<bool> view_used(num_views, false);
   for (int v = 0; v < num_views; ++v) {
@@ -275,21 +256,13 @@ StatusOr<StereoCalibration> CalibrateStereo(
     return Status::Error("bundle adjustment diverged: the baseline is " +
                          FormatDouble(result.baseline));
   }
-  for (int v = 0; v < num_views; ++v) {
-    if (view_used[v]) {
-      result.cam0_from_target[v] =
-          RigidFromPose(parameters.cam0_from_target[v].data());
-    }
-  }
+  result.cam0_from_target =
+      internal::UsedViewPoses(parameters.cam0_from_target, view_used);
   // Each corner's final residual, evaluated once.
   internal::ResidualStatistics statistics =
       internal::SummarizeResiduals(corners, residual);
-  result.corners = std::move(statistics.corners);
-  result.rms_px = statistics.rms_px;
-  result.inlier_rms_px = statistics.inlier_rms_px;
-  result.num_inliers = statistics.num_inliers;
-  result.num_outliers = statistics.num_outliers;
   const double inlier_sum = statistics.inlier_ssr;
+  internal::StoreResidualStatistics(std::move(statistics), &result);
   result.num_views_used = num_views_used;
   for (int v = 0; v < num_views; ++v) {
     if (view_used[v] && used[v][0] != nullptr && used[v][1] != nullptr) {

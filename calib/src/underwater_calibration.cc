@@ -324,29 +324,12 @@ Status UnderwaterCalibrationOptions::Check() const {
   if (!(initial_n >= kMinIndex && initial_n <= kMaxIndex)) {
     return Status::Error("initial_n must be in [1, 2]");
   }
-  if (!(huber_px > 0.0) || !std::isfinite(huber_px)) {
-    return Status::Error("huber_px must be positive and finite");
-  }
-  if (!(outlier_sigmas > 0.0) || !std::isfinite(outlier_sigmas)) {
-    return Status::Error("outlier_sigmas must be positive and finite");
-  }
-  if (!(min_outlier_threshold_px >= 0.0) ||
-      !std::isfinite(min_outlier_threshold_px)) {
-    return Status::Error("min_outlier_threshold_px must be >= 0 and finite");
-  }
-  if (max_outlier_rounds < 0) {
-    return Status::Error("max_outlier_rounds must be >= 0");
-  }
-  if (max_num_iterations <= 0) {
-    return Status::Error("max_num_iterations must be positive");
-  }
-  if (min_corners_per_view < 4) {
-    return Status::Error("min_corners_per_view must be at least 4");
-  }
+  RCM_RETURN_IF_ERROR(internal::CheckSharedFitSettings(
+      {huber_px, outlier_sigmas, min_outlier_threshold_px, max_outlier_rounds,
+       max_num_iterations, min_corners_per_view, num_threads}));
   if (folds < 0 || folds == 1) {
     return Status::Error("folds must be 0 (no leave-out) or at least 2");
   }
-  if (num_threads <= 0) return Status::Error("num_threads must be positive");
   return Status::Ok();
 }
 
@@ -575,22 +558,14 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     result.rig = *rig;
   }
 
-  result.cam0_from_target.resize(num_views);
-  for (int v = 0; v < num_views; ++v) {
-    if (view_used[v]) {
-      result.cam0_from_target[v] =
-          RigidFromPose(parameters.cam0_from_target[v].data());
-    }
-  }
+  result.cam0_from_target =
+      internal::UsedViewPoses(parameters.cam0_from_target, view_used);
   internal::ResidualStatistics statistics =
       internal::SummarizeResiduals(corners, residual);
-  result.corners = std::move(statistics.corners);
-  result.rms_px = statistics.rms_px;
-  result.inlier_rms_px = statistics.inlier_rms_px;
+  const double inlier_ssr = statistics.inlier_ssr;
+  internal::StoreResidualStatistics(std::move(statistics), &result);
   result.initial_rms_px =
       num_initial == 0 ? 0.0 : std::sqrt(initial_sum / num_initial);
-  result.num_inliers = statistics.num_inliers;
-  result.num_outliers = statistics.num_outliers;
   result.num_views_used = num_views_used;
   result.num_stereo_views = num_stereo_views;
   result.num_parameters = num_parameters;
@@ -630,7 +605,7 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
         " inlier corners for " + std::to_string(num_parameters) +
         " unknowns (2 per corner must exceed them)");
   }
-  result.pixel_sigma = std::sqrt(statistics.inlier_ssr / redundancy);
+  result.pixel_sigma = std::sqrt(inlier_ssr / redundancy);
 
   // Covariance: sigma^2 (J^T J)^-1, the extrinsics' rotation moved to the
   // left perturbation, w = G a for the angle-axis parameters a.
@@ -725,8 +700,10 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
   // The ports.
   for (int c = 0; c < 2; ++c) {
     PortEstimate& port = result.ports[c];
-    port.port = estimated_ports[c];
-    port.port.normal.normalize();
+    // The rig's port, bit for bit (its normal is unit).
+    port.port = !result.rig.ports() ? estimated_ports[c]
+                : c == 0            ? result.rig.ports()->left
+                                    : result.rig.ports()->right;
     port.tilt = Eigen::Vector2d(port.port.normal.x() / port.port.normal.z(),
                                 port.port.normal.y() / port.port.normal.z());
     port.tilt_deg = kDegreesPerRadian *

@@ -6,6 +6,7 @@
 #define RCM_TESTS_CALIB_SYNTHETIC_TARGET_VIEWS_H_
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <functional>
 #include <optional>
 #include <random>
@@ -169,6 +170,30 @@ inline std::vector<StereoView> ObserveStereoUnderwater(
   return ObserveStereoWith(rig.left(), through(left), rig.right(),
                            through(right), rig.right_from_left(), target,
                            cam0_from_target, noise_px, seed);
+}
+
+// Moves each corner of `views` with probability `fraction` by 8-20 px in a
+// random direction (a detector confusing corners), deterministic in
+// `seed`; returns how many were moved.
+inline int AddGrossOutliers(double fraction, unsigned seed,
+                            std::vector<StereoView>* views) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int num_moved = 0;
+  for (StereoView& view : *views) {
+    for (std::optional<TargetObservation>* side : {&view.left, &view.right}) {
+      if (!side->has_value()) continue;
+      for (Eigen::Vector2d& pixel : (*side)->pixels) {
+        if (unit(rng) < fraction) {
+          const double angle = 2.0 * M_PI * unit(rng);
+          const double length = 8.0 + 12.0 * unit(rng);
+          pixel += length * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+          ++num_moved;
+        }
+      }
+    }
+  }
+  return num_moved;
 }
 
 }  // namespace rcm::calib::test
