@@ -352,10 +352,29 @@ TEST(UnderwaterCalibration, ExactMixedSingleCameraAndStereoViews) {
   EXPECT_GT(result->views[5].num_corners[1], 0);
 }
 
+TEST(UnderwaterCalibration, ConventionalModelCannotFitRefractionExactly) {
+  // On exact corners the refractive model's residuals vanish; a
+  // conventional model (the equidistant lens with its intrinsics free)
+  // absorbs most of the refraction but not all: measured RMS 0.050 px on
+  // the dataset rig (0.025 px on the narrow radtan rig), far above the
+  // solver's floor (1e-9) and below the detection noise of real corners.
+  const Dive dive = AlphasenseDive(20);
+  UnderwaterCalibrationOptions options = Lean();
+  options.fit_conventional_model = true;
+  const std::optional<UnderwaterCalibration> result =
+      CalibrateExact(dive, options);
+  ASSERT_TRUE(result.has_value());
+  ASSERT_TRUE(result->conventional.ok) << result->conventional.error;
+  EXPECT_GT(result->conventional.rms_px, 0.02);
+  EXPECT_LT(result->conventional.rms_px, 0.2);
+  EXPECT_GT(result->conventional.num_parameters, result->num_parameters);
+}
+
 TEST(UnderwaterCalibration, ConvergesForAnyIndexAndLargeDrifts) {
   // From initial_n = 1.34 and the air extrinsics: true n across [1, 1.6]
   // (n = 1: the target in air, a valid answer at the bound) and drifts up
-  // to 4 degrees.
+  // to 4 degrees (it converges to 20 degrees, measured; 4 is what a
+  // housing may do).
   const StereoRig air = AlphasenseFrontUnrectifiedRig();
   for (const double n : {1.0, 1.1, 1.25, 1.45, 1.6}) {
     for (const double drift_deg : {0.5, 4.0}) {
@@ -383,7 +402,8 @@ TEST(UnderwaterCalibration, ConvergesForAnyIndexAndLargeDrifts) {
 // 10 % of the truth (2m - p ~ 2000 degrees of freedom: relative sd 1.6 %),
 // the leave-out sigma of n close to the covariance's (independent noise:
 // the jackknife over 10 groups has a relative sd of ~1 / sqrt(2 * 9) =
-// 0.24, so [0.4, 2] is a wide band), and the conventional fit reported.
+// 0.24, so [0.4, 2] is a wide band; measured 1.2 for n, 1.0 for the
+// drift angle), and the conventional fit reported.
 TEST(UnderwaterCalibration, NoisyWithinReportedSigma) {
   constexpr double kNoisePx = 0.25;
   constexpr double kMaxSigmas = 4.0;
@@ -440,12 +460,11 @@ TEST(UnderwaterCalibration, NoisyWithinReportedSigma) {
             0.4 * change.rotation_sigma_deg.norm());
   EXPECT_LT(change.rotation_leave_out_sigma_deg->norm(),
             2.0 * change.rotation_sigma_deg.norm());
-  // The conventional fit of the same corners: with free intrinsics it
-  // absorbs most of the refraction into the equidistant distortion, but
-  // not all of it (measured: 0.30 px against 0.25).
+  // The conventional fit of the same corners ran (its model error is
+  // below this noise: ConventionalModelCannotFitRefractionExactly).
   ASSERT_TRUE(result->conventional.ok) << result->conventional.error;
   EXPECT_EQ(result->conventional.model, LensModelId::kEquidistant);
-  EXPECT_GT(result->conventional.pixel_sigma, result->pixel_sigma);
+  EXPECT_GT(result->conventional.pixel_sigma, 0.9 * kNoisePx);
   // The per-view residuals are the noise.
   for (const UnderwaterViewResidual& view : result->views) {
     for (int c = 0; c < 2; ++c) {
