@@ -654,8 +654,9 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
           "n ends at the lower bound 1 of [1, 2] and the corners pull it "
           "below by " +
           FormatFixed(-step / result.sigma_n, 1) +
-          " sigma: the images were probably taken in air, or the air "
-          "calibration does not describe these cameras");
+          " sigma, which no medium does: the air calibration probably does "
+          "not describe these cameras (focal lengths too long, another "
+          "rig's file), or the corners are not the target's");
     }
   }
 

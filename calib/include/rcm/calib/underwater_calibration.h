@@ -80,9 +80,10 @@
 // that differs from the air camera's; a bad observation (ids, pixels); no
 // view showing the target, or fewer than kMinUnderwaterViews usable views;
 // too few corners for the unknowns; a failed solve; n at the upper bound
-// 2, or at the lower bound 1 with the data pulling it below (more than
-// 3 sigma: the images were taken in air or the air calibration is not
-// this rig's); an air gap at its upper bound or a tilt beyond the limit;
+// 2, or at the lower bound 1 with the data pulling it below by more than
+// 3 sigma (n = 1 itself, a target in air, is an answer); each with the
+// likely cause (the air calibration is not these cameras' as they are
+// under water); an air gap at its upper bound or a tilt beyond the limit;
 // a degenerate covariance (the views do not constrain every unknown).
 #ifndef RCM_CALIB_UNDERWATER_CALIBRATION_H_
 #define RCM_CALIB_UNDERWATER_CALIBRATION_H_
