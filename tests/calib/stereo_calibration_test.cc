@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "calib/synthetic_target_views.h"
+#include "support/sample_moments.h"
 #include "support/test_rigs.h"
 
 namespace rcm::calib {
@@ -193,15 +194,10 @@ TEST(StereoCalibration, MonteCarloSigmaIsHonest) {
   }
   const char* names[5] = {"fx0", "cx0", "fy1", "cy1", "baseline"};
   for (int i = 0; i < 5; ++i) {
-    double mean = 0.0;
-    for (double x : samples[i]) mean += x;
-    mean /= kTrials;
-    double variance = 0.0;
-    for (double x : samples[i]) variance += (x - mean) * (x - mean);
-    const double stddev = std::sqrt(variance / (kTrials - 1));
-    EXPECT_LT(std::abs(mean), 0.45) << names[i];
-    EXPECT_GT(stddev, 0.7) << names[i];
-    EXPECT_LT(stddev, 1.3) << names[i];
+    const rcm::test::SampleMoments z = rcm::test::Moments(samples[i]);
+    EXPECT_LT(std::abs(z.mean), 0.45) << names[i];
+    EXPECT_GT(z.stddev, 0.7) << names[i];
+    EXPECT_LT(z.stddev, 1.3) << names[i];
   }
 }
 

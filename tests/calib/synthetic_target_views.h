@@ -27,13 +27,10 @@ namespace rcm::calib::test {
 // tilted by up to `max_tilt_deg` about x and y and rolled by up to 30
 // degrees. The rays are those in a medium of index `n` behind a thin port
 // ((xb, yb, m(n, rb)), refractive_model.h; n = 1: in air).
-inline std::vector<Rigid3d> BoardPoses(const Camera& camera,
-                                       const CalibrationTarget& target,
-                                       int count, unsigned seed,
-                                       double min_depth = 0.45,
-                                       double max_depth = 0.9,
-                                       double max_tilt_deg = 35.0,
-                                       double n = 1.0) {
+inline std::vector<Rigid3d> BoardPoses(
+    const Camera& camera, const CalibrationTarget& target, int count,
+    unsigned seed, double min_depth = 0.45, double max_depth = 0.9,
+    double max_tilt_deg = 35.0, double n = 1.0) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   const std::vector<Eigen::Vector3d> points = TargetPoints(target);
@@ -130,10 +127,9 @@ inline std::vector<StereoView> ObserveStereoWith(
     view.right_name = "right" + std::to_string(v) + ".png";
     view.left = ObserveTargetWith(left_camera, left, cam0_from_target[v],
                                   points, noise_px, &rng);
-    view.right =
-        ObserveTargetWith(right_camera, right,
-                          right_from_left * cam0_from_target[v], points,
-                          noise_px, &rng);
+    view.right = ObserveTargetWith(right_camera, right,
+                                   right_from_left * cam0_from_target[v],
+                                   points, noise_px, &rng);
     views.push_back(std::move(view));
   }
   return views;

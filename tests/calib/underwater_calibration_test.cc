@@ -16,6 +16,7 @@
 #include "calib/synthetic_target_views.h"
 #include "rcm/camera/refractive_model.h"
 #include "rcm/sim/reference_rigs.h"
+#include "support/sample_moments.h"
 
 namespace rcm::calib {
 namespace {
@@ -83,6 +84,11 @@ struct Dive {
   std::vector<StereoView> views;
 };
 
+// `rig` as the housings drifted.
+StereoRig Drifted(const StereoRig& rig) {
+  return rig.WithCam1Moved(kDriftRotation, kDriftTranslation).value();
+}
+
 Dive MakeDive(const StereoRig& air, const StereoRig& truth, double n,
               int num_views, double noise_px, unsigned seed) {
   Dive dive{air, truth, n, {}, {}};
@@ -97,9 +103,7 @@ Dive MakeDive(const StereoRig& air, const StereoRig& truth, double n,
 Dive AlphasenseDive(int num_views = 16, double noise_px = 0.0,
                     unsigned seed = 1) {
   const StereoRig air = AlphasenseFrontUnrectifiedRig();
-  return MakeDive(air,
-                  air.WithCam1Moved(kDriftRotation, kDriftTranslation).value(),
-                  kTrueN, num_views, noise_px, seed);
+  return MakeDive(air, Drifted(air), kTrueN, num_views, noise_px, seed);
 }
 
 StatusOr<UnderwaterCalibration> Calibrate(
@@ -209,9 +213,7 @@ TEST(UnderwaterCalibration, ExactThinPortRecoversNAndDrift) {
 
 TEST(UnderwaterCalibration, ExactNarrowRadTanRig) {
   const StereoRig air = NarrowRadTanRig();
-  const Dive dive = MakeDive(
-      air, air.WithCam1Moved(kDriftRotation, kDriftTranslation).value(), kTrueN,
-      16, 0.0, 1);
+  const Dive dive = MakeDive(air, Drifted(air), kTrueN, 16, 0.0, 1);
   const std::optional<UnderwaterCalibration> result =
       CalibrateExact(dive, Lean());
   ASSERT_TRUE(result.has_value());
@@ -224,9 +226,7 @@ TEST(UnderwaterCalibration, ExactThickPortKnownGap) {
   const StereoRig air = AlphasenseFrontUnrectifiedRig()
                             .WithPorts(ThickPort(), ThickPort())
                             .value();
-  const Dive dive = MakeDive(
-      air, air.WithCam1Moved(kDriftRotation, kDriftTranslation).value(), kTrueN,
-      16, 0.0, 1);
+  const Dive dive = MakeDive(air, Drifted(air), kTrueN, 16, 0.0, 1);
   const std::optional<UnderwaterCalibration> result =
       CalibrateExact(dive, Lean());
   ASSERT_TRUE(result.has_value());
@@ -247,10 +247,7 @@ TEST(UnderwaterCalibration, ExactThickPortRecoversAirGap) {
     const StereoRig air =
         base.WithPorts(ThickPort(0.005), ThickPort(0.005)).value();
     const StereoRig truth =
-        base.WithPorts(ThickPort(0.008), ThickPort(0.009))
-            .value()
-            .WithCam1Moved(kDriftRotation, kDriftTranslation)
-            .value();
+        Drifted(base.WithPorts(ThickPort(0.008), ThickPort(0.009)).value());
     const std::optional<UnderwaterCalibration> result =
         CalibrateExact(MakeDive(air, truth, kTrueN, 16, 0.0, 1), options);
     ASSERT_TRUE(result.has_value());
@@ -275,10 +272,7 @@ TEST(UnderwaterCalibration, ExactThinPortGapFromZero) {
   const StereoRig air = AlphasenseFrontUnrectifiedRig();
   FlatPort gap_only;
   gap_only.air_gap = 0.008;
-  const StereoRig truth = air.WithPorts(gap_only, gap_only)
-                              .value()
-                              .WithCam1Moved(kDriftRotation, kDriftTranslation)
-                              .value();
+  const StereoRig truth = Drifted(air.WithPorts(gap_only, gap_only).value());
   UnderwaterCalibrationOptions options = Lean();
   options.estimate_air_gap = true;
   const std::optional<UnderwaterCalibration> result =
@@ -297,11 +291,8 @@ TEST(UnderwaterCalibration, ExactTiltedPortRecoversTilt) {
   left.normal = TiltedPortNormal(1.5 * kDegree, 0.4);
   FlatPort right = ThickPort();
   right.normal = TiltedPortNormal(1.0 * kDegree, 2.0);
-  const StereoRig truth = AlphasenseFrontUnrectifiedRig()
-                              .WithPorts(left, right)
-                              .value()
-                              .WithCam1Moved(kDriftRotation, kDriftTranslation)
-                              .value();
+  const StereoRig truth =
+      Drifted(AlphasenseFrontUnrectifiedRig().WithPorts(left, right).value());
   UnderwaterCalibrationOptions options = Lean();
   options.estimate_air_gap = true;
   options.estimate_port_tilt = true;
@@ -505,17 +496,12 @@ TEST(UnderwaterCalibration, MonteCarloSigmaIsHonest) {
   }
   const char* names[2] = {"n", "drift"};
   for (int i = 0; i < 2; ++i) {
-    double mean = 0.0;
-    for (double x : z[i]) mean += x;
-    mean /= kTrials;
-    double variance = 0.0;
-    for (double x : z[i]) variance += (x - mean) * (x - mean);
-    const double stddev = std::sqrt(variance / (kTrials - 1));
-    EXPECT_LT(std::abs(mean), 0.4) << names[i];
-    EXPECT_GT(stddev, 0.7) << names[i];
-    EXPECT_LT(stddev, 1.3) << names[i];
-    std::printf("[ MEASURED ] z(%s): mean %.3f, sd %.3f\n", names[i], mean,
-                stddev);
+    const rcm::test::SampleMoments moments = rcm::test::Moments(z[i]);
+    EXPECT_LT(std::abs(moments.mean), 0.4) << names[i];
+    EXPECT_GT(moments.stddev, 0.7) << names[i];
+    EXPECT_LT(moments.stddev, 1.3) << names[i];
+    std::printf("[ MEASURED ] z(%s): mean %.3f, sd %.3f\n", names[i],
+                moments.mean, moments.stddev);
   }
 }
 
