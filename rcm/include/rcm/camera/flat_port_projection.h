@@ -61,9 +61,9 @@ namespace rcm {
 
 struct FlatPortProjection {
   // Newton iterations of the double solve: from s = 0 it takes 3-6 to
-  // machine precision, up to ~20 near the critical angle,
-  // where F flattens out (measured over n in [1, 2], thin and 8 + 6 mm
-  // ports); the guard fails the projection of points closer still.
+  // machine precision, up to ~20 near the critical angle, where F flattens
+  // out (measured over n in [1, 2], thin and 8 + 6 mm ports); the guard
+  // fails the projection of points closer still.
   static constexpr int kMaxNewtonIterations = 100;
 
   // F(s) of the header and, when `derivative` is given, F'(s), for the
