@@ -127,11 +127,22 @@ StatusOr<Camera> InitializeCamera(
 std::optional<Rigid3d> InitializeTargetPose(
     const Camera& camera, const std::vector<Eigen::Vector3d>& target_points,
     const TargetObservation& observation) {
+  std::vector<std::optional<Eigen::Vector2d>> normalized;
+  for (const Eigen::Vector2d& pixel : observation.pixels) {
+    normalized.push_back(camera.NormalizedFromImage(pixel));
+  }
+  return TargetPoseFromNormalized(target_points, observation, normalized);
+}
+
+std::optional<Rigid3d> TargetPoseFromNormalized(
+    const std::vector<Eigen::Vector3d>& target_points,
+    const TargetObservation& observation,
+    const std::vector<std::optional<Eigen::Vector2d>>& rays) {
+  CHECK_EQ(rays.size(), observation.pixels.size());
   std::vector<cv::Point3d> object;
   std::vector<cv::Point2d> normalized;
   for (int k = 0; k < observation.size(); ++k) {
-    const std::optional<Eigen::Vector2d> xy =
-        camera.NormalizedFromImage(observation.pixels[k]);
+    const std::optional<Eigen::Vector2d>& xy = rays[k];
     if (!xy || !xy->allFinite()) continue;
     const Eigen::Vector3d& x = target_points[observation.point_ids[k]];
     object.emplace_back(x.x(), x.y(), x.z());

@@ -3,10 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <random>
 #include <vector>
 
 #include "calib/synthetic_target_views.h"
+#include "support/sample_moments.h"
 #include "support/test_rigs.h"
 
 namespace rcm::calib {
@@ -194,15 +194,10 @@ TEST(StereoCalibration, MonteCarloSigmaIsHonest) {
   }
   const char* names[5] = {"fx0", "cx0", "fy1", "cy1", "baseline"};
   for (int i = 0; i < 5; ++i) {
-    double mean = 0.0;
-    for (double x : samples[i]) mean += x;
-    mean /= kTrials;
-    double variance = 0.0;
-    for (double x : samples[i]) variance += (x - mean) * (x - mean);
-    const double stddev = std::sqrt(variance / (kTrials - 1));
-    EXPECT_LT(std::abs(mean), 0.45) << names[i];
-    EXPECT_GT(stddev, 0.7) << names[i];
-    EXPECT_LT(stddev, 1.3) << names[i];
+    const rcm::test::SampleMoments z = rcm::test::Moments(samples[i]);
+    EXPECT_LT(std::abs(z.mean), 0.45) << names[i];
+    EXPECT_GT(z.stddev, 0.7) << names[i];
+    EXPECT_LT(z.stddev, 1.3) << names[i];
   }
 }
 
@@ -216,22 +211,7 @@ TEST(StereoCalibration, RejectsGrossOutliers) {
       BoardPoses(truth.rig.left(), Checkerboard(), 18, /*seed=*/7);
   std::vector<StereoView> views =
       ObserveStereo(truth.rig, Checkerboard(), poses, kNoisePx, 3);
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  int num_moved = 0;
-  for (StereoView& view : views) {
-    for (std::optional<TargetObservation>* side : {&view.left, &view.right}) {
-      if (!side->has_value()) continue;
-      for (Eigen::Vector2d& pixel : (*side)->pixels) {
-        if (unit(rng) < 0.03) {
-          const double angle = 2.0 * M_PI * unit(rng);
-          pixel += (8.0 + 12.0 * unit(rng)) *
-                   Eigen::Vector2d(std::cos(angle), std::sin(angle));
-          ++num_moved;
-        }
-      }
-    }
-  }
+  const int num_moved = test::AddGrossOutliers(0.03, /*seed=*/5, &views);
   ASSERT_GT(num_moved, 30);
   const StereoCalibration calibration = Calibrate(truth, views).value();
   EXPECT_EQ(calibration.num_outliers, num_moved);

@@ -1,10 +1,13 @@
 // Synthetic stereo views of a calibration target for the calibration
 // tests: board poses that cover the image of cam0 at several tilts and
-// depths, and the exact (or noisy) corner pixels in both cameras.
+// depths, and the exact (or noisy) corner pixels in both cameras, in air or
+// under water through exact flat ports.
 #ifndef RCM_TESTS_CALIB_SYNTHETIC_TARGET_VIEWS_H_
 #define RCM_TESTS_CALIB_SYNTHETIC_TARGET_VIEWS_H_
 
 #include <Eigen/Geometry>
+#include <cmath>
+#include <functional>
 #include <optional>
 #include <random>
 #include <string>
@@ -12,6 +15,8 @@
 
 #include "rcm/calib/calibration_target.h"
 #include "rcm/calib/target_observation.h"
+#include "rcm/camera/flat_port_camera.h"
+#include "rcm/camera/refractive_model.h"
 #include "rcm/geometry/stereo_rig.h"
 
 namespace rcm::calib::test {
@@ -20,13 +25,12 @@ namespace rcm::calib::test {
 // board's center is placed on the rays of a 3x3 grid of image points of
 // the left camera (cycling, jittered) at depths [min_depth, max_depth],
 // tilted by up to `max_tilt_deg` about x and y and rolled by up to 30
-// degrees.
-inline std::vector<Rigid3d> BoardPoses(const Camera& camera,
-                                       const CalibrationTarget& target,
-                                       int count, unsigned seed,
-                                       double min_depth = 0.45,
-                                       double max_depth = 0.9,
-                                       double max_tilt_deg = 35.0) {
+// degrees. The rays are those in a medium of index `n` behind a thin port
+// ((xb, yb, m(n, rb)), refractive_model.h; n = 1: in air).
+inline std::vector<Rigid3d> BoardPoses(
+    const Camera& camera, const CalibrationTarget& target, int count,
+    unsigned seed, double min_depth = 0.45, double max_depth = 0.9,
+    double max_tilt_deg = 35.0, double n = 1.0) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   const std::vector<Eigen::Vector3d> points = TargetPoints(target);
@@ -39,8 +43,11 @@ inline std::vector<Rigid3d> BoardPoses(const Camera& camera,
     const double fx = 0.5 + 0.3 * (cell % 3 - 1) + 0.04 * unit(rng);
     const double fy = 0.5 + 0.3 * (cell / 3 - 1) + 0.04 * unit(rng);
     const Eigen::Vector2d pixel(fx * camera.width(), fy * camera.height());
-    const Eigen::Vector2d normalized =
+    const Eigen::Vector2d undistorted =
         camera.NormalizedFromImage(pixel).value();
+    const Eigen::Vector2d normalized =
+        undistorted /
+        FlatPortRefraction::RadialFactor(n, undistorted.squaredNorm());
     const double depth =
         min_depth + (max_depth - min_depth) * 0.5 * (1.0 + unit(rng));
     const double deg = M_PI / 180.0;
@@ -62,11 +69,18 @@ inline std::vector<Rigid3d> BoardPoses(const Camera& camera,
   return poses;
 }
 
-// The corners of the target that `camera` sees in the image at
-// camera_from_target, with Gaussian pixel noise of `noise_px` per axis.
-// nullopt when fewer than `min_corners` are in the image.
-inline std::optional<TargetObservation> ObserveTarget(
-    const Camera& camera, const Rigid3d& camera_from_target,
+// Where a camera images a point given in its frame; nullopt when it does
+// not.
+using PointProjection =
+    std::function<std::optional<Eigen::Vector2d>(const Eigen::Vector3d&)>;
+
+// The corners of the target that `project` images inside `camera`'s image
+// at camera_from_target (points at least 5 cm in front of the camera),
+// with Gaussian pixel noise of `noise_px` per axis. nullopt when fewer
+// than `min_corners` are in the image.
+inline std::optional<TargetObservation> ObserveTargetWith(
+    const Camera& camera, const PointProjection& project,
+    const Rigid3d& camera_from_target,
     const std::vector<Eigen::Vector3d>& points, double noise_px,
     std::mt19937* rng, int min_corners = 6) {
   std::normal_distribution<double> noise(0.0, 1.0);
@@ -75,8 +89,7 @@ inline std::optional<TargetObservation> ObserveTarget(
   for (int id = 0; id < static_cast<int>(points.size()); ++id) {
     const Eigen::Vector3d p = camera_from_target * points[id];
     if (!(p.z() > 0.05)) continue;
-    const std::optional<Eigen::Vector2d> pixel =
-        camera.ProjectNormalized(p.head<2>() / p.z());
+    const std::optional<Eigen::Vector2d> pixel = project(p);
     if (!pixel || !camera.InImage(*pixel)) continue;
     Eigen::Vector2d measured = *pixel;
     if (noise_px > 0.0) {
@@ -90,9 +103,19 @@ inline std::optional<TargetObservation> ObserveTarget(
   return observation;
 }
 
-// Stereo views of `rig` (left = cam0) at the given target poses.
-inline std::vector<StereoView> ObserveStereo(
-    const StereoRig& rig, const CalibrationTarget& target,
+// The pinhole camera in air: the lens of the point's normalized point.
+inline PointProjection InAir(const Camera& camera) {
+  return [&camera](const Eigen::Vector3d& p) {
+    return camera.ProjectNormalized(p.head<2>() / p.z());
+  };
+}
+
+// Stereo views at the given target poses of two cameras that image points
+// by `left` and `right` (each in its own frame), cam1 at right_from_left.
+inline std::vector<StereoView> ObserveStereoWith(
+    const Camera& left_camera, const PointProjection& left,
+    const Camera& right_camera, const PointProjection& right,
+    const Rigid3d& right_from_left, const CalibrationTarget& target,
     const std::vector<Rigid3d>& cam0_from_target, double noise_px,
     unsigned seed) {
   std::mt19937 rng(seed);
@@ -102,14 +125,71 @@ inline std::vector<StereoView> ObserveStereo(
     StereoView view;
     view.left_name = "left" + std::to_string(v) + ".png";
     view.right_name = "right" + std::to_string(v) + ".png";
-    view.left =
-        ObserveTarget(rig.left(), cam0_from_target[v], points, noise_px, &rng);
-    view.right =
-        ObserveTarget(rig.right(), rig.right_from_left() * cam0_from_target[v],
-                      points, noise_px, &rng);
+    view.left = ObserveTargetWith(left_camera, left, cam0_from_target[v],
+                                  points, noise_px, &rng);
+    view.right = ObserveTargetWith(right_camera, right,
+                                   right_from_left * cam0_from_target[v],
+                                   points, noise_px, &rng);
     views.push_back(std::move(view));
   }
   return views;
+}
+
+// Stereo views of `rig` (left = cam0) in air at the given target poses.
+inline std::vector<StereoView> ObserveStereo(
+    const StereoRig& rig, const CalibrationTarget& target,
+    const std::vector<Rigid3d>& cam0_from_target, double noise_px,
+    unsigned seed) {
+  return ObserveStereoWith(rig.left(), InAir(rig.left()), rig.right(),
+                           InAir(rig.right()), rig.right_from_left(), target,
+                           cam0_from_target, noise_px, seed);
+}
+
+// Stereo views of `rig` under water, in a medium of index n, imaged through
+// the exact flat ports of the rig (FlatPortCamera::ImageFromPoint; thin
+// ports when the rig has none).
+inline std::vector<StereoView> ObserveStereoUnderwater(
+    const StereoRig& rig, double n, const CalibrationTarget& target,
+    const std::vector<Rigid3d>& cam0_from_target, double noise_px,
+    unsigned seed) {
+  const StereoRig::Ports ports =
+      rig.ports() ? *rig.ports() : StereoRig::Ports{FlatPort(), FlatPort()};
+  const FlatPortCamera left =
+      FlatPortCamera::Create(rig.left(), ports.left, n).value();
+  const FlatPortCamera right =
+      FlatPortCamera::Create(rig.right(), ports.right, n).value();
+  const auto through = [](const FlatPortCamera& camera) -> PointProjection {
+    return [&camera](const Eigen::Vector3d& p) {
+      return camera.ImageFromPoint(p);
+    };
+  };
+  return ObserveStereoWith(rig.left(), through(left), rig.right(),
+                           through(right), rig.right_from_left(), target,
+                           cam0_from_target, noise_px, seed);
+}
+
+// Moves each corner of `views` with probability `fraction` by 8-20 px in a
+// random direction (a detector confusing corners), deterministic in
+// `seed`; returns how many were moved.
+inline int AddGrossOutliers(double fraction, unsigned seed,
+                            std::vector<StereoView>* views) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int num_moved = 0;
+  for (StereoView& view : *views) {
+    for (std::optional<TargetObservation>* side : {&view.left, &view.right}) {
+      if (!side->has_value()) continue;
+      for (Eigen::Vector2d& pixel : (*side)->pixels) {
+        if (unit(rng) < fraction) {
+          const double angle = 2.0 * M_PI * unit(rng);
+          const double length = 8.0 + 12.0 * unit(rng);
+          pixel += length * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+          ++num_moved;
+        }
+      }
+    }
+  }
+  return num_moved;
 }
 
 }  // namespace rcm::calib::test

@@ -1,16 +1,19 @@
 #include "rcm/camera/flat_port.h"
 
+#include <ceres/jet.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <random>
+#include <vector>
 
-#include <ceres/jet.h>
-
+#include "rcm/camera/flat_port_camera.h"
+#include "rcm/camera/flat_port_projection.h"
 #include "rcm/camera/refractive_model.h"
 #include "rcm/camera/thick_port_refraction.h"
-#include "rcm/camera/flat_port_camera.h"
 #include "support/test_rigs.h"
 
 namespace rcm {
@@ -420,6 +423,229 @@ TEST(ThickPortRefraction, JetDerivativesMatchCentralDifferences) {
       }
     }
   }
+}
+
+}  // namespace
+}  // namespace rcm
+
+// --- FlatPortProjection: the templated forward projection.
+
+namespace rcm {
+namespace {
+
+// The templated projection against ExactFlatPort's (another unknown, the
+// same physics): both solve to machine precision, so they agree to a few
+// ulps of the normalized point (|xb| up to tan(80 deg) = 5.7).
+constexpr double kProjectionTolerance = 1e-12;
+
+// FlatPortProjection::NormalizedFromPoint in double for a port.
+std::optional<Eigen::Vector2d> ProjectThroughPort(
+    const FlatPort& port, double n, const Eigen::Vector3d& point) {
+  const Eigen::Vector3d normal = port.normal.normalized();
+  Eigen::Vector2d normalized;
+  if (!FlatPortProjection::NormalizedFromPoint(
+          n, port.air_gap, port.glass_thickness, port.glass_index,
+          normal.data(), point.data(), normalized.data())) {
+    return std::nullopt;
+  }
+  return normalized;
+}
+
+// Ports of every kind: thin, tilted thin, air gap only, glass only, thick
+// (8 mm gap + 6 mm glass, the README's housing), thick and tilted.
+std::vector<FlatPort> PortsOfEveryKind() {
+  FlatPort tilted_thin;
+  tilted_thin.normal = TiltedPortNormal(2.0 * M_PI / 180.0, -1.1);
+  FlatPort gap_only;
+  gap_only.air_gap = 0.01;
+  FlatPort glass_only;
+  glass_only.glass_thickness = 0.005;
+  glass_only.glass_index = 1.517;
+  FlatPort thick;
+  thick.air_gap = 0.008;
+  thick.glass_thickness = 0.006;
+  return {FlatPort(), tilted_thin, gap_only,
+          glass_only, thick,       ThickTiltedPort()};
+}
+
+TEST(FlatPortProjection, ThinPortIsThePapersClosedForm) {
+  for (const double n : {1.0, 1.2, 1.333, 1.6, 2.0}) {
+    for (const Eigen::Vector2d& xb : NormalizedPoints(1.45, 500, 21)) {
+      Eigen::Vector3d bearing;
+      FlatPortRefraction::BearingInWater(n, xb.x(), xb.y(), bearing.data());
+      const Eigen::Vector3d point = bearing * (2.3 / bearing.z());
+      Eigen::Vector2d expected;
+      ASSERT_TRUE(FlatPortRefraction::NormalizedFromPointInWater(
+          n, point.data(), &expected.x(), &expected.y()));
+      const std::optional<Eigen::Vector2d> actual =
+          ProjectThroughPort(FlatPort(), n, point);
+      ASSERT_TRUE(actual.has_value()) << "n " << n << " at " << xb.transpose();
+      EXPECT_LT((*actual - expected).norm(),
+                kProjectionTolerance * (1.0 + expected.norm()))
+          << "n " << n << " at " << xb.transpose();
+    }
+  }
+}
+
+TEST(FlatPortProjection, AgreesWithTheExactPort) {
+  for (const FlatPort& port : PortsOfEveryKind()) {
+    for (const double n : {1.0, 1.342, 1.6, 2.0}) {
+      const ExactFlatPort exact = ExactFlatPort::Create(port, n).value();
+      std::mt19937_64 rng(23);
+      std::uniform_real_distribution<double> distance(0.05, 8.0);
+      int compared = 0;
+      for (const Eigen::Vector2d& xb : NormalizedPoints(1.4, 500, 22)) {
+        const std::optional<RayInMedium> ray = exact.RayFromNormalized(xb);
+        ASSERT_TRUE(ray.has_value());
+        const double length = distance(rng);
+        const Eigen::Vector3d point = ray->origin + length * ray->direction;
+        const std::optional<Eigen::Vector2d> expected =
+            exact.NormalizedFromPoint(point);
+        const std::optional<Eigen::Vector2d> actual =
+            ProjectThroughPort(port, n, point);
+        ASSERT_EQ(actual.has_value(), expected.has_value())
+            << point.transpose();
+        if (!actual) continue;
+        EXPECT_LT((*actual - *expected).norm(),
+                  kProjectionTolerance * (1.0 + expected->norm()))
+            << "n " << n << " at " << xb.transpose();
+        ++compared;
+      }
+      EXPECT_GT(compared, 490) << "n " << n;
+    }
+  }
+}
+
+TEST(FlatPortProjection, OnAndNearTheAxis) {
+  // On the normal axis the ray in air is the normal; a hair off it the
+  // paraxial solution. Nothing is 0/0 at rho = 0.
+  for (const FlatPort& port : PortsOfEveryKind()) {
+    const Eigen::Vector3d normal = port.normal.normalized();
+    const ExactFlatPort exact = ExactFlatPort::Create(port, 1.342).value();
+    const Eigen::Vector2d on_axis =
+        ProjectThroughPort(port, 1.342, 1.5 * normal).value();
+    EXPECT_LT((on_axis - normal.head<2>() / normal.z()).norm(), 1e-15);
+    for (const double offset : {1e-300, 1e-12, 1e-8, 1e-4}) {
+      const Eigen::Vector3d point =
+          1.5 * normal + offset * normal.cross(Eigen::Vector3d::UnitX());
+      const Eigen::Vector2d expected = exact.NormalizedFromPoint(point).value();
+      const Eigen::Vector2d actual =
+          ProjectThroughPort(port, 1.342, point).value();
+      EXPECT_LT((actual - expected).norm(), kProjectionTolerance) << offset;
+    }
+  }
+}
+
+TEST(FlatPortProjection, InvisiblePointsHaveNoProjection) {
+  const FlatPort thick = ThickTiltedPort();
+  // Inside the housing, in the glass, behind the camera, not finite.
+  EXPECT_FALSE(ProjectThroughPort(thick, 1.333, Eigen::Vector3d(0, 0, 0.035)));
+  EXPECT_FALSE(ProjectThroughPort(thick, 1.333, Eigen::Vector3d(0, 0, -1.0)));
+  EXPECT_FALSE(ProjectThroughPort(thick, 1.333, Eigen::Vector3d(0, 0, NAN)));
+  // Thin port: past the critical angle of water no ray in air reaches it.
+  const double critical = std::asin(1.0 / 1.333);
+  EXPECT_FALSE(
+      ProjectThroughPort(FlatPort(), 1.333,
+                         Eigen::Vector3d(std::sin(critical + 1e-3), 0.0,
+                                         std::cos(critical + 1e-3))));
+  EXPECT_TRUE(ProjectThroughPort(FlatPort(), 1.333,
+                                 Eigen::Vector3d(std::sin(critical - 1e-3), 0.0,
+                                                 std::cos(critical - 1e-3))));
+  // A port outside the model's domain, as a solver may step to.
+  const Eigen::Vector3d point(0.1, 0.2, 1.0);
+  FlatPort negative_gap;
+  negative_gap.air_gap = -1e-9;
+  EXPECT_FALSE(ProjectThroughPort(negative_gap, 1.333, point));
+  FlatPort huge_gap;
+  huge_gap.air_gap = 5e187;
+  EXPECT_FALSE(ProjectThroughPort(huge_gap, 1.333, point));
+  EXPECT_FALSE(ProjectThroughPort(FlatPort(), 0.99, point));
+  EXPECT_FALSE(ProjectThroughPort(FlatPort(), NAN, point));
+}
+
+// The projection of a point `in` = (n, d, tg, n_g, a, b, X, Y, Z) through
+// the port of normal N = (a, b, 1) / |(a, b, 1)|: every input of the
+// projection as one array, for derivatives.
+template <typename T>
+bool ProjectInputs(const T* in, T* normalized) {
+  using std::sqrt;
+  const T norm = sqrt(in[4] * in[4] + in[5] * in[5] + T(1.0));
+  const T normal[3] = {in[4] / norm, in[5] / norm, T(1.0) / norm};
+  return FlatPortProjection::NormalizedFromPoint(in[0], in[1], in[2], in[3],
+                                                 normal, in + 6, normalized);
+}
+
+// Jet derivatives with respect to every input against finite differences
+// of the double projection, for every kind of port, on the axis, a hair
+// off it and across the field. Central differences, or second-order
+// one-sided ones (-3 f(x) + 4 f(x + h) - f(x + 2h)) / 2h where the input
+// sits on the edge of its domain (d = 0, tg = 0, n_g = 1). Step 1e-6
+// (meters for the lengths): truncation ~1e-12, rounding ~1e-16 / 1e-6 *
+// |xb| ~ 1e-9 relative, so 1e-7 relative to 1 + |derivative| fails any
+// wrong derivative and passes the right one.
+TEST(FlatPortProjection, JetDerivativesMatchFiniteDifferences) {
+  constexpr int kNumInputs = 9;
+  using Jet = ceres::Jet<double, kNumInputs>;
+  constexpr double kStep = 1e-6;
+  constexpr double kDerivativeTolerance = 1e-7;
+  const double n = 1.342;
+  int checked = 0;
+  for (const FlatPort& port : PortsOfEveryKind()) {
+    const Eigen::Vector3d normal = port.normal.normalized();
+    const ExactFlatPort exact = ExactFlatPort::Create(port, n).value();
+    std::vector<Eigen::Vector3d> points = {
+        1.2 * normal, 1.2 * normal + Eigen::Vector3d(1e-9, 0.0, 0.0)};
+    for (const Eigen::Vector2d& xb : NormalizedPoints(1.2, 40, 24)) {
+      const RayInMedium ray = exact.RayFromNormalized(xb).value();
+      points.push_back(ray.origin + 0.9 * ray.direction);
+    }
+    for (const Eigen::Vector3d& point : points) {
+      const double values[kNumInputs] = {n,
+                                         port.air_gap,
+                                         port.glass_thickness,
+                                         port.glass_index,
+                                         normal.x() / normal.z(),
+                                         normal.y() / normal.z(),
+                                         point.x(),
+                                         point.y(),
+                                         point.z()};
+      Jet inputs[kNumInputs];
+      for (int i = 0; i < kNumInputs; ++i) inputs[i] = Jet(values[i], i);
+      Jet normalized[2];
+      ASSERT_TRUE(ProjectInputs(inputs, normalized));
+      for (int i = 0; i < kNumInputs; ++i) {
+        const bool on_edge =
+            (i == 1 || i == 2) ? values[i] == 0.0 : i == 3 && values[i] == 1.0;
+        const auto at = [&](double offset, double* out) {
+          double moved[kNumInputs];
+          std::copy(values, values + kNumInputs, moved);
+          moved[i] += offset;
+          return ProjectInputs(moved, out);
+        };
+        double numeric[2];
+        if (on_edge) {
+          double f0[2], f1[2], f2[2];
+          ASSERT_TRUE(at(0.0, f0) && at(kStep, f1) && at(2.0 * kStep, f2));
+          for (int k = 0; k < 2; ++k) {
+            numeric[k] = (-3.0 * f0[k] + 4.0 * f1[k] - f2[k]) / (2.0 * kStep);
+          }
+        } else {
+          double plus[2], minus[2];
+          ASSERT_TRUE(at(kStep, plus) && at(-kStep, minus));
+          for (int k = 0; k < 2; ++k) {
+            numeric[k] = (plus[k] - minus[k]) / (2.0 * kStep);
+          }
+        }
+        for (int k = 0; k < 2; ++k) {
+          EXPECT_NEAR(normalized[k].v[i], numeric[k],
+                      kDerivativeTolerance * (1.0 + std::abs(numeric[k])))
+              << "input " << i << " at " << point.transpose();
+          ++checked;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(checked, 6 * 42 * kNumInputs * 2);
 }
 
 }  // namespace

@@ -32,18 +32,24 @@ inline constexpr double kMinBoardPointDepth = 1e-9;
 
 namespace board_internal {
 
-// pi(lens, P) for a point in the camera frame; false behind the camera.
+// LensModel::ImgFromCam(lens, x, y) - pixel for a normalized point.
 template <typename LensModel, typename T>
-bool ProjectCameraPoint(const T* lens, const T point[3], T* residuals,
-                        const Eigen::Vector2d& pixel) {
-  if (!(point[2] > T(kMinBoardPointDepth))) return false;
-  const T x = point[0] / point[2];
-  const T y = point[1] / point[2];
+void NormalizedPointResidual(const T* lens, const T& x, const T& y,
+                             const Eigen::Vector2d& pixel, T* residuals) {
   T u;
   T v;
   LensModel::ImgFromCam(lens, x, y, &u, &v);
   residuals[0] = u - T(pixel.x());
   residuals[1] = v - T(pixel.y());
+}
+
+// pi(lens, P) for a point in the camera frame; false behind the camera.
+template <typename LensModel, typename T>
+bool ProjectCameraPoint(const T* lens, const T point[3], T* residuals,
+                        const Eigen::Vector2d& pixel) {
+  if (!(point[2] > T(kMinBoardPointDepth))) return false;
+  NormalizedPointResidual<LensModel>(lens, point[0] / point[2],
+                                     point[1] / point[2], pixel, residuals);
   return true;
 }
 

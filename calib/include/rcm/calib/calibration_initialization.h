@@ -52,6 +52,16 @@ std::optional<Rigid3d> InitializeTargetPose(
     const Camera& camera, const std::vector<Eigen::Vector3d>& target_points,
     const TargetObservation& observation);
 
+// The same from the corners' rays, given as normalized points (the ray
+// (x, y, 1) of a central camera): rays[k] belongs to corner k of the
+// observation, nullopt to leave it out. What InitializeTargetPose does
+// after undistortion, for cameras that are not a lens alone (the virtual
+// pinhole of a refractive camera, underwater_calibration.h).
+std::optional<Rigid3d> TargetPoseFromNormalized(
+    const std::vector<Eigen::Vector3d>& target_points,
+    const TargetObservation& observation,
+    const std::vector<std::optional<Eigen::Vector2d>>& rays);
+
 // The robust center of transforms (non-empty): medoid rotation, median
 // translation.
 Rigid3d MedianRigid(const std::vector<Rigid3d>& transforms);

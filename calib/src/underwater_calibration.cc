@@ -1,0 +1,841 @@
+#include "rcm/calib/underwater_calibration.h"
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+#include <glog/logging.h>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <utility>
+
+#include "board_bundle_adjustment.h"
+#include "rcm/calib/calibration_initialization.h"
+#include "rcm/calib/underwater_reprojection_error.h"
+#include "rcm/camera/refractive_model.h"
+#include "rcm/io/number_format.h"
+
+namespace rcm::calib {
+namespace {
+
+using internal::Corner;
+using internal::Pose;
+using internal::PoseFromRigid;
+using internal::RigidFromPose;
+
+constexpr double kDegreesPerRadian = 180.0 / M_PI;
+constexpr double kMinIndex = 1.0;
+constexpr double kMaxIndex = 2.0;
+// n within this of a bound of [1, 2] sits on it (Ceres projects a step
+// that crosses a bound onto it exactly; 1e-9 is far below any sigma_n).
+constexpr double kOnBound = 1e-9;
+// n at the lower bound is refused when the unconstrained Gauss-Newton step
+// from it, -C_nn g_n, points below 1 by more than this many sigma_n: the
+// data then want n < 1, which no water gives. Within it, n = 1 (air) is a
+// valid answer.
+constexpr double kMaxPullBelowAir = 3.0;
+// The box on each tilt parameter (a, b): beyond tan(30 deg) a port is
+// refused anyway (FlatPort::kMaxTiltDegrees).
+const double kMaxTiltParameter =
+    std::tan(FlatPort::kMaxTiltDegrees * M_PI / 180.0);
+
+// What the problem holds fixed: the target, the lenses and the glass.
+struct Model {
+  std::vector<Eigen::Vector3d> target_points;
+  std::array<LensModelId, 2> lens_models{};
+  std::array<UnderwaterCameraConstants, 2> constants{};
+};
+
+// The unknowns, as Ceres sees them.
+struct Parameters {
+  double n = 1.34;
+  Pose cam1_from_cam0{};
+  std::array<double, 2> air_gap{};              // per camera
+  std::array<std::array<double, 2>, 2> tilt{};  // per camera: (a, b)
+  std::vector<Pose> cam0_from_target;           // per input view
+};
+
+// Which of them are estimated (the poses always are).
+struct FreeParameters {
+  bool extrinsics = false;
+  std::array<bool, 2> air_gap{};
+  std::array<bool, 2> tilt{};
+};
+
+template <typename LensModel>
+ceres::CostFunction* MakeCost(const Model& model, const Corner& corner) {
+  const UnderwaterCameraConstants& constants = model.constants[corner.camera];
+  const Eigen::Vector3d& point = model.target_points[corner.point_id];
+  if (corner.camera == 0) {
+    return Cam0UnderwaterReprojectionError<LensModel>::Create(constants, point,
+                                                              corner.pixel);
+  }
+  return Cam1UnderwaterReprojectionError<LensModel>::Create(constants, point,
+                                                            corner.pixel);
+}
+
+ceres::CostFunction* CostFor(const Model& model, const Corner& corner) {
+  RCM_LENS_MODEL_SWITCH(model.lens_models[corner.camera],
+                        return MakeCost<LensModel>(model, corner);)
+  LOG(FATAL) << "unknown lens model";
+  return nullptr;
+}
+
+// Adds the inliers' residuals to `problem` (Huber at huber_px, none for 0),
+// the bounds, and holds the parameters that are not estimated constant.
+void AddResiduals(const Model& model, const std::vector<Corner>& corners,
+                  const FreeParameters& free, double huber_px,
+                  Parameters* parameters, ceres::Problem* problem) {
+  for (const Corner& corner : corners) {
+    if (!corner.inlier) continue;
+    ceres::LossFunction* loss =
+        huber_px > 0.0 ? new ceres::HuberLoss(huber_px) : nullptr;
+    const int c = corner.camera;
+    double* pose = parameters->cam0_from_target[corner.view].data();
+    if (c == 0) {
+      problem->AddResidualBlock(CostFor(model, corner), loss, &parameters->n,
+                                pose, &parameters->air_gap[0],
+                                parameters->tilt[0].data());
+    } else {
+      problem->AddResidualBlock(CostFor(model, corner), loss, &parameters->n,
+                                pose, parameters->cam1_from_cam0.data(),
+                                &parameters->air_gap[1],
+                                parameters->tilt[1].data());
+    }
+  }
+  if (!problem->HasParameterBlock(&parameters->n)) return;
+  problem->SetParameterLowerBound(&parameters->n, 0, kMinIndex);
+  problem->SetParameterUpperBound(&parameters->n, 0, kMaxIndex);
+  if (problem->HasParameterBlock(parameters->cam1_from_cam0.data()) &&
+      !free.extrinsics) {
+    problem->SetParameterBlockConstant(parameters->cam1_from_cam0.data());
+  }
+  for (int c = 0; c < 2; ++c) {
+    double* gap = &parameters->air_gap[c];
+    if (problem->HasParameterBlock(gap)) {
+      if (free.air_gap[c]) {
+        problem->SetParameterLowerBound(gap, 0, 0.0);
+        problem->SetParameterUpperBound(gap, 0, FlatPort::kMaxAirGap);
+      } else {
+        problem->SetParameterBlockConstant(gap);
+      }
+    }
+    double* tilt = parameters->tilt[c].data();
+    if (problem->HasParameterBlock(tilt)) {
+      if (free.tilt[c]) {
+        for (int i = 0; i < 2; ++i) {
+          problem->SetParameterLowerBound(tilt, i, -kMaxTiltParameter);
+          problem->SetParameterUpperBound(tilt, i, kMaxTiltParameter);
+        }
+      } else {
+        problem->SetParameterBlockConstant(tilt);
+      }
+    }
+  }
+}
+
+// The residual of one corner at the current parameters; false when the
+// port cannot image it.
+template <typename LensModel>
+bool EvaluateResidual(const Model& model, const Corner& corner,
+                      const Parameters& parameters, double* residual) {
+  const UnderwaterCameraConstants& constants = model.constants[corner.camera];
+  const Eigen::Vector3d& point = model.target_points[corner.point_id];
+  const double* pose = parameters.cam0_from_target[corner.view].data();
+  if (corner.camera == 0) {
+    return Cam0UnderwaterReprojectionError<LensModel>(
+        constants, point, corner.pixel)(&parameters.n, pose,
+                                        &parameters.air_gap[0],
+                                        parameters.tilt[0].data(), residual);
+  }
+  return Cam1UnderwaterReprojectionError<LensModel>(constants, point,
+                                                    corner.pixel)(
+      &parameters.n, pose, parameters.cam1_from_cam0.data(),
+      &parameters.air_gap[1], parameters.tilt[1].data(), residual);
+}
+
+// The same; NaN when the port cannot image the corner.
+Eigen::Vector2d Residual(const Model& model, const Corner& corner,
+                         const Parameters& parameters) {
+  Eigen::Vector2d residual;
+  bool ok = false;
+  RCM_LENS_MODEL_SWITCH(model.lens_models[corner.camera],
+                        ok = EvaluateResidual<LensModel>(
+                            model, corner, parameters, residual.data());
+                        break;)
+  if (!ok) residual.setConstant(std::numeric_limits<double>::quiet_NaN());
+  return residual;
+}
+
+// camera_from_target of one view through the thin port at n0 (header):
+// PnP on the normalized points (xb, yb) / m(n0, rb) of the corners' rays
+// in the water.
+std::optional<Rigid3d> ThinPortTargetPose(
+    const Camera& camera, double n0,
+    const std::vector<Eigen::Vector3d>& target_points,
+    const TargetObservation& observation) {
+  std::vector<std::optional<Eigen::Vector2d>> rays;
+  for (const Eigen::Vector2d& pixel : observation.pixels) {
+    std::optional<Eigen::Vector2d> normalized =
+        camera.NormalizedFromImage(pixel);
+    if (normalized) {
+      *normalized /=
+          FlatPortRefraction::RadialFactor(n0, normalized->squaredNorm());
+    }
+    rays.push_back(normalized);
+  }
+  return TargetPoseFromNormalized(target_points, observation, rays);
+}
+
+// The port normal of tilt parameters (a, b).
+Eigen::Vector3d NormalFromTilt(const std::array<double, 2>& tilt) {
+  return Eigen::Vector3d(tilt[0], tilt[1], 1.0).normalized();
+}
+
+// The blocks of the covariance (header order) and their parameter arrays.
+struct CovarianceLayout {
+  std::vector<UnderwaterParameterBlock> blocks;
+  std::vector<internal::CovarianceBlockRef> refs;
+  int size = 0;
+
+  void Add(const std::string& name, const double* block, int block_size) {
+    blocks.push_back({name, size, block_size});
+    refs.push_back({block, block_size});
+    size += block_size;
+  }
+};
+
+CovarianceLayout LayoutOf(const FreeParameters& free,
+                          const Parameters& parameters) {
+  CovarianceLayout layout;
+  layout.Add("n", &parameters.n, 1);
+  if (free.extrinsics) {
+    layout.Add("cam1_from_cam0", parameters.cam1_from_cam0.data(), 6);
+  }
+  for (int c = 0; c < 2; ++c) {
+    if (free.air_gap[c]) {
+      layout.Add("cam" + std::to_string(c) + " air_gap", &parameters.air_gap[c],
+                 1);
+    }
+  }
+  for (int c = 0; c < 2; ++c) {
+    if (free.tilt[c]) {
+      layout.Add("cam" + std::to_string(c) + " port_tilt",
+                 parameters.tilt[c].data(), 2);
+    }
+  }
+  return layout;
+}
+
+// The estimated parameters in the covariance's layout, the extrinsics'
+// rotation as the left perturbation w = log(R R_reference^T).
+Eigen::VectorXd ParameterVector(const FreeParameters& free,
+                                const Parameters& parameters,
+                                const Eigen::Matrix3d& reference_rotation) {
+  const CovarianceLayout layout = LayoutOf(free, parameters);
+  Eigen::VectorXd x(layout.size);
+  for (size_t b = 0; b < layout.blocks.size(); ++b) {
+    const UnderwaterParameterBlock& block = layout.blocks[b];
+    const double* values = layout.refs[b].block;
+    if (block.name == "cam1_from_cam0") {
+      const Rigid3d rigid = RigidFromPose(values);
+      const Eigen::Matrix3d delta =
+          rigid.rotation * reference_rotation.transpose();
+      Eigen::Vector3d w;
+      ceres::RotationMatrixToAngleAxis(delta.data(), w.data());
+      x.segment<3>(block.offset) = w;
+      x.segment<3>(block.offset + 3) = rigid.translation;
+    } else {
+      for (int i = 0; i < block.size; ++i) x[block.offset + i] = values[i];
+    }
+  }
+  return x;
+}
+
+// The change of the extrinsics from the air calibration's (header) when
+// the underwater extrinsics are moved by the left perturbation
+// delta = [r (rad); u (m)], R = exp([r]x) R_water, t = t_water + u:
+//   [w; dt] = [log(R R_air^T); t - R R_air^T t_air].
+// Templated so that Jets give its Jacobian in delta.
+template <typename T>
+void PerturbedChange(const Rigid3d& air, const Rigid3d& water, const T* delta,
+                     T* change) {
+  Eigen::Matrix<T, 3, 3> turn;
+  ceres::AngleAxisToRotationMatrix(delta, turn.data());
+  const Eigen::Matrix<T, 3, 3> rotation =
+      turn * (water.rotation * air.rotation.transpose()).cast<T>();
+  ceres::RotationMatrixToAngleAxis(rotation.data(), change);
+  const Eigen::Matrix<T, 3, 1> shift =
+      water.translation.cast<T>() +
+      Eigen::Matrix<T, 3, 1>(delta[3], delta[4], delta[5]) -
+      rotation * air.translation.cast<T>();
+  for (int i = 0; i < 3; ++i) change[3 + i] = shift[i];
+}
+
+// [w (rad); dt (m)] and, when `jacobian` is given, d[w; dt] / d delta at
+// delta = 0 (autodiff).
+Eigen::Matrix<double, 6, 1> ChangeFromAir(
+    const Rigid3d& air, const Rigid3d& water,
+    Eigen::Matrix<double, 6, 6>* jacobian = nullptr) {
+  using Jet = ceres::Jet<double, 6>;
+  Jet delta[6];
+  for (int i = 0; i < 6; ++i) delta[i] = Jet(0.0, i);
+  Jet change[6];
+  PerturbedChange(air, water, delta, change);
+  Eigen::Matrix<double, 6, 1> value;
+  for (int i = 0; i < 6; ++i) {
+    value[i] = change[i].a;
+    if (jacobian != nullptr) jacobian->row(i) = change[i].v.transpose();
+  }
+  return value;
+}
+
+// [w (deg); |w| (deg); dt (mm)]: the change as reported.
+Eigen::Matrix<double, 7, 1> ReportedChange(
+    const Eigen::Matrix<double, 6, 1>& change) {
+  Eigen::Matrix<double, 7, 1> reported;
+  reported.head<3>() = kDegreesPerRadian * change.head<3>();
+  reported[3] = kDegreesPerRadian * change.head<3>().norm();
+  reported.tail<3>() = 1e3 * change.tail<3>();
+  return reported;
+}
+
+// sqrt((g - 1) / g * sum_k (x_k - mean x)^2), per component.
+Eigen::VectorXd JackknifeSigma(const std::vector<Eigen::VectorXd>& samples) {
+  const int g = static_cast<int>(samples.size());
+  Eigen::VectorXd mean = Eigen::VectorXd::Zero(samples[0].size());
+  for (const Eigen::VectorXd& x : samples) mean += x;
+  mean /= g;
+  Eigen::VectorXd sum = Eigen::VectorXd::Zero(mean.size());
+  for (const Eigen::VectorXd& x : samples) {
+    sum += (x - mean).cwiseAbs2();
+  }
+  return ((g - 1.0) / g * sum).cwiseSqrt();
+}
+
+std::string CameraName(int c) { return "cam" + std::to_string(c); }
+
+}  // namespace
+
+Status UnderwaterCalibrationOptions::Check() const {
+  if (!(initial_n >= kMinIndex && initial_n <= kMaxIndex)) {
+    return Status::Error("initial_n must be in [1, 2]");
+  }
+  RCM_RETURN_IF_ERROR(internal::CheckSharedFitSettings(
+      {huber_px, outlier_sigmas, min_outlier_threshold_px, max_outlier_rounds,
+       max_num_iterations, min_corners_per_view, num_threads}));
+  if (folds < 0 || folds == 1) {
+    return Status::Error("folds must be 0 (no leave-out) or at least 2");
+  }
+  return Status::Ok();
+}
+
+const UnderwaterParameterBlock* UnderwaterCovariance::Find(
+    std::string_view name) const {
+  for (const UnderwaterParameterBlock& block : blocks) {
+    if (block.name == name) return &block;
+  }
+  return nullptr;
+}
+
+Eigen::MatrixXd UnderwaterCovariance::Block(std::string_view row,
+                                            std::string_view col) const {
+  const UnderwaterParameterBlock* r = Find(row);
+  const UnderwaterParameterBlock* c = Find(col);
+  CHECK(r != nullptr && c != nullptr)
+      << "no covariance block " << (r == nullptr ? row : col);
+  return matrix.block(r->offset, c->offset, r->size, c->size);
+}
+
+StatusOr<UnderwaterCalibration> CalibrateUnderwater(
+    const CalibrationTarget& target, const std::vector<StereoView>& views,
+    const ImageSize& cam0_size, const ImageSize& cam1_size,
+    const StereoRig& air_rig, const UnderwaterCalibrationOptions& options,
+    const std::function<void(int, int)>& progress) {
+  RCM_RETURN_IF_ERROR(options.Check());
+  const Camera* cameras[2] = {&air_rig.left(), &air_rig.right()};
+  const ImageSize sizes[2] = {cam0_size, cam1_size};
+  const int num_views = static_cast<int>(views.size());
+  for (int c = 0; c < 2; ++c) {
+    bool seen = false;
+    for (const StereoView& view : views) {
+      seen |= (c == 0 ? view.left : view.right).has_value();
+    }
+    const bool none = sizes[c].width == 0 && sizes[c].height == 0;
+    if ((seen || !none) && (sizes[c].width != cameras[c]->width() ||
+                            sizes[c].height != cameras[c]->height())) {
+      return Status::Error(
+          CameraName(c) + " images are " + std::to_string(sizes[c].width) +
+          "x" + std::to_string(sizes[c].height) +
+          " but the air calibration's " + CameraName(c) + " is " +
+          std::to_string(cameras[c]->width()) + "x" +
+          std::to_string(cameras[c]->height()) +
+          ": the air rig is not these cameras' (or the images were scaled)");
+    }
+  }
+
+  Model model;
+  model.target_points = TargetPoints(target);
+  const int num_points = static_cast<int>(model.target_points.size());
+  StatusOr<internal::UsedObservations> selected = internal::SelectObservations(
+      views, num_points, options.min_corners_per_view,
+      options.use_single_camera_views);
+  if (!selected.ok()) return selected.status();
+  const internal::UsedObservations& used = *selected;
+
+  // The ports: the air rig's blocks, or thin ports.
+  std::array<FlatPort, 2> ports = {FlatPort(), FlatPort()};
+  if (air_rig.ports()) ports = {air_rig.ports()->left, air_rig.ports()->right};
+  for (int c = 0; c < 2; ++c) {
+    model.lens_models[c] = cameras[c]->model();
+    std::copy(cameras[c]->params(),
+              cameras[c]->params() + cameras[c]->num_params(),
+              model.constants[c].lens.begin());
+    model.constants[c].glass_thickness = ports[c].glass_thickness;
+    model.constants[c].glass_index = ports[c].glass_index;
+  }
+
+  // Target poses through the thin port at initial_n (header).
+  const Rigid3d& air_extrinsics = air_rig.right_from_left();
+  Parameters parameters;
+  parameters.n = options.initial_n;
+  parameters.cam1_from_cam0 = PoseFromRigid(air_extrinsics);
+  for (int c = 0; c < 2; ++c) {
+    parameters.air_gap[c] = ports[c].air_gap;
+    const Eigen::Vector3d normal = ports[c].normal.normalized();
+    parameters.tilt[c] = {normal.x() / normal.z(), normal.y() / normal.z()};
+  }
+  parameters.cam0_from_target.resize(num_views);
+  std::vector<Corner> corners;
+  std::vector<bool> view_used(num_views, false);
+  std::array<bool, 2> camera_used = {false, false};
+  int num_stereo_views = 0;
+  for (int v = 0; v < num_views; ++v) {
+    std::optional<Rigid3d> camera_from_target[2];
+    for (int c = 0; c < 2; ++c) {
+      if (used[v][c] == nullptr) continue;
+      camera_from_target[c] = ThinPortTargetPose(
+          *cameras[c], options.initial_n, model.target_points, *used[v][c]);
+    }
+    std::optional<Rigid3d> cam0_from_target = camera_from_target[0];
+    if (!cam0_from_target && camera_from_target[1]) {
+      cam0_from_target = air_extrinsics.Inverse() * *camera_from_target[1];
+    }
+    if (!cam0_from_target) continue;
+    view_used[v] = true;
+    parameters.cam0_from_target[v] = PoseFromRigid(*cam0_from_target);
+    for (int c = 0; c < 2; ++c) {
+      if (used[v][c] == nullptr) continue;
+      camera_used[c] = true;
+      for (int k = 0; k < used[v][c]->size(); ++k) {
+        corners.push_back(
+            {v, c, used[v][c]->point_ids[k], used[v][c]->pixels[k], true});
+      }
+    }
+    if (used[v][0] != nullptr && used[v][1] != nullptr) ++num_stereo_views;
+  }
+  const int num_views_used =
+      static_cast<int>(std::count(view_used.begin(), view_used.end(), true));
+  if (num_views_used == 0) {
+    return Status::Error("no view shows the target with at least " +
+                         std::to_string(options.min_corners_per_view) +
+                         " corners (and a pose)");
+  }
+  if (num_views_used < kMinUnderwaterViews) {
+    return Status::Error("the target is seen with at least " +
+                         std::to_string(options.min_corners_per_view) +
+                         " corners (and a pose) in " +
+                         std::to_string(num_views_used) +
+                         " view(s); at least " +
+                         std::to_string(kMinUnderwaterViews) + " are needed");
+  }
+
+  FreeParameters free;
+  free.extrinsics = num_stereo_views > 0;
+  for (int c = 0; c < 2; ++c) {
+    free.air_gap[c] = options.estimate_air_gap && camera_used[c];
+    free.tilt[c] = options.estimate_port_tilt && camera_used[c];
+  }
+  const CovarianceLayout layout = LayoutOf(free, parameters);
+  const int num_parameters = layout.size + 6 * num_views_used;
+
+  const auto residual = [&](const Corner& corner) {
+    return Residual(model, corner, parameters);
+  };
+  // A corner the start cannot image (past the critical angle at initial_n
+  // through poses from the thin-port approximation) would fail the first
+  // solve: it starts as an outlier, and the outlier rounds, which judge
+  // every corner at each round's solution, take it back when it fits.
+  double initial_sum = 0.0;
+  int num_initial = 0;
+  for (Corner& corner : corners) {
+    const Eigen::Vector2d start = residual(corner);
+    corner.inlier = start.allFinite();
+    if (corner.inlier) {
+      initial_sum += start.squaredNorm();
+      ++num_initial;
+    }
+  }
+
+  // Robust solves with outlier rejection, then least squares on the
+  // inliers (board_bundle_adjustment.h).
+  const ceres::Solver::Options solver_options = internal::BoardSolverOptions(
+      options.max_num_iterations, options.num_threads);
+  ceres::Problem problem;
+  RCM_RETURN_IF_ERROR(internal::FitWithOutlierRejection(
+      {options.huber_px, options.outlier_sigmas,
+       options.min_outlier_threshold_px, options.max_outlier_rounds},
+      solver_options,
+      [&](double huber_px, ceres::Problem* problem) {
+        AddResiduals(model, corners, free, huber_px, &parameters, problem);
+      },
+      residual, &corners, &problem));
+
+  if (!std::isfinite(parameters.n) || parameters.n >= kMaxIndex - kOnBound) {
+    return Status::Error(
+        "n = " + FormatFixed(parameters.n, 4) +
+        " ends at the upper bound of [1, 2], which is not a physical answer: "
+        "the air calibration probably does not describe these cameras under "
+        "water (another rig's file, a lens refocused or zoomed since, a dome "
+        "rather than a flat port), or the corners are not the target's");
+  }
+  for (int c = 0; c < 2; ++c) {
+    if (free.air_gap[c] &&
+        parameters.air_gap[c] >= FlatPort::kMaxAirGap - kOnBound) {
+      return Status::Error(
+          CameraName(c) + " air gap ends at the upper bound " +
+          FormatDouble(FlatPort::kMaxAirGap) +
+          " m: the flat-port model does not explain these images");
+    }
+  }
+
+  // The result, from the solution.
+  UnderwaterCalibration result(air_rig);
+  result.n = parameters.n;
+  result.extrinsics_estimated = free.extrinsics;
+  const Rigid3d water_extrinsics =
+      free.extrinsics ? RigidFromPose(parameters.cam1_from_cam0.data())
+                      : air_extrinsics;
+  std::array<FlatPort, 2> estimated_ports = ports;
+  for (int c = 0; c < 2; ++c) {
+    if (free.air_gap[c]) {
+      // FlatPort takes a gap of 0 or >= kMinLayerThickness.
+      estimated_ports[c].air_gap =
+          parameters.air_gap[c] < FlatPort::kMinLayerThickness
+              ? 0.0
+              : parameters.air_gap[c];
+      if (parameters.air_gap[c] < FlatPort::kMinLayerThickness) {
+        result.notes.push_back(
+            CameraName(c) + " air gap estimated at " +
+            FormatDouble(parameters.air_gap[c]) +
+            " m, the lower bound: a thin port (the lens at the glass)");
+      }
+    }
+    if (free.tilt[c]) {
+      estimated_ports[c].normal = NormalFromTilt(parameters.tilt[c]);
+    }
+    if (Status status = estimated_ports[c].Check(); !status.ok()) {
+      return Status::Error("the estimated " + CameraName(c) + " " +
+                           status.message());
+    }
+  }
+  {
+    StatusOr<StereoRig> rig =
+        StereoRig::Create(air_rig.left(), air_rig.right(), water_extrinsics);
+    if (!rig.ok()) {
+      return Status::Error("bundle adjustment diverged: " +
+                           rig.status().message());
+    }
+    const bool ports_changed =
+        free.air_gap[0] || free.air_gap[1] || free.tilt[0] || free.tilt[1];
+    if (air_rig.ports() || ports_changed) {
+      rig = rig->WithPorts(estimated_ports[0], estimated_ports[1]);
+      if (!rig.ok()) return rig.status();
+    }
+    result.rig = *rig;
+  }
+
+  result.cam0_from_target =
+      internal::UsedViewPoses(parameters.cam0_from_target, view_used);
+  internal::ResidualStatistics statistics =
+      internal::SummarizeResiduals(corners, residual);
+  const double inlier_ssr = statistics.inlier_ssr;
+  internal::StoreResidualStatistics(std::move(statistics), &result);
+  result.initial_rms_px =
+      num_initial == 0 ? 0.0 : std::sqrt(initial_sum / num_initial);
+  result.num_views_used = num_views_used;
+  result.num_stereo_views = num_stereo_views;
+  result.num_parameters = num_parameters;
+  result.views.resize(num_views);
+  std::vector<std::array<int, 2>> num_projected(num_views, {0, 0});
+  for (const CornerResidual& corner : result.corners) {
+    UnderwaterViewResidual& view = result.views[corner.view];
+    ++view.num_corners[corner.camera];
+    if (!corner.residual.allFinite()) continue;
+    ++num_projected[corner.view][corner.camera];
+    view.rms_px[corner.camera] += corner.residual.squaredNorm();
+  }
+  for (int v = 0; v < num_views; ++v) {
+    for (int c = 0; c < 2; ++c) {
+      if (num_projected[v][c] > 0) {
+        result.views[v].rms_px[c] =
+            std::sqrt(result.views[v].rms_px[c] / num_projected[v][c]);
+      }
+    }
+  }
+  // A fit that leaves many corners out is not a calibration of these
+  // cameras: said, not refused (the residuals show it too).
+  constexpr double kSuspectOutlierFraction = 0.1;
+  if (result.num_outliers > kSuspectOutlierFraction * corners.size()) {
+    result.notes.push_back(
+        FormatFixed(100.0 * result.num_outliers / corners.size(), 0) +
+        " % of the corners are outliers (" +
+        std::to_string(result.num_outliers) + " of " +
+        std::to_string(corners.size()) +
+        "): the air calibration may not describe these cameras, or the "
+        "detector confused corners");
+  }
+  const int redundancy = 2 * result.num_inliers - num_parameters;
+  if (redundancy <= 0) {
+    return Status::Error(
+        "too few corners: " + std::to_string(result.num_inliers) +
+        " inlier corners for " + std::to_string(num_parameters) +
+        " unknowns (2 per corner must exceed them)");
+  }
+  result.pixel_sigma = std::sqrt(inlier_ssr / redundancy);
+
+  // Covariance: sigma^2 (J^T J)^-1, the extrinsics' rotation moved to the
+  // left perturbation, w = G a for the angle-axis parameters a.
+  Eigen::MatrixXd unscaled;
+  if (!internal::JointCovariance(layout.refs, /*cross_blocks=*/true,
+                                 options.num_threads, &problem, &unscaled)) {
+    return Status::Error(
+        "the underwater calibration is degenerate: its covariance cannot be "
+        "computed (the views do not constrain every unknown; add views with "
+        "the target tilted, near the image corners and at several "
+        "distances)");
+  }
+  result.covariance.blocks = layout.blocks;
+  Eigen::MatrixXd to_left = Eigen::MatrixXd::Identity(layout.size, layout.size);
+  if (const UnderwaterParameterBlock* block =
+          result.covariance.Find("cam1_from_cam0")) {
+    to_left.block<3, 3>(block->offset, block->offset) =
+        internal::LeftPerturbationFromAngleAxis(
+            parameters.cam1_from_cam0.data());
+  }
+  const double variance = result.pixel_sigma * result.pixel_sigma;
+  result.covariance.matrix =
+      variance * to_left * unscaled * to_left.transpose();
+  if (!result.covariance.matrix.allFinite() ||
+      !(result.covariance.matrix.diagonal().minCoeff() >= 0.0)) {
+    return Status::Error(
+        "the underwater calibration is degenerate: its covariance has a "
+        "negative or non-finite variance");
+  }
+  result.sigma_n = std::sqrt(result.covariance.matrix(0, 0));
+
+  // At the lower bound, n = 1 is an answer when the data do not pull below
+  // it (kMaxPullBelowAir).
+  if (parameters.n <= kMinIndex + kOnBound) {
+    ceres::Problem::EvaluateOptions evaluate;
+    evaluate.parameter_blocks = {&parameters.n};
+    evaluate.num_threads = options.num_threads;
+    std::vector<double> gradient;
+    double cost = 0.0;
+    problem.Evaluate(evaluate, &cost, nullptr, &gradient, nullptr);
+    const double step = -unscaled(0, 0) * gradient[0];
+    // (A pull of less than kOnBound is rounding: exact corners of a target
+    // in air give 1e-13 against a sigma_n of 1e-16.)
+    if (step < -kMaxPullBelowAir * result.sigma_n && step < -kOnBound) {
+      return Status::Error(
+          "n ends at the lower bound 1 of [1, 2] and the corners pull it "
+          "below by " +
+          FormatFixed(-step / result.sigma_n, 1) +
+          " sigma, which no medium does: the air calibration probably does "
+          "not describe these cameras (focal lengths too long, another "
+          "rig's file), or the corners are not the target's");
+    }
+  }
+
+  // The extrinsics and their change from the air calibration.
+  if (free.extrinsics) {
+    const UnderwaterParameterBlock& block =
+        *result.covariance.Find("cam1_from_cam0");
+    result.extrinsics_covariance =
+        result.covariance.matrix.block<6, 6>(block.offset, block.offset);
+    Eigen::Matrix<double, 6, 6> jacobian;
+    const Eigen::Matrix<double, 6, 1> change =
+        ChangeFromAir(air_extrinsics, water_extrinsics, &jacobian);
+    const Eigen::Matrix<double, 7, 1> reported = ReportedChange(change);
+    ExtrinsicChange& out = result.extrinsic_change;
+    out.rotation_deg = reported.head<3>();
+    out.angle_deg = reported[3];
+    out.translation_mm = reported.tail<3>();
+    out.covariance =
+        jacobian * result.extrinsics_covariance * jacobian.transpose();
+    for (int i = 0; i < 3; ++i) {
+      out.rotation_sigma_deg[i] =
+          kDegreesPerRadian * std::sqrt(out.covariance(i, i));
+      out.translation_sigma_mm[i] =
+          1e3 * std::sqrt(out.covariance(3 + i, 3 + i));
+    }
+    const Eigen::Vector3d w = change.head<3>();
+    // |w| to first order: the variance along w's direction (the largest
+    // axis' when w is 0).
+    Eigen::Vector3d direction = w;
+    if (!(direction.norm() > 0.0)) {
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(
+          out.covariance.topLeftCorner<3, 3>());
+      direction = eigen.eigenvectors().col(2);
+    }
+    direction.normalize();
+    out.angle_sigma_deg =
+        kDegreesPerRadian *
+        std::sqrt(
+            direction.dot(out.covariance.topLeftCorner<3, 3>() * direction));
+  }
+
+  // The ports.
+  for (int c = 0; c < 2; ++c) {
+    PortEstimate& port = result.ports[c];
+    // The rig's port, bit for bit (its normal is unit).
+    port.port = !result.rig.ports() ? estimated_ports[c]
+                : c == 0            ? result.rig.ports()->left
+                                    : result.rig.ports()->right;
+    port.tilt = Eigen::Vector2d(port.port.normal.x() / port.port.normal.z(),
+                                port.port.normal.y() / port.port.normal.z());
+    port.tilt_deg = kDegreesPerRadian *
+                    std::acos(std::clamp(port.port.normal.z(), -1.0, 1.0));
+    port.air_gap_estimated = free.air_gap[c];
+    port.tilt_estimated = free.tilt[c];
+    if (free.air_gap[c]) {
+      const std::string name = CameraName(c) + " air_gap";
+      port.air_gap_sigma = std::sqrt(result.covariance.Block(name, name)(0, 0));
+    }
+    if (free.tilt[c]) {
+      const std::string name = CameraName(c) + " port_tilt";
+      port.tilt_sigma =
+          result.covariance.Block(name, name).diagonal().cwiseSqrt();
+    }
+  }
+
+  // Leave views out (header): each replicate re-solves the inliers' least
+  // squares without its views, from the full solution.
+  std::vector<int> used_views;
+  for (int v = 0; v < num_views; ++v) {
+    if (view_used[v]) used_views.push_back(v);
+  }
+  const int groups = std::min(options.folds, num_views_used);
+  const int total_steps = 1 + (groups >= 2 ? groups : 0);
+  if (progress) progress(1, total_steps);
+  if (options.folds > 0 && groups < 2) {
+    result.notes.push_back("leave-out: fewer than 2 views to leave out");
+  }
+  if (groups >= 2) {
+    std::vector<int> group_of(num_views, -1);
+    for (size_t k = 0; k < used_views.size(); ++k) {
+      group_of[used_views[k]] = static_cast<int>(k) % groups;
+    }
+    UnderwaterLeaveOut leave_out;
+    leave_out.folds = groups;
+    std::vector<Eigen::VectorXd> samples;
+    std::vector<Eigen::VectorXd> changes;
+    const Eigen::Matrix3d reference = water_extrinsics.rotation;
+    for (int k = 0; k < groups; ++k) {
+      std::vector<Corner> kept;
+      std::array<bool, 2> camera_kept = {false, false};
+      bool stereo_kept = false;
+      for (const Corner& corner : corners) {
+        if (group_of[corner.view] == k || !corner.inlier) continue;
+        kept.push_back(corner);
+        camera_kept[corner.camera] = true;
+      }
+      for (int v : used_views) {
+        stereo_kept |=
+            group_of[v] != k && used[v][0] != nullptr && used[v][1] != nullptr;
+      }
+      bool observable = !free.extrinsics || stereo_kept;
+      for (int c = 0; c < 2; ++c) {
+        observable &= !(free.air_gap[c] || free.tilt[c]) || camera_kept[c];
+      }
+      Parameters replicate = parameters;
+      ceres::Problem fold_problem;
+      AddResiduals(model, kept, free, /*huber_px=*/0.0, &replicate,
+                   &fold_problem);
+      ceres::Solver::Summary summary;
+      if (observable && !kept.empty()) {
+        ceres::Solve(solver_options, &fold_problem, &summary);
+      }
+      // (A replicate at n = 1 is an answer, as for the full solution; one
+      // at 2 is not.)
+      if (!observable || kept.empty() || !summary.IsSolutionUsable() ||
+          replicate.n >= kMaxIndex - kOnBound) {
+        ++leave_out.failed_folds;
+      } else {
+        samples.push_back(ParameterVector(free, replicate, reference));
+        if (free.extrinsics) {
+          changes.push_back(ReportedChange(ChangeFromAir(
+              air_extrinsics, RigidFromPose(replicate.cam1_from_cam0.data()))));
+        }
+      }
+      if (progress) progress(2 + k, total_steps);
+    }
+    if (samples.size() >= 2) {
+      leave_out.sigma = JackknifeSigma(samples);
+      result.sigma_n_leave_out = leave_out.sigma[0];
+      if (free.extrinsics) {
+        const Eigen::VectorXd sigma = JackknifeSigma(changes);
+        result.extrinsic_change.rotation_leave_out_sigma_deg = sigma.head<3>();
+        result.extrinsic_change.angle_leave_out_sigma_deg = sigma[3];
+        result.extrinsic_change.translation_leave_out_sigma_mm =
+            sigma.tail<3>();
+      }
+      result.leave_out = std::move(leave_out);
+    } else {
+      result.notes.push_back("leave-out: only " +
+                             std::to_string(samples.size()) + " of " +
+                             std::to_string(groups) + " replicates succeeded");
+    }
+  }
+
+  // The conventional model on the same corners.
+  if (options.fit_conventional_model) {
+    ConventionalFit& fit = result.conventional;
+    fit.model = air_rig.left().model();
+    if (air_rig.right().model() != fit.model) {
+      result.notes.push_back(
+          "conventional fit: both cameras use cam0's lens model (" +
+          std::string(LensModelName(fit.model)) + ")");
+    }
+    StereoCalibrationOptions conventional;
+    conventional.model = fit.model;
+    conventional.huber_px = options.huber_px;
+    conventional.outlier_sigmas = options.outlier_sigmas;
+    conventional.min_outlier_threshold_px = options.min_outlier_threshold_px;
+    conventional.max_outlier_rounds = options.max_outlier_rounds;
+    conventional.max_num_iterations = options.max_num_iterations;
+    conventional.use_single_camera_views = options.use_single_camera_views;
+    conventional.min_corners_per_view = options.min_corners_per_view;
+    conventional.compute_covariance = false;
+    conventional.num_threads = options.num_threads;
+    const StatusOr<StereoCalibration> calibration = CalibrateStereo(
+        target, views, {cameras[0]->width(), cameras[0]->height()},
+        {cameras[1]->width(), cameras[1]->height()}, conventional);
+    if (calibration.ok()) {
+      fit.ok = true;
+      fit.rms_px = calibration->rms_px;
+      fit.inlier_rms_px = calibration->inlier_rms_px;
+      fit.pixel_sigma = calibration->pixel_sigma;
+      fit.num_parameters = calibration->num_parameters;
+    } else {
+      fit.error = calibration.status().message();
+      result.notes.push_back("conventional fit: " + fit.error);
+    }
+  }
+  return result;
+}
+
+}  // namespace rcm::calib
