@@ -1,23 +1,26 @@
 // rcm simulate: a synthetic underwater stereo sequence with ground truth.
 #include <gflags/gflags.h>
 
+#include <array>
 #include <chrono>
-#include <cstdlib>
+#include <cmath>
 #include <iostream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
+#include <vector>
 
 #include "command.h"
 #include "index_flag.h"
+#include "number_list_flag.h"
 #include "progress.h"
+#include "rcm/calib/calibration_target.h"
 #include "rcm/io/atomic_file.h"
 #include "rcm/io/number_format.h"
 #include "rcm/sim/sequence_simulator.h"
 #include "rcm/sim/sequence_writer.h"
 #include "rig_flags.h"
 #include "simulation_flags.h"
-
+#include "target_flags.h"
 
 DEFINE_int32(matches_per_frame, 0,
              "also write matches.csv with this many exact correspondences "
@@ -32,10 +35,19 @@ DEFINE_string(depth_range, "",
               "MIN,MAX in meters: sample the matches at depths uniform in "
               "[MIN, MAX] on random left pixels' rays instead of on the "
               "tank's surfaces (needs --noimages)");
+DEFINE_string(extrinsic_drift, "",
+              "RX,RY,RZ[,TX,TY,TZ]: cam1 has moved since the air "
+              "calibration by this rotation (angle-axis, degrees, cam1 "
+              "frame) and change of cam1_from_cam0's translation (mm): the "
+              "images and matches are those of the moved rig, camchain.yaml "
+              "stays the calibration (StereoRig::WithCam1Moved)");
+DEFINE_string(board_distance, "0.6,2.0",
+              "with --board: MIN,MAX in meters, the range of the board's "
+              "distance in front of cam0");
 DEFINE_bool(images, true, "render the images (--noimages: matches only)");
 DEFINE_bool(overwrite, false,
             "replace a sequence already in --out (its frames, matches, "
-            "camchain and truth)");
+            "camchain, board and truth)");
 
 namespace rcm::cli {
 namespace {
@@ -46,20 +58,32 @@ constexpr char kUsage[] =
     "usage: rcm simulate --out DIR [--n 1.333 | --media water:30,air:30]\n"
     "                    [--frames 20] [--air-gap 0.01 --glass-thickness "
     "0.005]\n"
-    "                    [--matches-per-frame 500] [--calib RIG.yaml] "
-    "[--seed 1]\n\n"
+    "                    [--matches-per-frame 500] [--calib RIG.yaml | --rig "
+    "narrow]\n"
+    "                    [--extrinsic-drift 0.5,0,0] [--board chessboard "
+    "--cols 9 --rows 6\n"
+    "                    --square 0.03 [--board-distance 0.6,2]] [--seed "
+    "1]\n\n"
     "A robot moves through a textured pool with the stereo rig looking 16\n"
     "degrees down; each camera sees through an exact flat port (air gap,\n"
     "glass, optional tilt; vector Snell's law), not through the model that\n"
     "rcm estimates, so the data can test that model. Writes into DIR:\n"
     "  left/000000.png ...   8-bit mono images of cam0\n"
     "  right/000000.png ...  8-bit mono images of cam1\n"
-    "  camchain.yaml         the in-air calibration (Kalibr)\n"
+    "  camchain.yaml         the in-air calibration (Kalibr), without the\n"
+    "                        --extrinsic-drift\n"
+    "  board.csv             with --board: frame,t,tx,ty,tz,qx,qy,qz,qw,\n"
+    "                        visible_left,visible_right (cam0_from_target\n"
+    "                        in rcm calibrate's target frame; 1 when the\n"
+    "                        camera sees every inner corner)\n"
     "  truth.csv             frame,t,n,tx,ty,tz,qx,qy,qz,qw (world_from_cam0)\n"
     "  matches.csv           with --matches-per-frame: frame,xl,yl,xr,yr,t\n"
     "                        (points of the tank's surfaces, or with\n"
     "                        --depth-range points at sampled depths)\n"
     "  simulation.json       the settings, to reproduce the run\n"
+    "With --board a diver holds a printed chessboard (the flags of rcm\n"
+    "calibrate; chessboards only) in front of the rig, moving it slowly and\n"
+    "keeping it in view of both cameras when possible.\n"
     "truth.csv is written last; the same flags give the same bytes.";
 
 int RunSimulate();
@@ -70,10 +94,103 @@ extern const Subcommand kSimulateCommand = {
     "simulate",
     "synthetic stereo sequence through exact flat ports, with ground truth",
     kUsage,
-    {__FILE__, kSimulationFlagsSource, kIndexFlagSource, kRigFlagsSource},
+    {__FILE__, kSimulationFlagsSource, kIndexFlagSource, kRigFlagsSource,
+     kTargetFlagsSource},
     RunSimulate};
 
 namespace {
+
+constexpr double kDegree = M_PI / 180.0;
+
+// "--flag VALUE", the context of an error line.
+std::string FlagContext(const char* flag, const std::string& value) {
+  return std::string("--") + flag + " " + value;
+}
+
+// True when the flag `name` (gflags' spelling) was set on the command line.
+bool FlagGiven(const char* name) {
+  gflags::CommandLineFlagInfo info;
+  return gflags::GetCommandLineFlagInfo(name, &info) && !info.is_default;
+}
+
+// --extrinsic-drift into options->cam1_drift.
+Status DriftFromFlag(SequenceOptions* options) {
+  if (FLAGS_extrinsic_drift.empty()) return Status::Ok();
+  const std::string context =
+      FlagContext("extrinsic-drift", FLAGS_extrinsic_drift);
+  const StatusOr<std::vector<double>> values =
+      ParseNumberList(FLAGS_extrinsic_drift);
+  if (!values.ok() || (values->size() != 3 && values->size() != 6)) {
+    return Status::Error(context +
+                         ": expected RX,RY,RZ[,TX,TY,TZ] (degrees, "
+                         "millimetres), e.g. 0.5,0,0");
+  }
+  const std::vector<double>& v = values.value();
+  options->cam1_drift.rotation = Eigen::Vector3d(v[0], v[1], v[2]) * kDegree;
+  if (v.size() == 6) {
+    options->cam1_drift.translation = Eigen::Vector3d(v[3], v[4], v[5]) * 1e-3;
+  }
+  return options->cam1_drift.Check().WithContext(context);
+}
+
+// --board and --board-distance into options->board, board_motion.
+Status BoardFromFlags(SequenceOptions* options) {
+  if (!TargetGiven()) {
+    if (FlagGiven("board_distance")) {
+      return Status::Error("--board-distance needs --board chessboard");
+    }
+    return Status::Ok();
+  }
+  if (!FLAGS_target.empty()) {
+    return Status::Error(
+        "--target: rcm simulate renders chessboards only; give --board "
+        "chessboard --cols N --rows M --square S");
+  }
+  if (!BoardIsChessboard()) {
+    return Status::Error(FlagContext("board", FLAGS_board) +
+                         ": rcm simulate renders chessboards only (--board "
+                         "chessboard --cols N --rows M --square S)");
+  }
+  const StatusOr<calib::CalibrationTarget> target = TargetFromFlags();
+  if (!target.ok()) return target.status();
+  SceneBoard board;
+  board.cols = target->cols;
+  board.rows = target->rows;
+  board.square = target->col_spacing;
+  RCM_RETURN_IF_ERROR(
+      board.Check().WithContext(FlagContext("board", FLAGS_board)));
+  options->board = board;
+  const std::string context =
+      FlagContext("board-distance", FLAGS_board_distance);
+  const StatusOr<std::vector<double>> range =
+      ParseNumberList(FLAGS_board_distance);
+  if (!range.ok() || range->size() != 2) {
+    return Status::Error(context + ": expected MIN,MAX in meters, e.g. 0.6,2");
+  }
+  options->board_motion.min_distance = (*range)[0];
+  options->board_motion.max_distance = (*range)[1];
+  return options->board_motion.Check().WithContext(context);
+}
+
+// Rows of a 4x4 matrix, for JSON.
+nlohmann::json MatrixRows(const Eigen::Matrix4d& matrix) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (int r = 0; r < 4; ++r) {
+    rows.push_back({matrix(r, 0), matrix(r, 1), matrix(r, 2), matrix(r, 3)});
+  }
+  return rows;
+}
+
+// Frames in which the board is fully visible: left, right, both.
+std::array<int, 3> CountVisibleBoardFrames(const SequenceSimulator& sim) {
+  std::array<int, 3> counts = {0, 0, 0};
+  for (const BoardFrame& frame : sim.board_frames()) {
+    counts[0] += frame.fully_visible[0] ? 1 : 0;
+    counts[1] += frame.fully_visible[1] ? 1 : 0;
+    counts[2] += frame.fully_visible[0] && frame.fully_visible[1] ? 1 : 0;
+  }
+  return counts;
+}
 
 int RunSimulate() {
   const Subcommand& command = kSimulateCommand;
@@ -93,26 +210,28 @@ int RunSimulate() {
   options.match_noise_px = FLAGS_match_noise;
   options.outlier_fraction = FLAGS_outliers;
   if (!FLAGS_depth_range.empty()) {
-    const size_t comma = FLAGS_depth_range.find(',');
-    char* end = nullptr;
-    const std::string min_text = FLAGS_depth_range.substr(0, comma);
-    options.match_min_depth = std::strtod(min_text.c_str(), &end);
-    bool ok = comma != std::string::npos && !min_text.empty() && *end == '\0';
-    if (ok) {
-      const std::string max_text = FLAGS_depth_range.substr(comma + 1);
-      options.match_max_depth = std::strtod(max_text.c_str(), &end);
-      ok = !max_text.empty() && *end == '\0';
-    }
-    if (!ok) {
+    const StatusOr<std::vector<double>> range =
+        ParseNumberList(FLAGS_depth_range);
+    if (!range.ok() || range->size() != 2) {
       PrintError(command, "--depth-range " + FLAGS_depth_range +
                               ": expected MIN,MAX in meters, e.g. 0.6,6");
       return kExitUsage;
     }
+    options.match_min_depth = (*range)[0];
+    options.match_max_depth = (*range)[1];
     const Status valid = options.Check();
     if (!valid.ok()) {
       PrintError(command, "--depth-range: " + valid.message());
       return kExitUsage;
     }
+  }
+  if (const Status drift = DriftFromFlag(&options); !drift.ok()) {
+    PrintError(command, drift.message());
+    return kExitUsage;
+  }
+  if (const Status board = BoardFromFlags(&options); !board.ok()) {
+    PrintError(command, board.message());
+    return kExitUsage;
   }
   if (!options.render_images && options.matches_per_frame == 0) {
     PrintError(command,
@@ -143,6 +262,33 @@ int RunSimulate() {
   settings["outliers"] = FLAGS_outliers;
   settings["images"] = FLAGS_images;
   settings["depth_range"] = FLAGS_depth_range;
+  settings["extrinsic_drift"] = {{"rotation_deg",
+                                  {options.cam1_drift.rotation.x() / kDegree,
+                                   options.cam1_drift.rotation.y() / kDegree,
+                                   options.cam1_drift.rotation.z() / kDegree}},
+                                 {"translation_mm",
+                                  {options.cam1_drift.translation.x() * 1e3,
+                                   options.cam1_drift.translation.y() * 1e3,
+                                   options.cam1_drift.translation.z() * 1e3}}};
+  // The extrinsics that made the data (camchain.yaml has the calibration).
+  settings["true_cam1_from_cam0"] =
+      MatrixRows(simulator.value()->true_rig().right_from_left().ToMatrix());
+  if (options.board) {
+    const std::array<int, 3> visible =
+        CountVisibleBoardFrames(*simulator.value());
+    settings["board"] = {
+        {"type", "chessboard"},
+        {"cols", options.board->cols},
+        {"rows", options.board->rows},
+        {"square", options.board->square},
+        {"distance",
+         {options.board_motion.min_distance,
+          options.board_motion.max_distance}},
+        {"fully_visible_frames",
+         {{"left", visible[0]}, {"right", visible[1]}, {"both", visible[2]}}}};
+  } else {
+    settings["board"] = nullptr;
+  }
   const Status settings_written = WriteFileAtomically(
       FLAGS_out + "/simulation.json", settings.dump(2) + "\n");
   if (!settings_written.ok()) {
@@ -170,12 +316,29 @@ int RunSimulate() {
             << left.width() << "x" << left.height() << ")\n"
             << "  media    " << sim.media().ToString() << "\n"
             << "  port     air gap " << options.left_port.air_gap
-            << " m, glass " << options.left_port.glass_thickness
-            << " m (index " << options.left_port.glass_index << ")\n"
-            << "  files    "
-            << (options.render_images ? "left/ right/ " : "")
+            << " m, glass " << options.left_port.glass_thickness << " m (index "
+            << options.left_port.glass_index << ")\n";
+  if (!options.cam1_drift.IsZero()) {
+    std::cout << "  drift    cam1 turned "
+              << FormatFixed(options.cam1_drift.rotation.norm() / kDegree, 3)
+              << " deg, moved "
+              << FormatFixed(options.cam1_drift.translation.norm() * 1e3, 2)
+              << " mm since the calibration in camchain.yaml\n";
+  }
+  if (options.board) {
+    const std::array<int, 3> visible = CountVisibleBoardFrames(sim);
+    std::cout << "  board    chessboard " << options.board->cols << "x"
+              << options.board->rows << " inner corners, "
+              << FormatFixed(options.board->square * 1e3, 1) << " mm squares, "
+              << options.board_motion.min_distance << "-"
+              << options.board_motion.max_distance
+              << " m away; every corner in both images in " << visible[2]
+              << " of " << sim.num_frames() << " frames\n";
+  }
+  std::cout << "  files    " << (options.render_images ? "left/ right/ " : "")
             << (options.matches_per_frame > 0 ? "matches.csv " : "")
-            << "camchain.yaml truth.csv simulation.json" << std::endl;
+            << "camchain.yaml " << (options.board ? "board.csv " : "")
+            << "truth.csv simulation.json" << std::endl;
   return kExitOk;
 }
 

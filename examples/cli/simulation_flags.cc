@@ -15,8 +15,10 @@ DEFINE_string(media, "",
 DEFINE_int32(frames, 20, "frames to simulate (20 Hz) when --media is not set");
 DEFINE_string(rig, "alphasense",
               "built-in rig when --calib is not given: alphasense (the "
-              "dataset rig of DESIGN.md Sec. 5 on rectified extrinsics) or "
-              "alphasense-unrectified (0.5 deg rotation, baseline off axis)");
+              "dataset rig of DESIGN.md Sec. 5 on rectified extrinsics), "
+              "alphasense-unrectified (0.5 deg rotation, baseline off axis) "
+              "or narrow (a hand-built housing: 640x480 radtan, f 500 px, "
+              "65 mm baseline, 2.5 deg toe-in)");
 DEFINE_double(air_gap, 0.0,
               "port: air between the camera center and the glass, meters "
               "(0 = the paper's thin port)");
@@ -48,9 +50,13 @@ StatusOr<Simulation> SimulationFromFlags(const std::string& calib,
              FLAGS_rig == "alphasense_unrectified") {
     simulation.rig = AlphasenseFrontUnrectifiedRig();
     simulation.rig_name = "alphasense-unrectified";
+  } else if (FLAGS_rig == "narrow") {
+    simulation.rig = NarrowFieldRig();
+    simulation.rig_name = "narrow";
   } else if (FLAGS_rig != "alphasense") {
     return Status::Error("--rig " + FLAGS_rig +
-                         ": expected alphasense or alphasense-unrectified");
+                         ": expected alphasense, alphasense-unrectified or "
+                         "narrow");
   }
 
   StatusOr<double> n = RefractiveIndexFromFlag(/*required=*/false);

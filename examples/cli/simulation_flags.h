@@ -30,7 +30,7 @@ extern const char kSimulationFlagsSource[];
 
 struct Simulation {
   StereoRig rig;
-  std::string rig_name;  // "alphasense", or the --calib path
+  std::string rig_name;  // "alphasense", "narrow", ..., or the --calib path
   SequenceOptions options;
 };
 

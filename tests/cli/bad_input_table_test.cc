@@ -939,6 +939,29 @@ void AddSimulateRows(std::vector<BadInputCase>* rows) {
              : "glass_index = " + value.value + " is outside [1, 2]",
          outputs});
   }
+  rows->push_back(
+      {"SimulateExtrinsicDriftMalformed", Nothing(),
+       SimulateArgs({"--extrinsic-drift", "0.5,x,0", "--out", "$D/out"}),
+       "--extrinsic-drift 0.5,x,0: expected RX,RY,RZ[,TX,TY,TZ]", outputs});
+  rows->push_back(
+      {"SimulateExtrinsicDriftTooLarge", Nothing(),
+       SimulateArgs({"--extrinsic-drift", "0,0,45", "--out", "$D/out"}),
+       "rotation of 45 deg is above 10 deg", outputs});
+  rows->push_back(
+      {"SimulateBoardAprilGrid", Nothing(),
+       SimulateArgs({"--board", "aprilgrid", "--cols", "6", "--rows", "6",
+                     "--tag-size", "0.088", "--out", "$D/out"}),
+       "--board aprilgrid: rcm simulate renders chessboards only",
+       Concat(outputs, {"$D/out/board.csv"})});
+  rows->push_back(
+      {"SimulateBoardTargetFile",
+       File("target.yaml",
+            "target_type: 'checkerboard'\ntargetCols: 6\n"
+            "targetRows: 7\nrowSpacingMeters: 0.06\n"
+            "colSpacingMeters: 0.06\n"),
+       SimulateArgs({"--target", "$D/target.yaml", "--out", "$D/out"}),
+       "--target: rcm simulate renders chessboards only",
+       Concat(outputs, {"$D/out/board.csv"})});
   rows->push_back({"SimulateOutBelowAFile",
                    File("file", "a file\n"),
                    SimulateArgs({"--out", "$D/file/out"}),

@@ -403,5 +403,16 @@ TEST(CalibrateCli, BagGivesTheFoldersResult) {
 }
 #endif
 
+TEST(CalibrateCli, HelpListsTheTargetFlags) {
+  // The target flags live in target_flags.cc, shared with rcm simulate.
+  const RunResult result = Rcm({"calibrate", "--help"});
+  EXPECT_EQ(result.exit_code, 0);
+  for (const char* flag :
+       {"--target=", "--board=", "--cols=", "--rows=", "--square=",
+        "--tag-size=", "--tag-spacing=", "--marker=", "--dictionary="}) {
+    EXPECT_NE(result.out.find(flag), std::string::npos) << flag;
+  }
+}
+
 }  // namespace
 }  // namespace rcm

@@ -5,9 +5,10 @@
 #include <algorithm>
 #include <opencv2/imgproc.hpp>
 
-#include "rcm/estimation/batch_refinement.h"
 #include "rcm/camera/flat_port_camera.h"
+#include "rcm/estimation/batch_refinement.h"
 #include "rcm/sim/reference_rigs.h"
+#include "rcm/sim/scene_intersection.h"
 
 namespace rcm {
 namespace {
@@ -223,6 +224,129 @@ TEST(SequenceSimulator, RejectsInvalidOptions) {
       SequenceSimulator::Create(rig, options);
   ASSERT_FALSE(bad_port.ok());
   EXPECT_NE(bad_port.status().message().find("left port"), std::string::npos);
+}
+
+TEST(SequenceSimulator, DriftMovesTheRigThatMakesTheDataOnly) {
+  // The housing drifted by 0.5 degrees: the data are those of the moved
+  // rig (thin port, exact: it returns n to 1e-9), while rig() stays the
+  // calibration, on which the same matches give a confidently wrong n
+  // (DESIGN.md Sec. 7; 1.77 for the true 1.34).
+  const StereoRig rig = NarrowFieldRig();
+  SequenceOptions options = MatchesOnly({{1.34, 20}});
+  options.cam1_drift.rotation = Eigen::Vector3d(0.0, 0.5, 0.0) * M_PI / 180.0;
+  options.cam1_drift.translation = Eigen::Vector3d(0.5e-3, 0.0, 0.0);
+  std::unique_ptr<SequenceSimulator> simulator =
+      SequenceSimulator::Create(rig, options).value();
+  const StereoRig moved = rig.WithCam1Moved(options.cam1_drift.rotation,
+                                            options.cam1_drift.translation)
+                              .value();
+  EXPECT_EQ(simulator->rig().right_from_left().ToMatrix(),
+            rig.right_from_left().ToMatrix());
+  EXPECT_EQ(simulator->true_rig().right_from_left().ToMatrix(),
+            moved.right_from_left().ToMatrix());
+  std::vector<StereoCorrespondence> matches;
+  for (int i = 0; i < simulator->num_frames(); ++i) {
+    const SequenceFrame frame = simulator->Frame(i).value();
+    matches.insert(matches.end(), frame.matches.begin(), frame.matches.end());
+  }
+  ASSERT_EQ(matches.size(), 6000u);
+  EXPECT_NEAR(
+      RefineRefractiveIndex(moved, matches, RefinementOptions()).value().n,
+      1.34, 1e-9);
+  const RefinementSummary calibrated =
+      RefineRefractiveIndex(rig, matches, RefinementOptions()).value();
+  EXPECT_GT(calibrated.n - 1.34, 0.2);
+  EXPECT_LT(calibrated.sigma_n, 0.05);
+  // No drift: the rig as given, bit for bit.
+  const std::unique_ptr<SequenceSimulator> still =
+      SequenceSimulator::Create(rig, MatchesOnly({{1.34, 1}})).value();
+  EXPECT_EQ(still->true_rig().right_from_left().ToMatrix(),
+            rig.right_from_left().ToMatrix());
+  // Too much drift is refused.
+  options.cam1_drift.rotation = Eigen::Vector3d(0.0, 11.0, 0.0) * M_PI / 180.0;
+  const Status refused = SequenceSimulator::Create(rig, options).status();
+  EXPECT_NE(refused.message().find("above 10 deg"), std::string::npos)
+      << refused.message();
+  options.cam1_drift.rotation = Eigen::Vector3d(0.0, NAN, 0.0);
+  EXPECT_FALSE(SequenceSimulator::Create(rig, options).ok());
+}
+
+TEST(SequenceSimulator, FramesCarryTheBoardsTruth) {
+  SequenceOptions options = MatchesOnly({{1.34, 3}}, 50);
+  options.board = SceneBoard();
+  std::unique_ptr<SequenceSimulator> simulator =
+      SequenceSimulator::Create(NarrowFieldRig(), options).value();
+  ASSERT_EQ(simulator->board_frames().size(), 3u);
+  for (int i = 0; i < 3; ++i) {
+    const SequenceFrame frame = simulator->Frame(i).value();
+    const BoardFrame& board = simulator->board_frames()[i];
+    ASSERT_TRUE(frame.cam0_from_target.has_value());
+    EXPECT_EQ(frame.cam0_from_target->ToMatrix(),
+              board.cam0_from_target.ToMatrix());
+    EXPECT_EQ(frame.board_fully_visible, board.fully_visible);
+    EXPECT_TRUE(frame.board_fully_visible[0] && frame.board_fully_visible[1]);
+  }
+  const std::unique_ptr<SequenceSimulator> without =
+      SequenceSimulator::Create(NarrowFieldRig(), MatchesOnly({{1.34, 1}}, 5))
+          .value();
+  EXPECT_TRUE(without->board_frames().empty());
+  const SequenceFrame frame = without->Frame(0).value();
+  EXPECT_FALSE(frame.cam0_from_target.has_value());
+  EXPECT_FALSE(frame.board_fully_visible[0] || frame.board_fully_visible[1]);
+  options.board->cols = 1;
+  EXPECT_FALSE(SequenceSimulator::Create(NarrowFieldRig(), options).ok());
+}
+
+TEST(SequenceSimulator, MatchesOnTheBoardAreExactToo) {
+  // The board close in front of the rig covers much of both images: many
+  // matches land on it (the ray of the left pixel meets the board first),
+  // and with a thin port all of them still give n to 1e-9.
+  const StereoRig rig = NarrowFieldRig();
+  SequenceOptions options = MatchesOnly({{1.34, 1}}, 400);
+  options.board = SceneBoard();
+  options.board_motion.min_distance = 0.6;
+  options.board_motion.max_distance = 0.7;
+  std::unique_ptr<SequenceSimulator> simulator =
+      SequenceSimulator::Create(rig, options).value();
+  const SequenceFrame frame = simulator->Frame(0).value();
+  ASSERT_EQ(frame.matches.size(), 400u);
+  const PlacedBoard placed(*options.board,
+                           frame.world_from_cam0 * *frame.cam0_from_target);
+  const FlatPortCamera left =
+      FlatPortCamera::Create(rig.left(), FlatPort(), 1.34).value();
+  int on_board = 0;
+  for (const StereoCorrespondence& match : frame.matches) {
+    const RayInMedium ray = left.RayFromImage(match.left_pixel).value();
+    on_board += IntersectScene(simulator->scene(), &placed,
+                               frame.world_from_cam0 * ray.origin,
+                               frame.world_from_cam0.rotation * ray.direction)
+                    ->on_board;
+  }
+  EXPECT_GT(on_board, 40);
+  EXPECT_LT(on_board, 400);
+  EXPECT_NEAR(
+      RefineRefractiveIndex(rig, frame.matches, RefinementOptions()).value().n,
+      1.34, 1e-9);
+}
+
+TEST(SequenceSimulator, SameSeedSameFramesWithABoard) {
+  SequenceOptions options = WithImages(1);
+  options.board = SceneBoard();
+  options.seed = 3;
+  const StereoRig rig = NarrowFieldRig();
+  const SequenceFrame a =
+      SequenceSimulator::Create(rig, options).value()->Frame(0).value();
+  const SequenceFrame b =
+      SequenceSimulator::Create(rig, options).value()->Frame(0).value();
+  EXPECT_EQ(cv::norm(a.left, b.left, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(a.right, b.right, cv::NORM_INF), 0.0);
+  EXPECT_EQ(a.cam0_from_target->ToMatrix(), b.cam0_from_target->ToMatrix());
+  options.seed = 4;
+  const SequenceFrame c =
+      SequenceSimulator::Create(rig, options).value()->Frame(0).value();
+  EXPECT_GT((a.cam0_from_target->translation - c.cam0_from_target->translation)
+                .norm(),
+            1e-3);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 #include "rcm/io/camchain.h"
@@ -109,6 +110,48 @@ TEST(SequenceWriter, UnwritableFolderIsOneLineError) {
   const Status not_folder = WriteSequence(file, simulator.get(), {});
   ASSERT_FALSE(not_folder.ok());
   EXPECT_NE(not_folder.message().find("not a folder"), std::string::npos);
+}
+
+TEST(SequenceWriter, WritesTheBoardAndTheCalibrationNotTheDrift) {
+  // board.csv has one row per frame, cam0_from_target and the two flags;
+  // camchain.yaml is the nominal rig, whatever the drift.
+  const StereoRig rig = NarrowFieldRig();
+  SequenceOptions options = MatchesOnly({MediaSegment{1.34, 3}}, 20);
+  options.board = SceneBoard();
+  options.cam1_drift.rotation = Eigen::Vector3d(0.0, 0.5, 0.0) * M_PI / 180.0;
+  std::unique_ptr<SequenceSimulator> simulator =
+      SequenceSimulator::Create(rig, options).value();
+  const std::string folder = test::TempFilePath("board_sequence");
+  fs::remove_all(folder);
+  ASSERT_TRUE(WriteSequence(folder, simulator.get(), {}).ok());
+  std::ifstream board(folder + "/board.csv");
+  std::string line;
+  std::getline(board, line);
+  EXPECT_EQ(line, "frame,t,tx,ty,tz,qx,qy,qz,qw,visible_left,visible_right");
+  for (int i = 0; i < 3; ++i) {
+    ASSERT_TRUE(std::getline(board, line));
+    EXPECT_EQ(line.rfind(std::to_string(i) + ",", 0), 0u) << line;
+    EXPECT_EQ(line.substr(line.size() - 4), ",1,1") << line;
+  }
+  EXPECT_FALSE(std::getline(board, line));
+  std::ifstream whole(folder + "/board.csv");
+  std::stringstream text;
+  text << whole.rdbuf();
+  EXPECT_EQ(FormatBoardCsv(*simulator), text.str());
+  const StereoRig written =
+      StereoRigFromCamchain(ReadCamchain(folder + "/camchain.yaml").value(), 0,
+                            1)
+          .value();
+  EXPECT_TRUE(written.right_from_left().rotation.isApprox(
+      rig.right_from_left().rotation, 1e-15));
+  // A sequence without a board replaces the old board.csv (overwrite).
+  std::unique_ptr<SequenceSimulator> plain =
+      SequenceSimulator::Create(rig, MatchesOnly({MediaSegment{1.34, 1}}, 5))
+          .value();
+  SequenceWriterOptions overwrite;
+  overwrite.overwrite = true;
+  ASSERT_TRUE(WriteSequence(folder, plain.get(), overwrite).ok());
+  EXPECT_FALSE(fs::exists(folder + "/board.csv"));
 }
 
 }  // namespace

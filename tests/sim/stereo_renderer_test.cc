@@ -8,7 +8,9 @@
 
 #include "rcm/camera/flat_port_camera.h"
 #include "rcm/sim/reference_rigs.h"
+#include "rcm/sim/scene_board.h"
 #include "rcm/sim/trajectory.h"
+#include "sim/test_pool.h"
 
 namespace rcm {
 namespace {
@@ -17,12 +19,8 @@ namespace {
 // storage of the cached rays (1e-7 relative in distance, 1e-5 DN).
 constexpr double kRoundingTolerance = 0.5 + 1e-3;
 
-// The default textured pool (12 x 8 x 3 m), built once (~0.3 s).
-const TankScene& Pool() {
-  static const TankScene* const scene =
-      new TankScene(TankScene::Create(TankSceneOptions()).value());
-  return *scene;
-}
+using test::Pool;
+using test::RobotPose;
 
 // A pool whose every surface is the same grey.
 const TankScene& FlatPool() {
@@ -42,13 +40,6 @@ Rigid3d LookingDown(const Eigen::Vector3d& position) {
   pose.rotation.col(2) = Eigen::Vector3d(0.0, 0.0, -1.0);
   pose.translation = position;
   return pose;
-}
-
-// The first pose of the default trajectory: 1.2 m up, 16 degrees down.
-Rigid3d RobotPose() {
-  return GenerateTrajectory(Pool(), TrajectoryOptions())
-      .value()[0]
-      .world_from_cam0;
 }
 
 RenderOptions Quick() {
@@ -403,6 +394,50 @@ TEST(StereoRenderer, UntraceablePixelsAreBlack) {
   EXPECT_EQ(images.right.at<uint8_t>(239, 319), 0);
   EXPECT_GT(images.left.at<uint8_t>(120, 160), 0);
   EXPECT_FALSE(wide.NormalizedFromImage(Eigen::Vector2d(0.0, 0.0)));
+}
+
+TEST(StereoRenderer, ABoardOnlyChangesThePixelsThatSeeIt) {
+  // Out of sight (behind the rig) a board changes no byte: the images are
+  // those of the renderer without one. In front, it covers a patch of
+  // both images, and no pixel outside the patch its outline projects to.
+  StereoRenderer renderer = MakeRenderer(Pool(), Quick());
+  const Rigid3d pose = RobotPose();
+  const StereoImages plain = renderer.Render(pose, 1.333, 2).value();
+  const SceneBoard board;
+  Rigid3d behind;
+  behind.translation = Eigen::Vector3d(0.0, 0.0, -1.0);
+  const PlacedBoard hidden(board, pose * behind);
+  const StereoImages with_hidden =
+      renderer.Render(pose, 1.333, 2, &hidden).value();
+  EXPECT_EQ(DifferingPixels(plain.left, with_hidden.left), 0);
+  EXPECT_EQ(DifferingPixels(plain.right, with_hidden.right), 0);
+
+  Rigid3d ahead;
+  ahead.translation = Eigen::Vector3d(0.0, 0.0, 1.0) - board.Center();
+  const PlacedBoard shown(board, pose * ahead);
+  const StereoImages with_board =
+      renderer.Render(pose, 1.333, 2, &shown).value();
+  const FlatPortCamera camera =
+      FlatPortCamera::Create(renderer.rig().left(), FlatPort(), 1.333).value();
+  // The printed area's projection, a convex quadrilateral up to the
+  // lens's and port's slight bending, grown by 2 px.
+  std::vector<cv::Point> outline;
+  for (const Eigen::Vector3d& corner :
+       {Eigen::Vector3d(board.MinX(), board.MinY(), 0.0),
+        Eigen::Vector3d(board.MaxX(), board.MinY(), 0.0),
+        Eigen::Vector3d(board.MaxX(), board.MaxY(), 0.0),
+        Eigen::Vector3d(board.MinX(), board.MaxY(), 0.0)}) {
+    const Eigen::Vector2d pixel = camera.ImageFromPoint(ahead * corner).value();
+    outline.emplace_back(static_cast<int>(std::lround(pixel.x())),
+                         static_cast<int>(std::lround(pixel.y())));
+  }
+  cv::Mat mask(plain.left.size(), CV_8UC1, cv::Scalar(0));
+  cv::fillConvexPoly(mask, outline, cv::Scalar(255));
+  cv::dilate(mask, mask, cv::Mat(), cv::Point(-1, -1), 2);
+  const cv::Mat changed = plain.left != with_board.left;
+  EXPECT_GT(cv::countNonZero(changed & mask), cv::countNonZero(mask) / 2);
+  EXPECT_EQ(cv::countNonZero(changed & ~mask), 0);
+  EXPECT_GT(DifferingPixels(plain.right, with_board.right), 10000);
 }
 
 }  // namespace

@@ -50,4 +50,31 @@ StereoRig AlphasenseFrontUnrectifiedRig() {
       .value();
 }
 
+Camera NarrowFieldCam0() {
+  return Camera::Create(LensModelId::kRadTan, 640, 480,
+                        {502.37, 501.84, 321.62, 238.41},
+                        {-0.1183, 0.0521, 1.2e-4, -8.0e-5})
+      .value();
+}
+
+Camera NarrowFieldCam1() {
+  return Camera::Create(LensModelId::kRadTan, 640, 480,
+                        {498.61, 498.93, 317.35, 242.87},
+                        {-0.1231, 0.0478, -9.0e-5, 1.5e-4})
+      .value();
+}
+
+StereoRig NarrowFieldRig() {
+  Rigid3d right_from_left;
+  right_from_left.rotation =
+      Eigen::AngleAxisd(kNarrowFieldToeIn, Eigen::Vector3d::UnitY())
+          .toRotationMatrix();
+  right_from_left.translation =
+      -(right_from_left.rotation *
+        Eigen::Vector3d(kNarrowFieldBaseline, 0.0, 0.0));
+  return StereoRig::Create(NarrowFieldCam0(), NarrowFieldCam1(),
+                           right_from_left)
+      .value();
+}
+
 }  // namespace rcm

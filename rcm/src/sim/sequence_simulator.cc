@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "rcm/camera/flat_port_camera.h"
+#include "rcm/sim/scene_intersection.h"
 #include "rcm/sim/stereo_sampler.h"
 #include "rcm/util/splitmix64.h"
 
@@ -34,9 +35,26 @@ enum SeedStream : uint64_t {
   kMatchSeed = 4,
   kNoiseSeed = 5,
   kOutlierSeed = 6,
+  kBoardSeed = 7,
 };
 
 }  // namespace
+
+Status ExtrinsicDrift::Check() const {
+  std::ostringstream message;
+  if (!rotation.allFinite() || !translation.allFinite()) {
+    message << "extrinsic drift is not finite";
+  } else if (rotation.norm() > kMaxRotationDeg * M_PI / 180.0) {
+    message << "extrinsic drift rotation of " << rotation.norm() * 180.0 / M_PI
+            << " deg is above " << kMaxRotationDeg << " deg";
+  } else if (translation.norm() > kMaxTranslation) {
+    message << "extrinsic drift translation of " << translation.norm() * 1e3
+            << " mm is above " << kMaxTranslation * 1e3 << " mm";
+  } else {
+    return Status::Ok();
+  }
+  return Status::Error(message.str());
+}
 
 Status SequenceOptions::Check() const {
   RCM_RETURN_IF_ERROR(MediaSchedule::Create(media).status());
@@ -44,6 +62,11 @@ Status SequenceOptions::Check() const {
   RCM_RETURN_IF_ERROR(right_port.Check().WithContext("right port"));
   RCM_RETURN_IF_ERROR(scene.Check());
   RCM_RETURN_IF_ERROR(render.Check());
+  RCM_RETURN_IF_ERROR(cam1_drift.Check());
+  if (board) {
+    RCM_RETURN_IF_ERROR(board->Check());
+    RCM_RETURN_IF_ERROR(board_motion.Check());
+  }
   std::ostringstream message;
   if (matches_per_frame < 0) {
     message << "matches_per_frame = " << matches_per_frame << " must be >= 0";
@@ -69,8 +92,15 @@ Status SequenceOptions::Check() const {
 StatusOr<std::unique_ptr<SequenceSimulator>> SequenceSimulator::Create(
     const StereoRig& rig, const SequenceOptions& options) {
   RCM_RETURN_IF_ERROR(options.Check());
+  StereoRig true_rig = rig;
+  if (!options.cam1_drift.IsZero()) {
+    StatusOr<StereoRig> moved = rig.WithCam1Moved(
+        options.cam1_drift.rotation, options.cam1_drift.translation);
+    if (!moved.ok()) return moved.status().WithContext("extrinsic drift");
+    true_rig = std::move(moved).value();
+  }
   std::unique_ptr<SequenceSimulator> simulator(new SequenceSimulator(
-      rig, options, MediaSchedule::Create(options.media).value()));
+      rig, true_rig, options, MediaSchedule::Create(options.media).value()));
   simulator->n_of_frame_ = simulator->media_.PerFrame();
 
   TankSceneOptions scene_options = options.scene;
@@ -87,11 +117,24 @@ StatusOr<std::unique_ptr<SequenceSimulator>> SequenceSimulator::Create(
   if (!poses.ok()) return poses.status();
   simulator->poses_ = std::move(poses).value();
 
+  if (options.board) {
+    BoardMotionOptions motion_options = options.board_motion;
+    motion_options.seed = DeriveSeed(options.seed, kBoardSeed);
+    StatusOr<BoardMotion> motion = BoardMotion::Create(
+        *options.board, motion_options, true_rig.right_from_left());
+    if (!motion.ok()) return motion.status();
+    StatusOr<std::vector<BoardFrame>> frames = PlanBoardFrames(
+        motion.value(), true_rig, options.left_port, options.right_port,
+        simulator->n_of_frame_, simulator->poses_, *simulator->scene_);
+    if (!frames.ok()) return frames.status();
+    simulator->board_frames_ = std::move(frames).value();
+  }
+
   if (options.render_images) {
     RenderOptions render = options.render;
     render.seed = DeriveSeed(options.seed, kRenderSeed);
     StatusOr<StereoRenderer> renderer =
-        StereoRenderer::Create(rig, options.left_port, options.right_port,
+        StereoRenderer::Create(true_rig, options.left_port, options.right_port,
                                simulator->scene_.get(), render);
     if (!renderer.ok()) return renderer.status();
     simulator->renderer_ =
@@ -100,19 +143,19 @@ StatusOr<std::unique_ptr<SequenceSimulator>> SequenceSimulator::Create(
   return simulator;
 }
 
-std::vector<StereoCorrespondence> SequenceSimulator::SampleMatches(int index,
-                                                                  double n) {
+std::vector<StereoCorrespondence> SequenceSimulator::SampleMatches(
+    int index, double n, const PlacedBoard* board) {
   // Ports and media passed SequenceOptions::Check in Create.
   const FlatPortCamera left =
-      FlatPortCamera::Create(rig_.left(), options_.left_port, n).value();
+      FlatPortCamera::Create(true_rig_.left(), options_.left_port, n).value();
   const FlatPortCamera right =
-      FlatPortCamera::Create(rig_.right(), options_.right_port, n).value();
+      FlatPortCamera::Create(true_rig_.right(), options_.right_port, n).value();
   const Rigid3d& world_from_left = poses_[index].world_from_cam0;
   const Rigid3d world_from_right =
-      world_from_left * rig_.right_from_left().Inverse();
+      world_from_left * true_rig_.right_from_left().Inverse();
   const Rigid3d right_from_world = world_from_right.Inverse();
-  const Camera& left_camera = rig_.left();
-  const Camera& right_camera = rig_.right();
+  const Camera& left_camera = true_rig_.left();
+  const Camera& right_camera = true_rig_.right();
 
   std::mt19937_64 rng(
       DeriveSeed(DeriveSeed(options_.seed, kMatchSeed), index));
@@ -134,21 +177,21 @@ std::vector<StereoCorrespondence> SequenceSimulator::SampleMatches(int index,
     const Eigen::Vector2d left_pixel(u(rng), drawn_v);
     const std::optional<RayInMedium> left_ray = left.RayFromImage(left_pixel);
     if (!left_ray) continue;
-    const std::optional<SurfaceHit> hit =
-        scene_->Intersect(world_from_left * left_ray->origin,
-                          world_from_left.rotation * left_ray->direction);
+    const std::optional<SceneHit> hit =
+        IntersectScene(*scene_, board, world_from_left * left_ray->origin,
+                       world_from_left.rotation * left_ray->direction);
     if (!hit) continue;
     const std::optional<Eigen::Vector2d> right_pixel =
-        right.ImageFromPoint(right_from_world * hit->point);
+        right.ImageFromPoint(right_from_world * hit->point());
     if (!right_pixel || !right_camera.InImage(*right_pixel)) continue;
     const std::optional<RayInMedium> right_ray =
         right.RayFromImage(*right_pixel);
     if (!right_ray) continue;
-    const std::optional<SurfaceHit> right_hit =
-        scene_->Intersect(world_from_right * right_ray->origin,
-                          world_from_right.rotation * right_ray->direction);
+    const std::optional<SceneHit> right_hit =
+        IntersectScene(*scene_, board, world_from_right * right_ray->origin,
+                       world_from_right.rotation * right_ray->direction);
     if (!right_hit ||
-        (right_hit->point - hit->point).norm() > kVisibilityTolerance) {
+        (right_hit->point() - hit->point()).norm() > kVisibilityTolerance) {
       continue;
     }
     StereoCorrespondence match;
@@ -168,9 +211,18 @@ StatusOr<SequenceFrame> SequenceSimulator::Frame(int index) {
   frame.t = poses_[index].t;
   frame.n = n_of_frame_[index];
   frame.world_from_cam0 = poses_[index].world_from_cam0;
+  std::optional<PlacedBoard> board;
+  if (options_.board) {
+    const BoardFrame& board_frame = board_frames_[index];
+    frame.cam0_from_target = board_frame.cam0_from_target;
+    frame.board_fully_visible = board_frame.fully_visible;
+    board.emplace(*options_.board,
+                  frame.world_from_cam0 * board_frame.cam0_from_target);
+  }
+  const PlacedBoard* placed = board ? &*board : nullptr;
   if (renderer_ != nullptr) {
     StatusOr<StereoImages> images =
-        renderer_->Render(frame.world_from_cam0, frame.n, index);
+        renderer_->Render(frame.world_from_cam0, frame.n, index, placed);
     if (!images.ok()) return images.status();
     frame.left = images.value().left;
     frame.right = images.value().right;
@@ -184,7 +236,7 @@ StatusOr<SequenceFrame> SequenceSimulator::Frame(int index) {
       sampler.per_frame = options_.matches_per_frame;
       sampler.seed = DeriveSeed(DeriveSeed(options_.seed, kMatchSeed), index);
       StatusOr<std::vector<StereoCorrespondence>> sampled =
-          SampleFlatPortCorrespondences(rig_, options_.left_port,
+          SampleFlatPortCorrespondences(true_rig_, options_.left_port,
                                         options_.right_port, sampler);
       if (!sampled.ok()) return sampled.status();
       frame.matches = std::move(sampled).value();
@@ -193,7 +245,7 @@ StatusOr<SequenceFrame> SequenceSimulator::Frame(int index) {
         match.timestamp = frame.t;
       }
     } else {
-      frame.matches = SampleMatches(index, frame.n);
+      frame.matches = SampleMatches(index, frame.n, placed);
     }
     if (options_.match_noise_px > 0.0) {
       AddPixelNoise(options_.match_noise_px,
@@ -202,7 +254,7 @@ StatusOr<SequenceFrame> SequenceSimulator::Frame(int index) {
     }
     if (options_.outlier_fraction > 0.0) {
       frame.outlier_indices = AddOutliers(
-          rig_, options_.outlier_fraction,
+          true_rig_, options_.outlier_fraction,
           DeriveSeed(DeriveSeed(options_.seed, kOutlierSeed), index),
           &frame.matches);
     }

@@ -19,7 +19,7 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr const char* kSequenceFiles[] = {"matches.csv", "camchain.yaml",
-                                          "truth.csv"};
+                                          "board.csv", "truth.csv"};
 constexpr const char* kImageFolders[] = {"left", "right"};
 
 // True when `folder` holds a file or image folder of a sequence.
@@ -34,7 +34,7 @@ bool HoldsSequence(const fs::path& folder) {
   return false;
 }
 
-// Removes the files an earlier sequence left: the three files and the
+// Removes the files an earlier sequence left: the four files and the
 // frame images (six digits + .png) in left/ and right/. Other files stay.
 Status RemoveSequence(const fs::path& folder) {
   std::error_code error;
@@ -78,17 +78,44 @@ std::string SequenceImageName(int index) {
   return name;
 }
 
+namespace {
+
+// ",tx,ty,tz,qx,qy,qz,qw" of a pose (Hamilton quaternion).
+void AppendPose(const Rigid3d& pose, std::string* text) {
+  const Eigen::Quaterniond q(pose.rotation);
+  const Eigen::Vector3d& p = pose.translation;
+  for (const double value : {p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w()}) {
+    *text += ',';
+    *text += FormatDouble(value);
+  }
+}
+
+}  // namespace
+
 std::string FormatTruthCsv(const SequenceSimulator& simulator) {
   std::string text = "frame,t,n,tx,ty,tz,qx,qy,qz,qw\n";
   for (int i = 0; i < simulator.num_frames(); ++i) {
     const TimedPose& pose = simulator.poses()[i];
-    const Eigen::Quaterniond q(pose.world_from_cam0.rotation);
-    const Eigen::Vector3d& p = pose.world_from_cam0.translation;
     text += std::to_string(i);
-    for (const double value : {pose.t, simulator.n_of_frame()[i], p.x(), p.y(),
-                               p.z(), q.x(), q.y(), q.z(), q.w()}) {
+    for (const double value : {pose.t, simulator.n_of_frame()[i]}) {
       text += ',';
       text += FormatDouble(value);
+    }
+    AppendPose(pose.world_from_cam0, &text);
+    text += '\n';
+  }
+  return text;
+}
+
+std::string FormatBoardCsv(const SequenceSimulator& simulator) {
+  std::string text =
+      "frame,t,tx,ty,tz,qx,qy,qz,qw,visible_left,visible_right\n";
+  const std::vector<BoardFrame>& frames = simulator.board_frames();
+  for (size_t i = 0; i < frames.size(); ++i) {
+    text += std::to_string(i) + ',' + FormatDouble(simulator.poses()[i].t);
+    AppendPose(frames[i].cam0_from_target, &text);
+    for (const bool visible : frames[i].fully_visible) {
+      text += visible ? ",1" : ",0";
     }
     text += '\n';
   }
@@ -155,6 +182,10 @@ Status WriteSequence(const std::string& folder, SequenceSimulator* simulator,
   }
   RCM_RETURN_IF_ERROR(WriteCamchain((root / "camchain.yaml").string(),
                                     CamchainFromStereoRig(rig)));
+  if (sequence.board) {
+    RCM_RETURN_IF_ERROR(WriteFileAtomically((root / "board.csv").string(),
+                                            FormatBoardCsv(*simulator)));
+  }
   return WriteFileAtomically((root / "truth.csv").string(),
                              FormatTruthCsv(*simulator));
 }

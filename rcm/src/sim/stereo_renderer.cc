@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "rcm/camera/flat_port_camera.h"
+#include "rcm/sim/scene_intersection.h"
 #include "rcm/util/parallel_for.h"
 #include "rcm/util/splitmix64.h"
 
@@ -178,7 +179,8 @@ StatusOr<const StereoRenderer::CacheEntry*> StereoRenderer::Rays(double n) {
 Status StereoRenderer::PrepareRays(double n) { return Rays(n).status(); }
 
 StatusOr<StereoImages> StereoRenderer::Render(const Rigid3d& world_from_cam0,
-                                              double n, int64_t frame_index) {
+                                              double n, int64_t frame_index,
+                                              const PlacedBoard* board) {
   const Rigid3d world_from_cam[2] = {
       world_from_cam0, world_from_cam0 * rig_.right_from_left().Inverse()};
   for (int c = 0; c < 2; ++c) {
@@ -221,33 +223,48 @@ StatusOr<StereoImages> StereoRenderer::Render(const Rigid3d& world_from_cam0,
     for (int k = 0; k < integer_exponent; ++k) power *= cosine;
     return power;
   };
+  // Irradiance of a reflecting surface at `point` of unit normal `normal`
+  // (pointing back to the camera): daylight and the lamp (see the header).
+  const auto irradiance_at = [&](const Eigen::Vector3d& point,
+                                 const Eigen::Vector3d& normal) {
+    double irradiance = o.ambient * (0.7 + 0.3 * normal.z());
+    if (light_on) {
+      const Eigen::Vector3d to_point = point - light_position;
+      const double r2 = to_point.squaredNorm();
+      const double r = std::sqrt(r2);
+      const double cos_beam = light_axis.dot(to_point) / r;
+      const double cos_incidence = -normal.dot(to_point) / r;
+      if (cos_beam > 0.0 && cos_incidence > 0.0) {
+        irradiance += o.light_intensity * beam(cos_beam) * cos_incidence *
+                      std::exp(-attenuation * r) / r2;
+      }
+    }
+    return irradiance;
+  };
+  // Radiance `emitted` at `distance` from the port, seen through the medium.
+  const auto through_medium = [&](double emitted, double distance) {
+    if (attenuation == 0.0) return emitted;
+    const double transmittance = std::exp(-attenuation * distance);
+    return emitted * transmittance + o.water_radiance * (1.0 - transmittance);
+  };
   // Radiance reaching the port along a traced sample (see the header).
-  const auto radiance = [&](const SurfaceHit& hit,
+  const auto radiance = [&](const SceneHit& scene_hit,
                             const Eigen::Vector3d& direction,
                             double angular_footprint) {
+    if (scene_hit.on_board) {
+      const BoardHit& hit = scene_hit.board;
+      const double albedo =
+          board->board().Shade(hit, angular_footprint * hit.distance);
+      return through_medium(albedo * irradiance_at(hit.point, hit.normal),
+                            hit.distance);
+    }
+    const SurfaceHit& hit = scene_hit.tank;
     const double albedo = scene_->ShadeAnisotropic(
         hit, direction, angular_footprint * hit.distance);
-    double emitted;
-    if (TankScene::IsEmissive(hit.surface)) {
-      emitted = o.surface_radiance * albedo;
-    } else {
-      double irradiance = o.ambient * (0.7 + 0.3 * hit.normal.z());
-      if (light_on) {
-        const Eigen::Vector3d to_point = hit.point - light_position;
-        const double r2 = to_point.squaredNorm();
-        const double r = std::sqrt(r2);
-        const double cos_beam = light_axis.dot(to_point) / r;
-        const double cos_incidence = -hit.normal.dot(to_point) / r;
-        if (cos_beam > 0.0 && cos_incidence > 0.0) {
-          irradiance += o.light_intensity * beam(cos_beam) * cos_incidence *
-                        std::exp(-attenuation * r) / r2;
-        }
-      }
-      emitted = albedo * irradiance;
-    }
-    if (attenuation == 0.0) return emitted;
-    const double transmittance = std::exp(-attenuation * hit.distance);
-    return emitted * transmittance + o.water_radiance * (1.0 - transmittance);
+    const double emitted = TankScene::IsEmissive(hit.surface)
+                               ? o.surface_radiance * albedo
+                               : albedo * irradiance_at(hit.point, hit.normal);
+    return through_medium(emitted, hit.distance);
   };
 
   StereoImages images;
@@ -287,8 +304,8 @@ StatusOr<StereoImages> StereoRenderer::Render(const Rigid3d& world_from_cam0,
                     translation;
                 const Eigen::Vector3d direction =
                     rotation * Eigen::Vector3d(sample[3], sample[4], sample[5]);
-                const std::optional<SurfaceHit> hit =
-                    scene_->Intersect(origin, direction);
+                const std::optional<SceneHit> hit =
+                    IntersectScene(*scene_, board, origin, direction);
                 if (!hit) continue;
                 sum += radiance(*hit, direction, sample[6]);
                 ++traced;

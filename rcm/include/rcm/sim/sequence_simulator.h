@@ -4,34 +4,70 @@
 // in the medium the schedule gives (media_schedule.h, e.g. air -> water ->
 // air). Per frame it renders both 8-bit images (stereo_renderer.h) and
 // samples exact correspondences that are consistent with the images: a
-// left pixel's ray is cast into the tank, the surface point it hits is
-// projected exactly into the right camera, and it is kept when the right
-// camera's ray through that pixel hits the same point (visible, in both
-// images). Or, for studies over a controlled depth range, points at
-// sampled depths (no images then). Noise and outliers are then added as
-// configured.
+// left pixel's ray is cast into the scene (scene_intersection.h: the tank
+// and the board), the surface point it hits is projected exactly into the
+// right camera, and it is kept when the right camera's ray through that
+// pixel hits the same point (visible, in both images). Or, for studies
+// over a controlled depth range, points at sampled depths (no images
+// then). Noise and outliers are then added as configured.
+//
+// Two things a real dive has that an in-air calibration does not know:
+// - extrinsic drift: the rig that renders the images and samples the
+//   matches is rig.WithCam1Moved(drift) (stereo_rig.h), while rig() stays
+//   the in-air calibration a user would have (and a writer's camchain);
+// - a calibration board held by a diver (scene_board.h, board_motion.h):
+//   a chessboard in front of the rig, moving smoothly, kept in view of
+//   both cameras whenever possible, rendered into the images through the
+//   exact ports; it occludes the tank, and the matches may land on it.
+//   Each frame records its truth pose cam0_from_target, in rcm::calib's
+//   target frame.
 //
 // Everything depends only on the options and the seed: the same options
 // give the same images and matches, bit for bit, however many threads.
 #ifndef RCM_SIM_SEQUENCE_SIMULATOR_H_
 #define RCM_SIM_SEQUENCE_SIMULATOR_H_
 
+#include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <vector>
 
+#include "rcm/camera/flat_port.h"
 #include "rcm/geometry/rigid3d.h"
 #include "rcm/geometry/stereo_correspondence.h"
 #include "rcm/geometry/stereo_rig.h"
-#include "rcm/camera/flat_port.h"
+#include "rcm/sim/board_motion.h"
 #include "rcm/sim/media_schedule.h"
+#include "rcm/sim/scene_board.h"
 #include "rcm/sim/stereo_renderer.h"
 #include "rcm/sim/tank_scene.h"
 #include "rcm/sim/trajectory.h"
 #include "rcm/util/status.h"
 
 namespace rcm {
+
+// How cam1 has moved relative to cam0 since the in-air calibration (a
+// housing whose cameras shifted), in StereoRig::WithCam1Moved's
+// convention: cam1_from_cam0 = (R, t) becomes (exp([w]x) R,
+// exp([w]x) t + dt).
+struct ExtrinsicDrift {
+  // Largest accepted drift: beyond it the rig is another rig.
+  static constexpr double kMaxRotationDeg = 10.0;
+  static constexpr double kMaxTranslation = 0.05;  // meters
+
+  // w: angle-axis, radians, in cam1's frame; |w| <= kMaxRotationDeg.
+  Eigen::Vector3d rotation = Eigen::Vector3d::Zero();
+  // dt: meters, cam1 frame; |dt| <= kMaxTranslation.
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+
+  Status Check() const;
+  bool IsZero() const {
+    return rotation.isZero(0.0) && translation.isZero(0.0);
+  }
+};
 
 struct SequenceOptions {
   // The medium of each frame; its length is the sequence's. Default: 20
@@ -56,6 +92,12 @@ struct SequenceOptions {
   // false.
   double match_min_depth = 0.0;  // meters
   double match_max_depth = 0.0;  // meters
+  // Default none: the rig is as calibrated.
+  ExtrinsicDrift cam1_drift;
+  // A chessboard held in front of the rig (default none), and how it
+  // moves; the motion's seed is replaced by one derived from `seed`.
+  std::optional<SceneBoard> board;
+  BoardMotionOptions board_motion;
   // Seeds everything (scene, trajectory, sensor noise, matches); the seeds
   // in `scene`, `trajectory` and `render` are replaced by ones derived
   // from it.
@@ -78,17 +120,25 @@ struct SequenceFrame {
   // outliers were asked for; outlier_indices lists the replaced ones.
   std::vector<StereoCorrespondence> matches;
   std::vector<int64_t> outlier_indices;
+  // With a board: its truth pose (rcm::calib's target frame), and per
+  // camera (left, right) whether every inner corner is visible
+  // (BoardFrame::fully_visible).
+  std::optional<Rigid3d> cam0_from_target;
+  std::array<bool, 2> board_fully_visible = {false, false};
 };
 
 class SequenceSimulator {
  public:
-  // Builds the tank textures and the trajectory. Fails on invalid options,
-  // a trajectory that does not fit in the tank, or ports/media the exact
-  // port refuses.
+  // Builds the tank textures, the trajectory and the board's motion. Fails
+  // on invalid options, a trajectory that does not fit in the tank, or
+  // ports/media the exact port refuses.
   static StatusOr<std::unique_ptr<SequenceSimulator>> Create(
       const StereoRig& rig, const SequenceOptions& options);
 
+  // The in-air calibration (what a user has, and what a writer writes).
   const StereoRig& rig() const { return rig_; }
+  // The rig as it is in the water: rig() with options().cam1_drift.
+  const StereoRig& true_rig() const { return true_rig_; }
   const SequenceOptions& options() const { return options_; }
   const MediaSchedule& media() const { return media_; }
   int num_frames() const { return media_.num_frames(); }
@@ -96,6 +146,8 @@ class SequenceSimulator {
   const TankScene& scene() const { return *scene_; }
   // n of every frame.
   const std::vector<double>& n_of_frame() const { return n_of_frame_; }
+  // With a board: its pose and visibility in every frame; empty without.
+  const std::vector<BoardFrame>& board_frames() const { return board_frames_; }
 
   // Renders frame `index` (in [0, num_frames())) and samples up to
   // matches_per_frame matches (fewer only when the two cameras barely
@@ -104,19 +156,26 @@ class SequenceSimulator {
   StatusOr<SequenceFrame> Frame(int index);
 
  private:
-  SequenceSimulator(const StereoRig& rig, const SequenceOptions& options,
-                    MediaSchedule media)
-      : rig_(rig), options_(options), media_(std::move(media)) {}
+  SequenceSimulator(const StereoRig& rig, const StereoRig& true_rig,
+                    const SequenceOptions& options, MediaSchedule media)
+      : rig_(rig),
+        true_rig_(true_rig),
+        options_(options),
+        media_(std::move(media)) {}
 
-  // Matches of frame `index` on the tank's surfaces, in a medium of index n.
-  std::vector<StereoCorrespondence> SampleMatches(int index, double n);
+  // Matches of frame `index` on the scene's surfaces (the tank's, and the
+  // board's when given), in a medium of index n.
+  std::vector<StereoCorrespondence> SampleMatches(int index, double n,
+                                                  const PlacedBoard* board);
 
   StereoRig rig_;
+  StereoRig true_rig_;
   SequenceOptions options_;
   MediaSchedule media_;
   std::vector<double> n_of_frame_;
   std::unique_ptr<TankScene> scene_;
   std::vector<TimedPose> poses_;
+  std::vector<BoardFrame> board_frames_;
   std::unique_ptr<StereoRenderer> renderer_;
 };
 

@@ -6,7 +6,14 @@
 //   matches.csv           exact (or noisy) correspondences of all frames,
 //                         `frame,xl,yl,xr,yr,t` (when matches are sampled)
 //   camchain.yaml         the in-air calibration (Kalibr camchain), with
-//                         port blocks when the ports are thick
+//                         port blocks when the ports are thick: the
+//                         nominal rig, without the extrinsic drift
+//   board.csv             with a board, one row per frame:
+//                         frame,t,tx,ty,tz,qx,qy,qz,qw,visible_left,
+//                         visible_right with (t, q) the pose
+//                         cam0_from_target (rcm::calib's target frame)
+//                         and 1/0 whether each camera sees every inner
+//                         corner
 //   truth.csv             one row per frame: frame,t,n,tx,ty,tz,qx,qy,qz,qw
 //                         with n the medium and (t, q) the pose
 //                         world_from_cam0 (cam0's position in the world
@@ -27,8 +34,8 @@ namespace rcm {
 
 struct SequenceWriterOptions {
   // Replace the files of an earlier sequence in the folder (its frames,
-  // matches, camchain and truth). Without it, a folder that already holds
-  // any of them is refused.
+  // matches, camchain, board and truth). Without it, a folder that already
+  // holds any of them is refused.
   bool overwrite = false;
   // Called after each frame is written with (frames done, total).
   std::function<void(int, int)> progress;
@@ -39,6 +46,8 @@ std::string SequenceImageName(int index);
 
 // The truth.csv text of a simulator's frames.
 std::string FormatTruthCsv(const SequenceSimulator& simulator);
+// The board.csv text (the header alone without a board).
+std::string FormatBoardCsv(const SequenceSimulator& simulator);
 
 // Simulates every frame and writes the folder (created if missing). Fails
 // with one line when the folder cannot be created or written, or already

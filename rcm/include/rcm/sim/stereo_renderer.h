@@ -1,13 +1,15 @@
 // StereoRenderer: 8-bit monochrome stereo images of a TankScene as the
 // dataset cameras would record them, through each camera's lens and exact
-// flat port (rcm/camera/flat_port_camera.h), in air (n = 1, the tank drained) or in
-// water (n > 1).
+// flat port (rcm/camera/flat_port_camera.h), in air (n = 1, the tank drained)
+// or in water (n > 1).
 //
 // Per pixel, s x s samples on a regular grid (pixel centers at integers,
 // sample (i, j) of pixel (x, y) at (x + (i + 0.5) / s - 0.5, y + ...)) are
 // traced: the sample's ray in the medium (FlatPortCamera::RayFromImage,
 // camera frame; cached per camera and n since it does not depend on the
-// pose) is moved to the world and intersected with the tank. A sample
+// pose) is moved to the world and intersected with the scene
+// (scene_intersection.h: the tank, and the calibration board when one is
+// given, which occludes the tank where it is in front of it). A sample
 // whose ray cannot be traced (outside the lens model) contributes 0; a
 // pixel none of whose samples can be traced is black (0, no noise).
 //
@@ -22,10 +24,16 @@
 //     cos_i the cosine of incidence (0 when lit from behind);
 //   surface:       L0 = surface_radiance texture (emitted daylight);
 //   at the camera: L = L0 T + water_radiance (1 - T)
+//   board:         L0 = albedo (ambient (0.7 + 0.3 n_z) + lamp), as a wall,
+//                  with the normal of the side hit (the printed side's
+//                  black 0.05, white 0.85 by default; the back white)
 // (single-scattering veiling light of a homogeneous medium). Each sample's
 // texture lookup is filtered over its footprint: the angle between
 // neighbouring sample rays times d, elongated on oblique surfaces (see
-// TankScene::ShadeAnisotropic); the s x s box then averages the samples.
+// TankScene::ShadeAnisotropic); the board's checker pattern is box-filtered
+// analytically over the same footprint's extent in board coordinates
+// (SceneBoard::Shade), so that its corners are where the geometry puts
+// them. The s x s box then averages the samples.
 //
 // Sensor: DN = 255 exposure mean(L) plus Gaussian noise of variance
 //   read_noise^2 + DN 255 / full_well     (read noise and shot noise)
@@ -43,9 +51,10 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "rcm/camera/flat_port.h"
 #include "rcm/geometry/rigid3d.h"
 #include "rcm/geometry/stereo_rig.h"
-#include "rcm/camera/flat_port.h"
+#include "rcm/sim/scene_board.h"
 #include "rcm/sim/tank_scene.h"
 #include "rcm/util/status.h"
 
@@ -111,10 +120,12 @@ class StereoRenderer {
   int NumCachedIndices() const { return static_cast<int>(cache_.size()); }
 
   // The stereo pair seen with cam0 at `world_from_cam0` in a medium of
-  // index n (1 = air); `frame_index` selects the noise. Fails when n is
-  // not in [1, 2] or a camera is outside the tank.
+  // index n (1 = air); `frame_index` selects the noise. With a `board`
+  // (may be null), the board is in the tank at its pose and occludes it.
+  // Fails when n is not in [1, 2] or a camera is outside the tank.
   StatusOr<StereoImages> Render(const Rigid3d& world_from_cam0, double n,
-                                int64_t frame_index);
+                                int64_t frame_index,
+                                const PlacedBoard* board = nullptr);
 
  private:
   struct RayTable;  // per camera and n, defined in the .cc
