@@ -15,6 +15,10 @@
 #include <string>
 #include <vector>
 
+#include "air_flag.h"
+#include "air_gap_flag.h"
+#include "calibrate_underwater.h"
+#include "calibration_run.h"
 #include "command.h"
 #include "image_input_flags.h"
 #include "lens_model_flag.h"
@@ -54,7 +58,8 @@ using calib::StereoCalibration;
 using calib::StereoView;
 
 constexpr char kUsage[] =
-    "rcm calibrate: calibrate a stereo rig in air from images of a target\n\n"
+    "rcm calibrate: calibrate a stereo rig in air from images of a target,\n"
+    "or refine it under water\n\n"
     "usage:\n"
     "  rcm calibrate --left DIR --right DIR --board chessboard --cols 9 "
     "--rows 6\n"
@@ -68,142 +73,22 @@ constexpr char kUsage[] =
     "report folder: residual and coverage pictures, the projection\n"
     "uncertainty over each image, per-view RMS, calibration.json.\n"
     "--out names the camchain file (.yaml) or a folder that gets\n"
-    "camchain.yaml and report/. Boards: chessboard (OpenCV's "
+    "camchain.yaml and report/; camchain-covariance.yaml beside the camchain\n"
+    "tells rcm estimate how well it is known.\n\n"
+    "Under water, at the start of a dive (about 20 views of the target):\n"
+    "  rcm calibrate --underwater --air AIR.yaml --left DIR --right DIR \\\n"
+    "      --board chessboard --cols 9 --rows 6 --square 0.03 --out water/\n"
+    "keeps the air lenses and estimates n, cam1_from_cam0 as it is in the\n"
+    "water and every target pose through the refractive model (optionally\n"
+    "the ports' air gaps and tilts); --left alone: one camera, n only. It\n"
+    "writes the camchain with the underwater extrinsics, which rcm estimate,\n"
+    "undistort and export take as they are, and a report (underwater.json,\n"
+    "residual and coverage pictures, per-view RMS).\n\n"
+    "Boards: chessboard (OpenCV's "
     "findChessboardCornersSB;\n"
     "--cols/--rows count inner corners), aprilgrid (Kalibr's, AprilTag "
     "36h11),\n"
     "charuco (OpenCV's).";
-
-// Where the outputs go: --out FILE.yaml -> FILE.yaml + FILE-report/;
-// --out DIR -> DIR/camchain.yaml + DIR/report/. --report overrides.
-struct OutputPaths {
-  std::string camchain;
-  std::string report;
-};
-
-OutputPaths OutputPathsFromFlags() {
-  namespace fs = std::filesystem;
-  const fs::path out(FLAGS_out);
-  const std::string extension = out.extension().string();
-  OutputPaths paths;
-  if (extension == ".yaml" || extension == ".yml") {
-    paths.camchain = out.string();
-    paths.report =
-        (out.parent_path() / (out.stem().string() + "-report")).string();
-  } else {
-    paths.camchain = (out / "camchain.yaml").string();
-    paths.report = (out / "report").string();
-  }
-  if (!FLAGS_report.empty()) paths.report = FLAGS_report;
-  return paths;
-}
-
-// "fx 532.69 +- 0.37" with the leave-out sigma when there is one.
-std::string WithSigma(double value, double sigma, int digits,
-                      std::optional<double> jackknife) {
-  std::string text =
-      FormatFixed(value, digits) + " +- " + FormatFixed(sigma, digits);
-  if (jackknife) text += " (" + FormatFixed(*jackknife, digits) + ")";
-  return text;
-}
-
-// Whether `folder` exists as a folder or can be created: its nearest
-// existing ancestor must be a folder we may write in. Creates nothing, so
-// that a run that fails later leaves no empty folders.
-Status CheckFolderCanBeCreated(const std::string& folder) {
-  namespace fs = std::filesystem;
-  fs::path existing = fs::path(folder).lexically_normal();
-  std::error_code error;
-  while (!existing.empty() && !fs::exists(existing, error)) {
-    existing = existing.parent_path();
-  }
-  if (existing.empty()) existing = ".";
-  if (!fs::is_directory(existing, error)) {
-    return Status::Error("cannot create folder " + folder + ": " +
-                         existing.string() + " is not a folder");
-  }
-  if (access(existing.c_str(), W_OK | X_OK) != 0) {
-    return Status::Error("cannot create folder " + folder + ": " +
-                         existing.string() + ": " + std::strerror(errno));
-  }
-  return Status::Ok();
-}
-
-// The outputs before the detection: a calibration is not wasted on a
-// camchain or report that cannot be written.
-Status CheckOutputPaths(const OutputPaths& paths) {
-  namespace fs = std::filesystem;
-  std::error_code error;
-  if (fs::is_directory(paths.camchain, error)) {
-    return Status::Error(paths.camchain +
-                         ": is a folder, expected the camchain file to write");
-  }
-  const std::string camchain_folder =
-      fs::path(paths.camchain).parent_path().string();
-  if (!camchain_folder.empty()) {
-    RCM_RETURN_IF_ERROR(CheckFolderCanBeCreated(camchain_folder));
-  }
-  return CheckFolderCanBeCreated(paths.report);
-}
-
-// The detection pass over every pair. Its warnings wait until the pass is
-// over, so that a run that fails says one thing, its error.
-struct Detections {
-  std::vector<StereoView> views;
-  std::optional<ImageSize> sizes[2];
-  int unreadable = 0;
-  std::string first_unreadable;  // why the first unreadable pair was skipped
-  std::vector<std::string> warnings;
-};
-
-StatusOr<Detections> DetectAll(StereoImageSource* source,
-                               const CalibrationTarget& target) {
-  Detections detections;
-  const size_t pairs = source->NumPairs();
-  Progress progress("rcm calibrate: detecting, pair", pairs);
-  int found = 0;
-  for (size_t i = 0; i < pairs; ++i) {
-    StatusOr<StereoImagePair> pair = source->ReadPair(i);
-    if (!pair.ok()) {
-      // One unreadable image loses its pair, never the pairing of others.
-      detections.warnings.push_back(pair.status().message() + "; pair skipped");
-      if (detections.unreadable++ == 0) {
-        detections.first_unreadable = pair.status().message();
-      }
-      progress.Update(i + 1);
-      continue;
-    }
-    const cv::Mat* images[2] = {&pair->left, &pair->right};
-    const std::string* names[2] = {&pair->left_name, &pair->right_name};
-    for (int c = 0; c < 2; ++c) {
-      const ImageSize size{images[c]->cols, images[c]->rows};
-      if (!detections.sizes[c]) {
-        detections.sizes[c] = size;
-      } else if (detections.sizes[c]->width != size.width ||
-                 detections.sizes[c]->height != size.height) {
-        return Status::Error(*names[c] + ": " + std::to_string(size.width) +
-                             "x" + std::to_string(size.height) +
-                             ", but the earlier " +
-                             (c == 0 ? "left" : "right") + " images are " +
-                             std::to_string(detections.sizes[c]->width) + "x" +
-                             std::to_string(detections.sizes[c]->height) +
-                             "; one camera's images must all have one size");
-      }
-    }
-    StereoView view = calib::DetectTargetPair(pair->left, pair->right, target);
-    view.left_name = pair->left_name;
-    view.right_name = pair->right_name;
-    view.timestamp = pair->timestamp.value_or(0.0);
-    if (!view.note.empty()) {
-      detections.warnings.push_back(pair->left_name + " and " +
-                                    pair->right_name + ": " + view.note);
-    }
-    found += view.stereo() ? 1 : 0;
-    detections.views.push_back(std::move(view));
-    progress.Update(i + 1, std::to_string(found) + " with the target in both");
-  }
-  return detections;
-}
 
 nlohmann::json CameraJson(const calib::CameraCalibration& calibration) {
   const Camera& camera = calibration.camera;
@@ -227,7 +112,7 @@ extern const Subcommand kCalibrateCommand = {
     "air stereo calibration from target images (folders or a ROS1 bag)",
     kUsage,
     {__FILE__, kImageInputFlagsSource, kTargetFlagsSource,
-     kLensModelFlagSource},
+     kLensModelFlagSource, kUnderwaterFlagsSource, kAirGapFlagSource, kAirFlagSource},
     RunCalibrate};
 
 namespace {
@@ -270,7 +155,29 @@ int RunCalibrate() {
     PrintError(command, target.status().message());
     return kExitUsage;
   }
-  const OutputPaths paths = OutputPathsFromFlags();
+  const CalibrationOutputPaths paths =
+      CalibrationOutputPathsFor(FLAGS_out, FLAGS_report);
+  if (FLAGS_underwater) {
+    if (!gflags::GetCommandLineFlagInfoOrDie("model").is_default) {
+      PrintError(command,
+                 "--model does not go with --underwater: the lenses are the "
+                 "air calibration's (--air)");
+      return kExitUsage;
+    }
+    UnderwaterRunOptions underwater;
+    underwater.huber_px = FLAGS_huber;
+    underwater.outlier_sigmas = FLAGS_outlier_sigmas;
+    underwater.min_corners = FLAGS_min_corners;
+    underwater.folds = FLAGS_folds;
+    return RunCalibrateUnderwater(command, *target, paths, underwater);
+  }
+  if (!FLAGS_air.empty() || FLAGS_estimate_air_gap ||
+      FLAGS_estimate_port_tilt) {
+    PrintError(command,
+               "--air, --estimate-air-gap and --estimate-port-tilt go with "
+               "--underwater");
+    return kExitUsage;
+  }
 
   StatusOr<std::unique_ptr<StereoImageSource>> source =
       OpenImageInputFromFlags();
@@ -282,7 +189,8 @@ int RunCalibrate() {
     PrintError(command, (*source)->Describe() + ": no image pairs");
     return kExitFailure;
   }
-  if (const Status status = CheckOutputPaths(paths); !status.ok()) {
+  if (const Status status = CheckCalibrationOutputPaths(paths);
+      !status.ok()) {
     PrintError(command, status.message());
     return kExitFailure;
   }
@@ -292,37 +200,19 @@ int RunCalibrate() {
     std::cout << "rcm calibrate: " << (*source)->Describe() << "; target "
               << calib::DescribeTarget(*target) << std::endl;
   }
-  StatusOr<Detections> detections = DetectAll(source->get(), *target);
+  StatusOr<Detections> detections = DetectTargets(source->get(), *target);
   if (!detections.ok()) {
     PrintError(command, detections.status().message());
     return kExitFailure;
   }
   const std::vector<StereoView>& views = detections->views;
-  int stereo = 0;
-  int left_only = 0;
-  int right_only = 0;
-  for (const StereoView& view : views) {
-    stereo += view.stereo() ? 1 : 0;
-    left_only += view.left && !view.right ? 1 : 0;
-    right_only += view.right && !view.left ? 1 : 0;
-  }
-  if (!detections->sizes[0] || !detections->sizes[1]) {
-    const int more = detections->unreadable - 1;
-    PrintError(command,
-               "no pair could be read: " + detections->first_unreadable +
-                   (more > 0 ? " (and " + std::to_string(more) + " more " +
-                                   (more == 1 ? "pair)" : "pairs)")
-                             : ""));
+  if (const Status status = CheckDetections(*detections, false); !status.ok()) {
+    PrintError(command, status.message());
     return kExitFailure;
   }
-  if (stereo == 0) {
-    PrintError(command, "the target was found in both images of no pair (" +
-                            std::to_string(left_only) + " left only, " +
-                            std::to_string(right_only) + " right only, of " +
-                            std::to_string(views.size()) +
-                            "); check the target flags and the images");
-    return kExitFailure;
-  }
+  const int stereo = detections->stereo;
+  const int left_only = detections->left_only;
+  const int right_only = detections->right_only;
   const ImageSize sizes[2] = {*detections->sizes[0], *detections->sizes[1]};
   for (const std::string& warning : detections->warnings) {
     PrintWarning(command, warning);
@@ -463,21 +353,10 @@ int RunCalibrate() {
     PrintError(command, status.message());
     return kExitFailure;
   }
-  // The covariance sidecar, which the estimators read with the camchain
-  // (rcm/io/calibration_covariance_file.h), just before it; removed again
-  // if the camchain cannot be written, so that an older camchain never
-  // gets this calibration's sidecar.
-  const std::string covariance_path = CovarianceSidecarPath(paths.camchain);
-  if (Status status = WriteCalibrationCovariance(
-          covariance_path,
+  if (Status status = WriteCamchainWithCovariance(
+          paths.camchain, camchain,
           calib::AirCalibrationCovariance(*calibration, cross_validation));
       !status.ok()) {
-    PrintError(command, status.message());
-    return kExitFailure;
-  }
-  if (Status status = WriteCamchain(paths.camchain, camchain); !status.ok()) {
-    std::error_code ignored;
-    std::filesystem::remove(covariance_path, ignored);
     PrintError(command, status.message());
     return kExitFailure;
   }

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <string>
 
+#include "air_flag.h"
 #include "command.h"
 #include "rcm/estimation/calibration_comparison.h"
 #include "rcm/io/atomic_file.h"
@@ -18,8 +19,6 @@
 #include "rcm/io/number_format.h"
 #include "rcm/viz/image_error_map.h"
 
-DEFINE_string(air, "",
-              "the in-air calibration: a Kalibr camchain or a ROS camera_info");
 DEFINE_string(water, "",
               "the underwater calibration of the same camera: a Kalibr "
               "camchain or a ROS camera_info");
@@ -91,7 +90,7 @@ extern const Subcommand kCompareCommand = {
     "compare",
     "n implied by an air and an underwater calibration of one camera",
     kUsage,
-    {__FILE__},
+    {__FILE__, kAirFlagSource},
     RunCompare};
 
 namespace {

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "air_gap_flag.h"
 #include "command.h"
 #include "image_input_flags.h"
 #include "progress.h"
@@ -91,10 +92,6 @@ DEFINE_double(inlier_threshold, 2.0,
 DEFINE_bool(refine_rotation, false,
             "refine: also estimate a small rotation correction of cam1 "
             "(reported with its correlation with n)");
-DEFINE_bool(estimate_air_gap, false,
-            "refine: also estimate the ports' air gap (one offset for both "
-            "cameras, from the camchain's port blocks or 0), reported with "
-            "its sigma and its correlation with n");
 DEFINE_string(drift_prior, "",
               "DEG[,MM]: how far the rig may have drifted since its "
               "calibration, per axis (cam1's rotation in degrees, its "
@@ -885,7 +882,7 @@ extern const Subcommand kEstimateCommand = {
     "estimate",
     "refractive index n from stereo images or correspondences",
     kUsage,
-    {__FILE__, kRigFlagsSource, kImageInputFlagsSource},
+    {__FILE__, kRigFlagsSource, kImageInputFlagsSource, kAirGapFlagSource},
     RunEstimate};
 
 namespace {

@@ -49,7 +49,8 @@ bool ImageInputGiven() {
          !FLAGS_pairs.empty() || !FLAGS_bag.empty();
 }
 
-StatusOr<std::unique_ptr<StereoImageSource>> OpenImageInputFromFlags() {
+StatusOr<std::unique_ptr<StereoImageSource>> OpenImageInputFromFlags(
+    bool allow_left_only) {
   const FrameSelection selection = SelectionFromFlags();
   RCM_RETURN_IF_ERROR(selection.Check().WithContext("--from/--to/--stride"));
   const bool folders =
@@ -83,10 +84,13 @@ StatusOr<std::unique_ptr<StereoImageSource>> OpenImageInputFromFlags() {
   if (!FLAGS_pairs.empty() && (!FLAGS_left.empty() || !FLAGS_right.empty())) {
     return Status::Error("give either --pairs or --left/--right, not both");
   }
-  if (FLAGS_pairs.empty() && (FLAGS_left.empty() || FLAGS_right.empty())) {
+  StereoFolderOptions options;
+  options.left_only = allow_left_only && FLAGS_pairs.empty() &&
+                      !FLAGS_left.empty() && FLAGS_right.empty();
+  if (!options.left_only && FLAGS_pairs.empty() &&
+      (FLAGS_left.empty() || FLAGS_right.empty())) {
     return Status::Error("--left and --right go together: give both folders");
   }
-  StereoFolderOptions options;
   options.left_dir = FLAGS_left;
   options.right_dir = FLAGS_right;
   options.pair_list = FLAGS_pairs;

@@ -35,7 +35,10 @@ bool ImageInputGiven();
 // input, a missing topic flag, a bag given to a build without bag
 // support, and the sources' own errors (stereo_image_folders.h,
 // bag_stereo_source.h).
-StatusOr<std::unique_ptr<StereoImageSource>> OpenImageInputFromFlags();
+// With `allow_left_only`, --left alone opens one camera's images
+// (StereoFolderOptions::left_only: empty right images).
+StatusOr<std::unique_ptr<StereoImageSource>> OpenImageInputFromFlags(
+    bool allow_left_only = false);
 
 }  // namespace rcm::cli
 

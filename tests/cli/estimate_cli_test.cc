@@ -71,7 +71,16 @@ TEST(EstimateCli, ExactDataGiveTrueIndexAsJson) {
   const nlohmann::json json = nlohmann::json::parse(result.out);
   EXPECT_EQ(json["estimator"], "refine");
   EXPECT_NEAR(json["n"].get<double>(), 1.333, 1e-9);
-  EXPECT_LT(json["sigma_n"].get<double>(), 1e-9);
+  // No pixel noise: the pixel-noise share vanishes, and what remains of
+  // sigma_n is the calibration's (a camchain without a covariance sidecar
+  // gets the default drift prior): it does not shrink with exact data.
+  EXPECT_LT(json["sigma_n_noise"].get<double>(), 1e-9);
+  EXPECT_NEAR(json["sigma_n"].get<double>(),
+              json["sigma_n_calibration"].get<double>(), 1e-12);
+  EXPECT_GT(json["sigma_n_calibration"].get<double>(), 1e-5);
+  EXPECT_EQ(json["calibration"]["source"],
+            "default drift prior 0.1 deg, 0.1 mm per axis");
+  EXPECT_EQ(json["calibration"]["rotation"], "self-calibrated");
   EXPECT_LT(json["crlb"].get<double>(), 1e-9);
   EXPECT_NEAR(json["n_closed_form"].get<double>(), 1.333, 1e-9);
   EXPECT_EQ(json["inliers"].get<int>(), 1000);
@@ -110,20 +119,31 @@ TEST(EstimateCli, RefineRotationIsReported) {
 }
 
 TEST(EstimateCli, OnlineAgreesWithRefine) {
-  // The online estimator equals the batch to 1e-6 (online_estimator_test).
-  const RunResult refine =
-      Rcm({"estimate", "--calib", kRig, "--matches", kDemoMatches, "--json"});
-  const RunResult online =
-      Rcm({"estimate", "--calib", kRig, "--matches", kDemoMatches,
-           "--estimator", "online", "--json"});
-  ASSERT_EQ(refine.exit_code, 0) << refine.err;
-  ASSERT_EQ(online.exit_code, 0) << online.err;
-  const nlohmann::json a = nlohmann::json::parse(refine.out);
-  const nlohmann::json b = nlohmann::json::parse(online.out);
-  EXPECT_EQ(b["estimator"], "online");
-  EXPECT_NEAR(a["n"].get<double>(), b["n"].get<double>(), 1e-6);
-  EXPECT_NEAR(a["sigma_n"].get<double>(), b["sigma_n"].get<double>(), 1e-6);
-  EXPECT_EQ(a["inliers"], b["inliers"]);
+  // With the calibration exact (--drift-prior 0) the online estimator
+  // equals the batch to 1e-6 (online_estimator_test). With the default
+  // drift prior both self-calibrate cam1's rotation, the batch on the
+  // nonlinear problem and the online estimator on the frames' linearized
+  // models (online_estimator.h): they agree to a small fraction of sigma
+  // (measured 0.1 sigma in n, 0.1 % in sigma on these 10 frames).
+  for (const bool exact : {true, false}) {
+    std::vector<std::string> args = {"estimate", "--calib", kRig,
+                                     "--matches", kDemoMatches, "--json"};
+    if (exact) args.insert(args.end(), {"--drift-prior", "0"});
+    const RunResult refine = Rcm(args);
+    args.insert(args.end(), {"--estimator", "online"});
+    const RunResult online = Rcm(args);
+    ASSERT_EQ(refine.exit_code, 0) << refine.err;
+    ASSERT_EQ(online.exit_code, 0) << online.err;
+    const nlohmann::json a = nlohmann::json::parse(refine.out);
+    const nlohmann::json b = nlohmann::json::parse(online.out);
+    EXPECT_EQ(b["estimator"], "online");
+    const double sigma = a["sigma_n"].get<double>();
+    EXPECT_NEAR(a["n"].get<double>(), b["n"].get<double>(),
+                exact ? 1e-6 : 0.2 * sigma);
+    EXPECT_NEAR(sigma, b["sigma_n"].get<double>(),
+                exact ? 1e-6 : 0.01 * sigma);
+    EXPECT_EQ(a["inliers"], b["inliers"]);
+  }
 }
 
 // Air -> water -> air, 12 frames each of 150 matches with 0.3 px noise, as
@@ -220,7 +240,13 @@ TEST(EstimateCli, RefineDoesNotWarnOnUnrectifiedRig) {
                    "  - [-0.01745240643728351, 0.0, 0.9998476951563913, 0.0]"),
            "--matches", kDemoMatches});
   EXPECT_EQ(result.exit_code, 0) << result.err;
-  EXPECT_TRUE(result.err.empty()) << result.err;
+  EXPECT_EQ(result.err.find("rectified"), std::string::npos) << result.err;
+  // The demo's matches come from the rectified rig, and this rig's cam1 is
+  // turned by 1 degree about y: the self-calibration finds the turn and
+  // says that the calibration is stale.
+  EXPECT_NE(result.err.find("the calibration is stale: cam1 has turned by 0.9"),
+            std::string::npos)
+      << result.err;
 }
 
 TEST(EstimateCli, DemoDataTextReport) {

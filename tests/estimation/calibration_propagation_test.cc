@@ -228,7 +228,9 @@ TEST(CalibrationPropagation, SelfCalibrationRecoversAHalfDegreeDriftInAPool) {
     held.self_calibrate_rotation = false;
     const StatusOr<RefinementSummary> stale =
         RefineRefractiveIndex(nominal, data, held);
-    if (stale.ok()) EXPECT_GT(std::abs(stale->n - kTrueN), 10.0 * bound);
+    if (stale.ok()) {
+      EXPECT_GT(std::abs(stale->n - kTrueN), 10.0 * bound);
+    }
   }
 }
 

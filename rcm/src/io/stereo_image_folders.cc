@@ -535,6 +535,17 @@ class ImageFileSource : public StereoImageSource {
     CHECK_LT(i, selected_.size()) << "pair index out of range";
     const size_t index = selected_[i];
     const PairFiles& files = pairs_[index];
+    if (files.right.empty()) {
+      // One camera only (StereoFolderOptions::left_only).
+      StatusOr<cv::Mat> left = DecodeImage(files.left);
+      if (!left.ok()) return left.status();
+      StereoImagePair pair;
+      pair.frame = static_cast<int64_t>(index);
+      pair.timestamp = files.timestamp;
+      pair.left = std::move(left).value();
+      pair.left_name = files.left;
+      return pair;
+    }
     // Decoding takes most of the time of a pair: the right image on a
     // thread of its own.
     std::future<StatusOr<cv::Mat>> right_future =
@@ -577,6 +588,13 @@ class ImageFileSource : public StereoImageSource {
 }  // namespace
 
 Status StereoFolderOptions::Check() const {
+  if (left_only) {
+    if (left_dir.empty() || !right_dir.empty() || !pair_list.empty()) {
+      return Status::Error(
+          "one camera's images are read from the left folder alone");
+    }
+    return selection.Check();
+  }
   if (!pair_list.empty()) {
     if (!left_dir.empty() || !right_dir.empty()) {
       return Status::Error(
@@ -612,6 +630,17 @@ StatusOr<std::unique_ptr<StereoImageSource>> OpenStereoImageFolders(
                            ": a time range needs timestamps: give each "
                            "pair's stamp in seconds as a third column");
     }
+  } else if (options.left_only) {
+    StatusOr<Folder> left = ListFolder(options.left_dir);
+    if (!left.ok()) return left.status();
+    for (size_t i = 0; i < left->names.size(); ++i) {
+      PairFiles files;
+      files.left = left->Path(left->names[i]);
+      if (!left->stamps.empty()) files.timestamp = left->stamps[i];
+      pairs.push_back(std::move(files));
+    }
+    how = "left camera only";
+    context = "folder " + options.left_dir;
   } else {
     StatusOr<Folder> left = ListFolder(options.left_dir);
     if (!left.ok()) return left.status();
@@ -639,8 +668,9 @@ StatusOr<std::unique_ptr<StereoImageSource>> OpenStereoImageFolders(
 
   // "folders left/ and right/: 120 pairs (every 2nd of 240), paired by
   // name", "120 pairs from list pairs.txt (every 2nd of 240)".
-  const std::string count = std::to_string(selected->size()) +
-                            (selected->size() == 1 ? " pair" : " pairs");
+  const char* unit = options.left_only ? " image" : " pair";
+  const std::string count = std::to_string(selected->size()) + unit +
+                            (selected->size() == 1 ? "" : "s");
   const std::string selection_text =
       SelectionText(options.selection, pairs.size());
   const std::string description =

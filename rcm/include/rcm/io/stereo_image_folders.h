@@ -62,10 +62,15 @@ struct StereoFolderOptions {
   std::string right_dir;
   // A list file naming the pairs (see above), instead of the folders.
   std::string pair_list;
+  // One camera only (rcm calibrate --underwater --left DIR): left_dir
+  // alone, each "pair" the left image with an empty right image (and an
+  // empty right name), stamps from the left names.
+  bool left_only = false;
   FrameSelection selection;
 
-  // Errors: neither the two folders nor a list, only one folder, a list
-  // together with folders, selection.Check().
+  // Errors: neither the two folders nor a list, only one folder (unless
+  // left_only, which takes exactly the left one), a list together with
+  // folders, selection.Check().
   Status Check() const;
 };
 

@@ -1,0 +1,442 @@
+// rcm calibrate --underwater: n and the rig's extrinsics as they are under
+// water, from images of a target shown to the rig at the start of a dive,
+// with the air calibration's lenses held (rcm::calib CalibrateUnderwater).
+#include "calibrate_underwater.h"
+
+#include <gflags/gflags.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "air_flag.h"
+#include "air_gap_flag.h"
+#include "calibration_run.h"
+#include "image_input_flags.h"
+#include "progress.h"
+#include "rcm/calib/calibration_report.h"
+#include "rcm/calib/underwater_calibration.h"
+#include "rcm/io/atomic_file.h"
+#include "rcm/io/calibration_covariance_file.h"
+#include "rcm/io/camchain.h"
+#include "rcm/io/image_file.h"
+#include "rcm/io/number_format.h"
+#include "rcm/io/stereo_rig_file.h"
+
+DEFINE_bool(underwater, false,
+            "calibrate under water: n and the extrinsics cam1_from_cam0 as "
+            "they are in the water, from views of the target through the "
+            "ports, with the lenses of the air calibration --air held "
+            "(--left alone: one camera, n only)");
+DEFINE_bool(estimate_port_tilt, false,
+            "--underwater: also estimate each port's tilt (two angles per "
+            "port)");
+
+namespace rcm::cli {
+
+extern const char kUnderwaterFlagsSource[] = __FILE__;
+
+namespace {
+
+using calib::ImageSize;
+using calib::StereoView;
+using calib::UnderwaterCalibration;
+
+
+std::string SizeText(int width, int height) {
+  return std::to_string(width) + "x" + std::to_string(height);
+}
+
+// The air camchain's port blocks must describe both housings alike for
+// --estimate-air-gap: a block on one camera only leaves the other's glass
+// unknown (thin, or the block's?), and the gap estimated behind it would
+// mean a different thing for each camera.
+Status CheckPortsForAirGap(const std::string& air) {
+  if (air.find(',') != std::string::npos) return Status::Ok();  // camera_info
+  const StatusOr<Camchain> camchain = ReadCamchain(air);
+  if (!camchain.ok() || camchain->cameras.size() < 2) return Status::Ok();
+  const bool left = camchain->cameras[0].port.has_value();
+  const bool right = camchain->cameras[1].port.has_value();
+  if (left != right) {
+    return Status::Error(
+        air + ": cam" + std::string(left ? "0" : "1") +
+        " has a port block and cam" + std::string(left ? "1" : "0") +
+        " has none, which contradicts --estimate-air-gap: the gap is "
+        "estimated behind each port's glass, so describe both ports (a "
+        "port block with air_gap 0 for an unknown gap) or neither");
+  }
+  return Status::Ok();
+}
+
+// The leave-out spread over the covariance's sigma, at least 1: the
+// factor the extrinsics' covariance is scaled by in the sidecar (as for
+// an air calibration, rcm/calib/calibration_covariance.h).
+double ExtrinsicsLeaveOutScale(const calib::ExtrinsicChange& change) {
+  double scale = 1.0;
+  if (!change.rotation_leave_out_sigma_deg) return scale;
+  for (int k = 0; k < 3; ++k) {
+    if (change.rotation_sigma_deg[k] > 0.0) {
+      scale = std::max(scale, (*change.rotation_leave_out_sigma_deg)[k] /
+                                  change.rotation_sigma_deg[k]);
+    }
+  }
+  return scale;
+}
+
+// The sidecar of an underwater calibration: medium water, no drift prior
+// (the extrinsics were measured in this dive), the extrinsics' covariance
+// of the bundle adjustment (scaled by the leave-out spread), the lenses'
+// from the air calibration's sidecar when it had one. One camera: the air
+// calibration's extrinsics and their uncertainty are kept.
+CalibrationCovarianceFile UnderwaterCovarianceFile(
+    const UnderwaterCalibration& result, const StereoRig& air_rig) {
+  CalibrationCovarianceFile file;
+  file.medium = "water";
+  file.cameras.resize(2);
+  if (const std::optional<CalibrationUncertainty>& air =
+          air_rig.calibration_uncertainty()) {
+    file.cameras[0].intrinsics_covariance = air->left_lens_covariance;
+    file.cameras[1].intrinsics_covariance = air->right_lens_covariance;
+    if (!result.extrinsics_estimated) {
+      file.cameras[1].from_previous_covariance = air->extrinsics_covariance;
+    }
+  }
+  if (result.extrinsics_estimated) {
+    const double scale = ExtrinsicsLeaveOutScale(result.extrinsic_change);
+    file.cameras[1].from_previous_covariance =
+        scale * scale * result.extrinsic_change.covariance;
+  }
+  return file;
+}
+
+std::string Vector3Text(const Eigen::Vector3d& v, int digits) {
+  return "(" + FormatFixed(v.x(), digits) + ", " + FormatFixed(v.y(), digits) +
+         ", " + FormatFixed(v.z(), digits) + ")";
+}
+
+nlohmann::json Vector3Json(const Eigen::Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
+
+// The report's pictures and table: the underwater corners drawn as the
+// air calibration's are (calibration_report.h), through a StereoCalibration
+// that holds the underwater solution's residuals and poses.
+Status WriteUnderwaterReport(const std::string& folder,
+                             const UnderwaterCalibration& result,
+                             const std::vector<StereoView>& views,
+                             const ImageSize sizes[2], bool one_camera,
+                             calib::CalibrationReport* report) {
+  calib::StereoCalibration drawing(result.rig.left(), result.rig.right());
+  drawing.cam1_from_cam0 = result.rig.right_from_left();
+  drawing.cam0_from_target = result.cam0_from_target;
+  drawing.corners = result.corners;
+  drawing.rms_px = result.rms_px;
+  drawing.inlier_rms_px = result.inlier_rms_px;
+  drawing.pixel_sigma = result.pixel_sigma;
+  drawing.num_views_used = result.num_views_used;
+  drawing.num_stereo_views = result.num_stereo_views;
+  drawing.num_inliers = result.num_inliers;
+  drawing.num_outliers = result.num_outliers;
+  *report = calib::SummarizeCalibration(drawing, views, sizes[0], sizes[1]);
+  std::error_code error;
+  std::filesystem::create_directories(folder, error);
+  if (error) {
+    return Status::Error("cannot create folder " + folder + ": " +
+                         error.message());
+  }
+  const std::filesystem::path dir(folder);
+  for (int c = 0; c < (one_camera ? 1 : 2); ++c) {
+    const std::string cam = "cam" + std::to_string(c);
+    RCM_RETURN_IF_ERROR(
+        WritePng(calib::DrawResidualField(drawing, c, sizes[c]),
+                 (dir / ("residuals_" + cam + ".png")).string()));
+    RCM_RETURN_IF_ERROR(
+        WritePng(calib::DrawCoverage(drawing, views, c, sizes[c]),
+                 (dir / ("coverage_" + cam + ".png")).string()));
+  }
+  RCM_RETURN_IF_ERROR(WritePng(calib::DrawPerViewRms(*report),
+                               (dir / "per_view_rms.png").string()));
+  return WriteFileAtomically((dir / "per_view.csv").string(),
+                             calib::FormatPerViewCsv(*report));
+}
+
+}  // namespace
+
+int RunCalibrateUnderwater(const Subcommand& command,
+                           const calib::CalibrationTarget& target,
+                           const CalibrationOutputPaths& paths,
+                           const UnderwaterRunOptions& run) {
+  const auto start = std::chrono::steady_clock::now();
+  if (FLAGS_air.empty()) {
+    PrintError(command,
+               "--underwater needs --air AIR.yaml, the in-air calibration of "
+               "the rig whose lenses it keeps");
+    return kExitUsage;
+  }
+  calib::UnderwaterCalibrationOptions options;
+  options.estimate_air_gap = FLAGS_estimate_air_gap;
+  options.estimate_port_tilt = FLAGS_estimate_port_tilt;
+  options.huber_px = run.huber_px;
+  options.outlier_sigmas = run.outlier_sigmas;
+  options.min_corners_per_view = run.min_corners;
+  options.folds = run.folds;
+  if (const Status status = options.Check(); !status.ok()) {
+    PrintError(command, status.message());
+    return kExitUsage;
+  }
+
+  const StatusOr<StereoRig> air_rig = ReadStereoRig(FLAGS_air);
+  if (!air_rig.ok()) {
+    PrintError(command, air_rig.status().message());
+    return kExitFailure;
+  }
+  if (FLAGS_estimate_air_gap) {
+    if (const Status status = CheckPortsForAirGap(FLAGS_air); !status.ok()) {
+      PrintError(command, status.message());
+      return kExitFailure;
+    }
+  }
+  StatusOr<std::unique_ptr<StereoImageSource>> source =
+      OpenImageInputFromFlags(/*allow_left_only=*/true);
+  if (!source.ok()) {
+    PrintError(command, source.status().message());
+    return kExitFailure;
+  }
+  if ((*source)->NumPairs() == 0) {
+    PrintError(command, (*source)->Describe() + ": no images");
+    return kExitFailure;
+  }
+  if (const Status status = CheckCalibrationOutputPaths(paths); !status.ok()) {
+    PrintError(command, status.message());
+    return kExitFailure;
+  }
+  if (!FLAGS_json) {
+    std::cout << "rcm calibrate --underwater: " << (*source)->Describe()
+              << "; target " << calib::DescribeTarget(target)
+              << "; air calibration " << FLAGS_air << std::endl;
+  }
+  StatusOr<Detections> detections = DetectTargets(source->get(), target);
+  if (!detections.ok()) {
+    PrintError(command, detections.status().message());
+    return kExitFailure;
+  }
+  const bool one_camera = !detections->sizes[1].has_value() &&
+                          detections->right_only == 0 &&
+                          FLAGS_right.empty() && FLAGS_pairs.empty() &&
+                          FLAGS_bag.empty();
+  if (const Status status = CheckDetections(*detections, one_camera);
+      !status.ok()) {
+    PrintError(command, "under water: " + status.message());
+    return kExitFailure;
+  }
+  // The images must be the air cameras'.
+  const Camera* air_cameras[2] = {&air_rig->left(), &air_rig->right()};
+  ImageSize sizes[2];
+  for (int c = 0; c < 2; ++c) {
+    sizes[c] = ImageSize{air_cameras[c]->width(), air_cameras[c]->height()};
+    if (!detections->sizes[c]) continue;
+    if (detections->sizes[c]->width != sizes[c].width ||
+        detections->sizes[c]->height != sizes[c].height) {
+      PrintError(command,
+                 std::string(c == 0 ? "the left" : "the right") +
+                     " images are " +
+                     SizeText(detections->sizes[c]->width,
+                              detections->sizes[c]->height) +
+                     " but cam" + std::to_string(c) + " of " + FLAGS_air +
+                     " is " + SizeText(sizes[c].width, sizes[c].height) +
+                     ": the air calibration must be of these cameras at this "
+                     "resolution");
+      return kExitFailure;
+    }
+  }
+  for (const std::string& warning : detections->warnings) {
+    PrintWarning(command, warning);
+  }
+
+  const std::vector<StereoView>& views = detections->views;
+  Progress solving("rcm calibrate: underwater bundle adjustment",
+                   static_cast<size_t>(1 + std::max(0, run.folds)));
+  const StatusOr<UnderwaterCalibration> result = calib::CalibrateUnderwater(
+      target, views, sizes[0], one_camera ? ImageSize{0, 0} : sizes[1],
+      *air_rig, options,
+      [&solving](int done, int) { solving.Update(static_cast<size_t>(done)); });
+  if (!result.ok()) {
+    PrintError(command, result.status().message());
+    return kExitFailure;
+  }
+
+  // The report first, the camchain last.
+  calib::CalibrationReport report;
+  if (const Status status = WriteUnderwaterReport(
+          paths.report, *result, views, sizes, one_camera, &report);
+      !status.ok()) {
+    PrintError(command, status.message());
+    return kExitFailure;
+  }
+  std::vector<std::string> warnings = result->notes;
+  if (result->conventional.ok &&
+      result->conventional.pixel_sigma < 0.9 * result->pixel_sigma) {
+    warnings.push_back(
+        "a conventional " +
+        std::string(LensModelName(result->conventional.model)) +
+        " model fitted freely to the same corners fits them better (pixel "
+        "noise " +
+        FormatFixed(result->conventional.pixel_sigma, 3) + " px against " +
+        FormatFixed(result->pixel_sigma, 3) +
+        " px): the port model may not describe the housing (an air gap or "
+        "glass: port blocks, --estimate-air-gap; a tilted port: "
+        "--estimate-port-tilt), or the lenses changed since the air "
+        "calibration");
+  }
+  for (const std::string& warning : report.warnings) warnings.push_back(warning);
+
+  const calib::ExtrinsicChange& change = result->extrinsic_change;
+  nlohmann::json json;
+  json["camchain"] = paths.camchain;
+  json["covariance"] = CovarianceSidecarPath(paths.camchain);
+  json["report"] = paths.report;
+  json["air"] = FLAGS_air;
+  json["target"] = calib::DescribeTarget(target);
+  json["source"] = (*source)->Describe();
+  json["cameras"] = one_camera ? 1 : 2;
+  json["n"] = result->n;
+  json["sigma_n"] = result->sigma_n;
+  json["sigma_n_leave_out"] = JsonNumber(result->sigma_n_leave_out);
+  json["rms_px"] = result->rms_px;
+  json["inlier_rms_px"] = result->inlier_rms_px;
+  json["pixel_sigma"] = result->pixel_sigma;
+  json["initial_rms_px"] = result->initial_rms_px;
+  json["views_used"] = result->num_views_used;
+  json["stereo_views"] = result->num_stereo_views;
+  json["corners"] = result->num_inliers + result->num_outliers;
+  json["outliers"] = result->num_outliers;
+  json["extrinsics_estimated"] = result->extrinsics_estimated;
+  json["extrinsic_change_deg"] =
+      result->extrinsics_estimated ? nlohmann::json(change.angle_deg) : nullptr;
+  if (result->extrinsics_estimated) {
+    json["extrinsic_change"] = {
+        {"angle_deg", change.angle_deg},
+        {"angle_sigma_deg", change.angle_sigma_deg},
+        {"angle_leave_out_sigma_deg", JsonNumber(change.angle_leave_out_sigma_deg)},
+        {"rotation_deg", Vector3Json(change.rotation_deg)},
+        {"rotation_sigma_deg", Vector3Json(change.rotation_sigma_deg)},
+        {"translation_mm", Vector3Json(change.translation_mm)},
+        {"translation_sigma_mm", Vector3Json(change.translation_sigma_mm)}};
+  }
+  for (int c = 0; c < 2; ++c) {
+    const calib::PortEstimate& port = result->ports[c];
+    json["ports"]["cam" + std::to_string(c)] = {
+        {"air_gap_m", port.port.air_gap},
+        {"air_gap_sigma_m",
+         port.air_gap_estimated ? nlohmann::json(port.air_gap_sigma) : nullptr},
+        {"glass_thickness_m", port.port.glass_thickness},
+        {"glass_index", port.port.glass_index},
+        {"tilt_deg", port.tilt_deg},
+        {"tilt_estimated", port.tilt_estimated}};
+  }
+  json["conventional"] = {
+      {"model", std::string(LensModelName(result->conventional.model))},
+      {"ok", result->conventional.ok},
+      {"rms_px", result->conventional.ok
+                     ? nlohmann::json(result->conventional.rms_px)
+                     : nullptr},
+      {"pixel_sigma", result->conventional.ok
+                          ? nlohmann::json(result->conventional.pixel_sigma)
+                          : nullptr},
+      {"error", result->conventional.error}};
+  json["warnings"] = warnings;
+  if (Status status = WriteFileAtomically(
+          (std::filesystem::path(paths.report) / "underwater.json").string(),
+          json.dump(2) + "\n");
+      !status.ok()) {
+    PrintError(command, status.message());
+    return kExitFailure;
+  }
+
+  Camchain camchain = CamchainFromStereoRig(result->rig);
+  if (FLAGS_air.find(',') == std::string::npos) {
+    // The air camchain's IMU calibration and topics carry over.
+    if (const StatusOr<Camchain> air = ReadCamchain(FLAGS_air); air.ok()) {
+      if (const Status status = CopyCamchainImuAndTopics(*air, 0, 1, &camchain);
+          !status.ok()) {
+        PrintError(command, status.message());
+        return kExitFailure;
+      }
+    }
+  }
+  if (Status status = WriteCamchainWithCovariance(
+          paths.camchain, camchain,
+          UnderwaterCovarianceFile(*result, *air_rig));
+      !status.ok()) {
+    PrintError(command, status.message());
+    return kExitFailure;
+  }
+
+  for (const std::string& warning : warnings) PrintWarning(command, warning);
+  if (FLAGS_json) {
+    std::cout << json.dump(2) << std::endl;
+    return kExitOk;
+  }
+  std::printf("%d views used (%d stereo), %d corners, %d outliers\n",
+              result->num_views_used, result->num_stereo_views,
+              result->num_inliers + result->num_outliers, result->num_outliers);
+  std::printf(
+      "refractive model: rms %.4f px (inliers %.4f px), pixel noise %.4f px "
+      "per axis\n",
+      result->rms_px, result->inlier_rms_px, result->pixel_sigma);
+  if (result->conventional.ok) {
+    std::printf(
+        "conventional %s fitted freely to the same corners: rms %.4f px, "
+        "pixel noise %.4f px\n",
+        std::string(LensModelName(result->conventional.model)).c_str(),
+        result->conventional.rms_px, result->conventional.pixel_sigma);
+  } else {
+    std::printf("conventional model: %s\n", result->conventional.error.c_str());
+  }
+  std::printf("+- covariance sigma%s\n",
+              result->sigma_n_leave_out ? " (leave-out sigma)" : "");
+  std::printf("n %s\n", WithSigma(result->n, result->sigma_n, 5,
+                                  result->sigma_n_leave_out)
+                            .c_str());
+  if (result->extrinsics_estimated) {
+    std::printf(
+        "cam1 has turned by %s deg since the air calibration: %s +- %s deg "
+        "about x, y, z; translation changed by %s +- %s mm\n",
+        WithSigma(change.angle_deg, change.angle_sigma_deg, 3,
+                  change.angle_leave_out_sigma_deg)
+            .c_str(),
+        Vector3Text(change.rotation_deg, 3).c_str(),
+        Vector3Text(change.rotation_sigma_deg, 3).c_str(),
+        Vector3Text(change.translation_mm, 2).c_str(),
+        Vector3Text(change.translation_sigma_mm, 2).c_str());
+  } else {
+    std::printf("extrinsics: the air calibration's (one camera)\n");
+  }
+  for (int c = 0; c < (one_camera ? 1 : 2); ++c) {
+    const calib::PortEstimate& port = result->ports[c];
+    if (!port.air_gap_estimated && !port.tilt_estimated) continue;
+    std::printf("cam%d port:", c);
+    if (port.air_gap_estimated) {
+      std::printf(" air gap %s mm",
+                  WithSigma(1e3 * port.port.air_gap, 1e3 * port.air_gap_sigma,
+                            2, std::nullopt)
+                      .c_str());
+    }
+    if (port.tilt_estimated) std::printf(" tilt %.3f deg", port.tilt_deg);
+    std::printf("\n");
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count();
+  std::printf("wrote %s (with %s) and %s/ in %.1f s\n", paths.camchain.c_str(),
+              CovarianceSidecarPath(paths.camchain).c_str(),
+              paths.report.c_str(), seconds);
+  return kExitOk;
+}
+
+}  // namespace rcm::cli

@@ -1,0 +1,38 @@
+// rcm calibrate --underwater (calibrate_underwater.cc): the part of
+// rcm calibrate that refines an air calibration on views of a target in
+// the water.
+#ifndef RCM_EXAMPLES_CLI_CALIBRATE_UNDERWATER_H_
+#define RCM_EXAMPLES_CLI_CALIBRATE_UNDERWATER_H_
+
+#include <gflags/gflags.h>
+
+#include "calibration_run.h"
+#include "command.h"
+#include "rcm/calib/calibration_target.h"
+
+DECLARE_bool(underwater);
+DECLARE_bool(estimate_port_tilt);
+
+namespace rcm::cli {
+
+// __FILE__ of calibrate_underwater.cc, for Subcommand::flag_sources.
+extern const char kUnderwaterFlagsSource[];
+
+// The flags rcm calibrate shares between air and water.
+struct UnderwaterRunOptions {
+  double huber_px = 1.0;
+  double outlier_sigmas = 5.0;
+  int min_corners = 6;
+  int folds = 10;
+};
+
+// Runs rcm calibrate --underwater once the common flags are checked
+// (--out, the images given, the target); returns the exit code.
+int RunCalibrateUnderwater(const Subcommand& command,
+                           const calib::CalibrationTarget& target,
+                           const CalibrationOutputPaths& paths,
+                           const UnderwaterRunOptions& options);
+
+}  // namespace rcm::cli
+
+#endif  // RCM_EXAMPLES_CLI_CALIBRATE_UNDERWATER_H_

@@ -1,0 +1,183 @@
+#include "calibration_run.h"
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <utility>
+
+#include "progress.h"
+#include "rcm/calib/target_detector.h"
+#include "rcm/io/number_format.h"
+
+namespace rcm::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Whether `folder` exists as a folder or can be created: its nearest
+// existing ancestor must be a folder we may write in. Creates nothing, so
+// that a run that fails later leaves no empty folders.
+Status CheckFolderCanBeCreated(const std::string& folder) {
+  fs::path existing = fs::path(folder).lexically_normal();
+  std::error_code error;
+  while (!existing.empty() && !fs::exists(existing, error)) {
+    existing = existing.parent_path();
+  }
+  if (existing.empty()) existing = ".";
+  if (!fs::is_directory(existing, error)) {
+    return Status::Error("cannot create folder " + folder + ": " +
+                         existing.string() + " is not a folder");
+  }
+  if (access(existing.c_str(), W_OK | X_OK) != 0) {
+    return Status::Error("cannot create folder " + folder + ": " +
+                         existing.string() + ": " + std::strerror(errno));
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+CalibrationOutputPaths CalibrationOutputPathsFor(const std::string& out,
+                                                 const std::string& report) {
+  const fs::path path(out);
+  const std::string extension = path.extension().string();
+  CalibrationOutputPaths paths;
+  if (extension == ".yaml" || extension == ".yml") {
+    paths.camchain = path.string();
+    paths.report =
+        (path.parent_path() / (path.stem().string() + "-report")).string();
+  } else {
+    paths.camchain = (path / "camchain.yaml").string();
+    paths.report = (path / "report").string();
+  }
+  if (!report.empty()) paths.report = report;
+  return paths;
+}
+
+Status CheckCalibrationOutputPaths(const CalibrationOutputPaths& paths) {
+  std::error_code error;
+  if (fs::is_directory(paths.camchain, error)) {
+    return Status::Error(paths.camchain +
+                         ": is a folder, expected the camchain file to write");
+  }
+  const std::string camchain_folder =
+      fs::path(paths.camchain).parent_path().string();
+  if (!camchain_folder.empty()) {
+    RCM_RETURN_IF_ERROR(CheckFolderCanBeCreated(camchain_folder));
+  }
+  return CheckFolderCanBeCreated(paths.report);
+}
+
+std::string WithSigma(double value, double sigma, int digits,
+                      std::optional<double> leave_out) {
+  std::string text =
+      FormatFixed(value, digits) + " +- " + FormatFixed(sigma, digits);
+  if (leave_out) text += " (" + FormatFixed(*leave_out, digits) + ")";
+  return text;
+}
+
+StatusOr<Detections> DetectTargets(StereoImageSource* source,
+                                   const calib::CalibrationTarget& target) {
+  Detections detections;
+  const size_t pairs = source->NumPairs();
+  Progress progress("rcm calibrate: detecting, pair", pairs);
+  for (size_t i = 0; i < pairs; ++i) {
+    StatusOr<StereoImagePair> pair = source->ReadPair(i);
+    if (!pair.ok()) {
+      // One unreadable image loses its pair, never the pairing of others.
+      detections.warnings.push_back(pair.status().message() + "; pair skipped");
+      if (detections.unreadable++ == 0) {
+        detections.first_unreadable = pair.status().message();
+      }
+      progress.Update(i + 1);
+      continue;
+    }
+    const bool one_camera = pair->right.empty();
+    const cv::Mat* images[2] = {&pair->left, &pair->right};
+    const std::string* names[2] = {&pair->left_name, &pair->right_name};
+    for (int c = 0; c < (one_camera ? 1 : 2); ++c) {
+      const calib::ImageSize size{images[c]->cols, images[c]->rows};
+      if (!detections.sizes[c]) {
+        detections.sizes[c] = size;
+      } else if (detections.sizes[c]->width != size.width ||
+                 detections.sizes[c]->height != size.height) {
+        return Status::Error(*names[c] + ": " + std::to_string(size.width) +
+                             "x" + std::to_string(size.height) +
+                             ", but the earlier " +
+                             (c == 0 ? "left" : "right") + " images are " +
+                             std::to_string(detections.sizes[c]->width) + "x" +
+                             std::to_string(detections.sizes[c]->height) +
+                             "; one camera's images must all have one size");
+      }
+    }
+    calib::StereoView view;
+    if (one_camera) {
+      view.left = calib::DetectTarget(pair->left, target);
+      if (!view.left) view.note = "no target found";
+    } else {
+      view = calib::DetectTargetPair(pair->left, pair->right, target);
+    }
+    view.left_name = pair->left_name;
+    view.right_name = pair->right_name;
+    view.timestamp = pair->timestamp.value_or(0.0);
+    if (!view.note.empty() && !one_camera) {
+      detections.warnings.push_back(pair->left_name + " and " +
+                                    pair->right_name + ": " + view.note);
+    }
+    detections.stereo += view.stereo() ? 1 : 0;
+    detections.left_only += view.left && !view.right ? 1 : 0;
+    detections.right_only += view.right && !view.left ? 1 : 0;
+    detections.views.push_back(std::move(view));
+    progress.Update(i + 1, one_camera
+                               ? std::to_string(detections.left_only) +
+                                     " with the target"
+                               : std::to_string(detections.stereo) +
+                                     " with the target in both");
+  }
+  return detections;
+}
+
+Status WriteCamchainWithCovariance(const std::string& camchain_path,
+                                   const Camchain& camchain,
+                                   const CalibrationCovarianceFile& covariance) {
+  const std::string covariance_path = CovarianceSidecarPath(camchain_path);
+  RCM_RETURN_IF_ERROR(WriteCalibrationCovariance(covariance_path, covariance));
+  const Status written = WriteCamchain(camchain_path, camchain);
+  if (!written.ok()) {
+    std::error_code ignored;
+    fs::remove(covariance_path, ignored);
+  }
+  return written;
+}
+
+Status CheckDetections(const Detections& detections, bool one_camera) {
+  if (!detections.sizes[0] && !detections.sizes[1]) {
+    const int more = detections.unreadable - 1;
+    return Status::Error(
+        "no pair could be read: " + detections.first_unreadable +
+        (more > 0 ? " (and " + std::to_string(more) + " more " +
+                        (more == 1 ? "pair)" : "pairs)")
+                  : ""));
+  }
+  if (one_camera) {
+    if (detections.left_only == 0) {
+      return Status::Error("the target was found in none of the " +
+                           std::to_string(detections.views.size()) +
+                           " images; check the target flags and the images");
+    }
+    return Status::Ok();
+  }
+  if (detections.stereo == 0) {
+    return Status::Error(
+        "the target was found in both images of no pair (" +
+        std::to_string(detections.left_only) + " left only, " +
+        std::to_string(detections.right_only) + " right only, of " +
+        std::to_string(detections.views.size()) +
+        "); check the target flags and the images");
+  }
+  return Status::Ok();
+}
+
+}  // namespace rcm::cli

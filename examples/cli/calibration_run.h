@@ -1,0 +1,74 @@
+// What `rcm calibrate` does the same in air and under water: where its
+// outputs go, the check that they can be written, and the detection pass
+// over the images.
+#ifndef RCM_EXAMPLES_CLI_CALIBRATION_RUN_H_
+#define RCM_EXAMPLES_CLI_CALIBRATION_RUN_H_
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rcm/calib/calibration_target.h"
+#include "rcm/calib/stereo_calibration.h"
+#include "rcm/calib/target_observation.h"
+#include "rcm/io/calibration_covariance_file.h"
+#include "rcm/io/camchain.h"
+#include "rcm/io/stereo_image_source.h"
+#include "rcm/util/status.h"
+
+namespace rcm::cli {
+
+// Where the outputs go: `out` FILE.yaml -> FILE.yaml + FILE-report/;
+// `out` DIR -> DIR/camchain.yaml + DIR/report/. A non-empty `report`
+// overrides the report folder.
+struct CalibrationOutputPaths {
+  std::string camchain;
+  std::string report;
+};
+CalibrationOutputPaths CalibrationOutputPathsFor(const std::string& out,
+                                                 const std::string& report);
+
+// The outputs before the detection, so that a calibration is not wasted
+// on a camchain or report that cannot be written: the camchain is not a
+// folder, and both folders exist or can be created (nothing is created).
+Status CheckCalibrationOutputPaths(const CalibrationOutputPaths& paths);
+
+// "fx 532.69 +- 0.37" with the leave-out sigma in parentheses when given.
+std::string WithSigma(double value, double sigma, int digits,
+                      std::optional<double> leave_out);
+
+// The detection pass over every pair (a progress bar on a terminal). Its
+// warnings wait until the pass is over, so that a run that fails says one
+// thing, its error. A source of one camera (empty right images) gives
+// views with the left observation only and no right size.
+struct Detections {
+  std::vector<calib::StereoView> views;
+  std::optional<calib::ImageSize> sizes[2];
+  int unreadable = 0;
+  std::string first_unreadable;  // why the first unreadable pair was skipped
+  std::vector<std::string> warnings;
+  // Views with the target in both images, in the left or the right only.
+  int stereo = 0;
+  int left_only = 0;
+  int right_only = 0;
+};
+// Fails (one line) when one camera's images differ in size.
+StatusOr<Detections> DetectTargets(StereoImageSource* source,
+                                   const calib::CalibrationTarget& target);
+
+// Writes the covariance sidecar (rcm/io/calibration_covariance_file.h)
+// and then the camchain, the product, last; the sidecar is removed again
+// if the camchain cannot be written, so that an older camchain never gets
+// this calibration's sidecar.
+Status WriteCamchainWithCovariance(const std::string& camchain_path,
+                                   const Camchain& camchain,
+                                   const CalibrationCovarianceFile& covariance);
+
+// The error of a run where no pair could be read, or none showed the
+// target (in both images, or with `one_camera` in the left one); Ok when
+// the detections can be calibrated from.
+Status CheckDetections(const Detections& detections, bool one_camera);
+
+}  // namespace rcm::cli
+
+#endif  // RCM_EXAMPLES_CLI_CALIBRATION_RUN_H_
