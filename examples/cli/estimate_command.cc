@@ -136,6 +136,12 @@ constexpr char kUsage[] =
     "Exit status: 0 on success, 1 when the input cannot give an estimate, "
     "2 on\nwrong flags.";
 
+// Matching again with the self-calibrated rotation when it moves pixels at
+// the focal length's distance from the center by more than this (the
+// band's half-width is about a pixel), at most kMaxMatchingPasses passes.
+constexpr double kRematchPx = 0.5;
+constexpr int kMaxMatchingPasses = 3;
+
 // Above this deviation from a rectified pair the closed form is biased.
 constexpr double kRectifiedToleranceDeg = 0.05;
 
@@ -217,6 +223,10 @@ struct ImageRun {
   double guide_ms = 0.0;                      // per-pair estimates, summed
   double seconds = 0.0;                       // wall clock of the pass
   int reacquired = 0;
+  // Passes of matching again with the self-calibrated rotation, and that
+  // rotation (zero when the pairs were matched with the calibration).
+  int rematched = 0;
+  Eigen::Vector3d matching_rotation = Eigen::Vector3d::Zero();
   // The pair drawn in matches_by_n.png.
   cv::Mat picture_left;
   int64_t picture_frame = -1;
@@ -1002,17 +1012,47 @@ int RunEstimate() {
       PrintError(command, source.status().message());
       return kExitFailure;
     }
-    StatusOr<ImageRun> pass =
-        RunFrontEnd(*rig, source->get(), *front_end_options, refinement);
-    if (!pass.ok()) {
-      PrintError(command, pass.status().message());
-      return kExitFailure;
-    }
-    run = std::move(*pass);
-    frames = std::move(run->frames);
-    for (const Frame& frame : frames) {
-      matches.insert(matches.end(), frame.matches.begin(),
-                     frame.matches.end());
+    // Matching searches the refractive epipolar band of the rig, so a rig
+    // that has turned since its calibration loses (and biases) the matches
+    // that the turn moves out of the band. When the self-calibration finds
+    // a turn that moves pixels by more than kRematchPx, the pairs are
+    // matched again with the rig turned by it (the estimate itself keeps
+    // the calibration and its prior), until the turn settles.
+    StereoRig matching_rig = *rig;
+    Eigen::Vector3d applied = Eigen::Vector3d::Zero();
+    const double focal = std::max({rig->left().fx(), rig->left().fy(),
+                                   rig->right().fx(), rig->right().fy()});
+    for (int pass_index = 0;; ++pass_index) {
+      StatusOr<ImageRun> pass = RunFrontEnd(matching_rig, source->get(),
+                                            *front_end_options, refinement);
+      if (!pass.ok()) {
+        PrintError(command, pass.status().message());
+        return kExitFailure;
+      }
+      const int rematched = run ? run->rematched + 1 : 0;
+      run = std::move(*pass);
+      run->rematched = rematched;
+      run->matching_rotation = applied;
+      frames = std::move(run->frames);
+      matches.clear();
+      for (const Frame& frame : frames) {
+        matches.insert(matches.end(), frame.matches.begin(),
+                       frame.matches.end());
+      }
+      if (FLAGS_estimator != "refine" || pass_index + 1 >= kMaxMatchingPasses) {
+        break;
+      }
+      const StatusOr<RefinementSummary> pooled =
+          RefineRefractiveIndex(*rig, matches, refinement);
+      if (!pooled.ok() || !pooled->rotation || !pooled->rotation->with_prior ||
+          (pooled->rotation->angle_axis - applied).norm() * focal <=
+              kRematchPx) {
+        break;
+      }
+      applied = pooled->rotation->angle_axis;
+      StatusOr<StereoRig> turned = rig->WithCam1Moved(applied);
+      if (!turned.ok()) break;
+      matching_rig = std::move(turned).value();
     }
   } else {
     StatusOr<std::vector<StereoCorrespondence>> read =
@@ -1085,6 +1125,11 @@ int RunEstimate() {
         {"clahe", FLAGS_clahe},
         {"matches_per_pair", matches.size() / pairs},
         {"reacquired_pairs", run->reacquired},
+        {"rematched", run->rematched},
+        {"matching_rotation_deg",
+         {run->matching_rotation.x() * 180.0 / M_PI,
+          run->matching_rotation.y() * 180.0 / M_PI,
+          run->matching_rotation.z() * 180.0 / M_PI}},
         {"pairs_per_second", frames.size() / std::max(run->seconds, 1e-9)},
         {"ms_per_pair",
          {{"decode", run->read_ms / pairs},
@@ -1168,6 +1213,14 @@ int RunEstimate() {
          << FormatFixed(run->stage_ms.match_ms / pairs, 1) << ", refine "
          << FormatFixed(run->stage_ms.refine_ms / pairs, 1) << ", estimate "
          << FormatFixed(run->guide_ms / pairs, 1) << ")\n";
+    if (run->rematched > 0) {
+      text << "  re-matched " << run->rematched
+           << (run->rematched == 1 ? " time" : " times")
+           << " with cam1 turned by "
+           << FormatFixed(run->matching_rotation.norm() * 180.0 / M_PI, 3)
+           << " deg (the self-calibrated rotation), so that the matching "
+              "band follows the rig\n";
+    }
     if (run->reacquired > 0) {
       text << "  re-acquired " << run->reacquired
            << " pairs whose matches left the band of the estimate (a change "

@@ -14,6 +14,7 @@
 
 DECLARE_string(media);
 DECLARE_int32(frames);
+DECLARE_double(frame_rate);
 DECLARE_string(rig);
 DECLARE_double(air_gap);
 DECLARE_double(glass_thickness);
