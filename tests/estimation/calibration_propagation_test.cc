@@ -57,8 +57,10 @@ TEST(CalibrationPropagation, RotationColumnsMatchJets) {
   const Eigen::Vector3d rotation(0.002, -0.001, 0.0005);
   std::vector<int64_t> all(prepared.prepared.size());
   for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int64_t>(i);
-  LocusNormalEquations equations(CalibrationParameterLayout::Of(rig).Size());
-  AccumulateLocusNormalEquations(rig, aligned, prepared.prepared, all, 1.3,
+  const CalibrationParameterLayout layout = CalibrationParameterLayout::Of(rig);
+  LocusNormalEquations equations(layout.Size());
+  AccumulateLocusNormalEquations(rig, layout, aligned, prepared.prepared, all,
+                                 1.3,
                                  rotation, &equations);
   ASSERT_EQ(equations.count, static_cast<int64_t>(all.size()));
 

@@ -312,10 +312,12 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
   std::vector<StereoCorrespondence> raw;
   raw.reserve(matches.size());
   for (const int64_t i : prepared.source_index) raw.push_back(correspondences[i]);
-  const CalibrationParameterLayout layout = CalibrationParameterLayout::Of(rig);
+  const CalibrationParameterLayout layout =
+      CalibrationParameterLayout::Of(rig, options.systematic_px);
   LocusNormalEquations equations(layout.Size());
   std::vector<LocusNormalEquations> per_frame;
-  AccumulateLocusNormalEquations(rig, raw, matches, inliers, parameters.n,
+  AccumulateLocusNormalEquations(rig, layout, raw, matches, inliers,
+                                 parameters.n,
                                  rotation, &equations, &per_frame);
   summary.consistency = FrameConsistencyOf(per_frame, summary.sigma_px);
   const double inflation =
@@ -326,6 +328,7 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
   summary.sigma_n = propagation->sigma_n;
   summary.sigma_n_noise = propagation->sigma_n_noise;
   summary.sigma_n_calibration = propagation->sigma_n_calibration;
+  summary.sigma_n_systematic = propagation->sigma_n_systematic;
   summary.crlb =
       summary.sigma_px / std::sqrt(LocusInformation(
                              final_essential, inlier_matches, parameters.n));
@@ -344,7 +347,9 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
     correction.cam1_from_cam0 = final_extrinsics;
     summary.rotation = correction;
   }
-  if (rig.calibration_uncertainty()) summary.calibration = *propagation;
+  if (rig.calibration_uncertainty() || layout.NumSystematic() > 0) {
+    summary.calibration = *propagation;
+  }
 
   // An estimate pinned at the upper bound is a failure, not a number.
   RCM_RETURN_IF_ERROR(CheckNotPinnedAtUpperBound(summary.n));

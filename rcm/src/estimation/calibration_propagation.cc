@@ -71,8 +71,10 @@ std::vector<Difference> LensDifferences(const StereoRig& rig,
 
 }  // namespace
 
-CalibrationParameterLayout CalibrationParameterLayout::Of(const StereoRig& rig) {
+CalibrationParameterLayout CalibrationParameterLayout::Of(
+    const StereoRig& rig, double systematic_px) {
   CalibrationParameterLayout layout;
+  layout.systematic_px = systematic_px;
   if (const std::optional<CalibrationUncertainty>& uncertainty =
           rig.calibration_uncertainty()) {
     if (uncertainty->left_lens_covariance.size() > 0) {
@@ -145,13 +147,16 @@ class LocusResidualModel {
 }  // namespace
 
 void AccumulateLocusNormalEquations(
-    const StereoRig& rig, const std::vector<StereoCorrespondence>& raw,
+    const StereoRig& rig, const CalibrationParameterLayout& layout,
+    const std::vector<StereoCorrespondence>& raw,
     const std::vector<PreparedCorrespondence>& matches,
     const std::vector<int64_t>& indices, double n,
     const Eigen::Vector3d& rotation, LocusNormalEquations* equations,
     std::vector<LocusNormalEquations>* per_frame) {
-  const CalibrationParameterLayout layout = CalibrationParameterLayout::Of(rig);
   const int size = layout.Size();
+  // Pixels to [-1, 1] over the left image, for the systematic field.
+  const double half_width = 0.5 * std::max(1, rig.left().width() - 1);
+  const double half_height = 0.5 * std::max(1, rig.left().height() - 1);
   CHECK_EQ(equations->information.rows(), size);
   // The rig at the solution, and moved both ways along each of w and dt.
   const StatusOr<StereoRig> at = rig.WithCam1Moved(rotation);
@@ -205,6 +210,15 @@ void AccumulateLocusNormalEquations(
       if (defined) {
         row[layout.LeftLens() + static_cast<int>(j)] =
             (values[0] - values[1]) / (2.0 * lens[j].step);
+      }
+    }
+    if (layout.NumSystematic() > 0) {
+      const double x = raw[i].left_pixel.x() / half_width - 1.0;
+      const double y = raw[i].left_pixel.y() / half_height - 1.0;
+      const double phi[CalibrationParameterLayout::kNumSystematic] = {
+          1.0, x, y, x * x, x * y, y * y};
+      for (int k = 0; k < CalibrationParameterLayout::kNumSystematic; ++k) {
+        row[layout.Systematic() + k] = phi[k];
       }
     }
     if (!defined || !row.allFinite()) continue;
@@ -390,6 +404,10 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
                       layout.num_right_lens, layout.num_right_lens) =
         uncertainty.right_lens_covariance;
   }
+  for (int k = 0; k < layout.NumSystematic(); ++k) {
+    calibration(layout.Systematic() + k, layout.Systematic() + k) =
+        layout.systematic_px * layout.systematic_px;
+  }
 
   const double m_nn = m(0, 0);
   if (!(m_nn > 0.0)) {
@@ -464,11 +482,12 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
   // (when held), translation, lenses; cross-covariances between kinds (a
   // measured covariance of rotation with translation) go with the
   // translation.
-  const auto group_of = [](int column) {
-    return column <= 3 ? 0 : column <= 6 ? 1 : 2;
+  const int systematic = layout.Systematic();
+  const auto group_of = [systematic](int column) {
+    return column <= 3 ? 0 : column <= 6 ? 1 : column < systematic ? 2 : 3;
   };
-  double shares[3] = {0.0, 0.0, 0.0};
-  for (int g = 0; g < 3; ++g) {
+  double shares[4] = {0.0, 0.0, 0.0, 0.0};
+  for (int g = 0; g < 4; ++g) {
     Eigen::MatrixXd part = Eigen::MatrixXd::Zero(np, np);
     for (int r = 0; r < np; ++r) {
       for (int c = 0; c < np; ++c) {
@@ -481,16 +500,22 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
   }
   result.variance_rotation = shares[0];
   result.variance_lenses = shares[2];
-  result.variance_translation = from_held(0, 0) - shares[0] - shares[2];
+  result.variance_systematic = shares[3];
+  result.variance_translation =
+      from_held(0, 0) - shares[0] - shares[2] - shares[3];
   result.variance_rotation += from_prior(0, 0);
 
   const double noise_variance =
       noise(0, 0) * noise_inflation * noise_inflation;
-  const double calibration_variance =
-      std::max(0.0, from_prior(0, 0) + from_held(0, 0));
+  const double calibration_variance = std::max(
+      0.0, from_prior(0, 0) + from_held(0, 0) - result.variance_systematic);
   result.sigma_n_noise = std::sqrt(std::max(0.0, noise_variance));
   result.sigma_n_calibration = std::sqrt(calibration_variance);
-  result.sigma_n = std::sqrt(std::max(0.0, noise_variance) + calibration_variance);
+  result.sigma_n_systematic =
+      std::sqrt(std::max(0.0, result.variance_systematic));
+  result.sigma_n =
+      std::sqrt(std::max(0.0, noise_variance) + calibration_variance +
+                std::max(0.0, result.variance_systematic));
 
   if (rotation_estimated) {
     const Eigen::MatrixXd total =

@@ -128,8 +128,9 @@ FrameFit FitFrame(const StereoRig& rig,
 
   // The calibration's share and the self-calibration need the inliers'
   // normal equations, taken at the frame's own estimate.
-  if (rig.calibration_uncertainty()) {
-    const CalibrationParameterLayout layout = CalibrationParameterLayout::Of(rig);
+  if (rig.calibration_uncertainty() || options.systematic_px > 0.0) {
+    const CalibrationParameterLayout layout =
+        CalibrationParameterLayout::Of(rig, options.systematic_px);
     fit.normal_equations = LocusNormalEquations(layout.Size());
     std::vector<StereoCorrespondence> raw;
     raw.reserve(fit.inliers.size());
@@ -137,13 +138,15 @@ FrameFit FitFrame(const StereoRig& rig,
     std::vector<int64_t> all(kept.size());
     for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int64_t>(i);
     AccumulateLocusNormalEquations(
-        rig, raw, kept, all, fit.estimate.ok() ? fit.estimate->n : fit.n_robust,
+        rig, layout, raw, kept, all,
+        fit.estimate.ok() ? fit.estimate->n : fit.n_robust,
         rotation, &fit.normal_equations);
   }
   if (fit.estimate.ok()) {
     FrameFit::Model model;
     const double information = fit.normal_equations.information(0, 0);
-    if (rig.calibration_uncertainty() && information > 0.0) {
+    if ((rig.calibration_uncertainty() || options.systematic_px > 0.0) &&
+        information > 0.0) {
       model.information = information;
       model.rotation_coupling =
           fit.normal_equations.information.block<3, 1>(1, 0);
@@ -172,7 +175,7 @@ StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
   if (!locus.ok()) return locus.status();
   CalibratedLocusEstimate estimate;
   estimate.locus = *locus;
-  if (!rig.calibration_uncertainty()) {
+  if (!rig.calibration_uncertainty() && options.systematic_px == 0.0) {
     estimate.consistency =
         FrameConsistencyOf(frame_estimates, locus->n, locus->sigma_px);
     const double inflation =
@@ -180,8 +183,10 @@ StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
     estimate.sigma_n_noise = estimate.sigma_n = locus->sigma_n * inflation;
     return estimate;
   }
-  const CalibrationUncertainty& uncertainty = *rig.calibration_uncertainty();
-  const CalibrationParameterLayout layout = CalibrationParameterLayout::Of(rig);
+  const CalibrationUncertainty uncertainty =
+      rig.calibration_uncertainty().value_or(CalibrationUncertainty());
+  const CalibrationParameterLayout layout =
+      CalibrationParameterLayout::Of(rig, options.systematic_px);
   LocusNormalEquations at_solution = normal_equations;
   const bool self_calibrate = SelfCalibrates(rig, options);
   Eigen::Vector3d rotation = Eigen::Vector3d::Zero();
@@ -216,8 +221,11 @@ StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
     estimate.sigma_n_noise = estimate.locus.crlb * inflation;
   }
   estimate.sigma_n_calibration = propagation->sigma_n_calibration;
-  estimate.sigma_n =
-      std::hypot(estimate.sigma_n_noise, estimate.sigma_n_calibration);
+  estimate.sigma_n_systematic = propagation->sigma_n_systematic;
+  estimate.sigma_n = std::sqrt(
+      estimate.sigma_n_noise * estimate.sigma_n_noise +
+      estimate.sigma_n_calibration * estimate.sigma_n_calibration +
+      estimate.sigma_n_systematic * estimate.sigma_n_systematic);
   estimate.locus.sigma_n = estimate.sigma_n;
   estimate.calibration = *propagation;
   return estimate;
@@ -227,7 +235,8 @@ OnlineRefractiveIndexEstimator::OnlineRefractiveIndexEstimator(
     const StereoRig& rig, const RefinementOptions& options)
     : rig_(rig),
       options_(options),
-      normal_equations_(CalibrationParameterLayout::Of(rig).Size()) {}
+      normal_equations_(
+          CalibrationParameterLayout::Of(rig, options.systematic_px).Size()) {}
 
 StatusOr<OnlineRefractiveIndexEstimator> OnlineRefractiveIndexEstimator::Create(
     const StereoRig& rig, const RefinementOptions& options) {
@@ -254,7 +263,7 @@ OnlineRefractiveIndexEstimator::AddFrame(
     ++num_skipped_frames_;
   } else {
     cost_.Add(fit.cost);
-    if (rig_.calibration_uncertainty()) {
+    if (rig_.calibration_uncertainty() || options_.systematic_px > 0.0) {
       normal_equations_.Add(fit.normal_equations);
     }
     if (fit.model) {
@@ -279,6 +288,7 @@ OnlineRefractiveIndexEstimator::Current() const {
   estimate.sigma_n = calibrated->sigma_n;
   estimate.sigma_n_noise = calibrated->sigma_n_noise;
   estimate.sigma_n_calibration = calibrated->sigma_n_calibration;
+  estimate.sigma_n_systematic = calibrated->sigma_n_systematic;
   estimate.crlb = locus.crlb;
   estimate.sigma_px = locus.sigma_px;
   estimate.consistency = calibrated->consistency;

@@ -61,6 +61,8 @@ Status RefinementOptions::Check() const {
   } else if (max_num_iterations < 1) {
     error << "max_num_iterations must be at least 1, got "
           << max_num_iterations;
+  } else if (!(systematic_px >= 0.0) || !std::isfinite(systematic_px)) {
+    error << "systematic_px must be >= 0 pixels, got " << systematic_px;
   } else if (num_threads < 1) {
     error << "num_threads must be at least 1, got " << num_threads;
   } else {

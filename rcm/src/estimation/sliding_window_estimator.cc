@@ -44,7 +44,8 @@ SlidingWindowRefractiveIndexEstimator::SlidingWindowRefractiveIndexEstimator(
       options_(options),
       window_options_(window_options),
       window_(window_options.window_frames),
-      window_normal_equations_(CalibrationParameterLayout::Of(rig).Size()) {
+      window_normal_equations_(
+          CalibrationParameterLayout::Of(rig, options.systematic_px).Size()) {
   pending_.reserve(window_options.confirm_frames);
 }
 
@@ -71,7 +72,7 @@ void SlidingWindowRefractiveIndexEstimator::ResumWindow() {
   for (int k = 0; k < window_count_; ++k) {
     const FrameCost& frame = window_[(window_begin_ + k) % window_.size()];
     window_cost_.Add(frame.cost);
-    if (rig_.calibration_uncertainty()) {
+    if (rig_.calibration_uncertainty() || options_.systematic_px > 0.0) {
       window_normal_equations_.Add(frame.normal_equations);
     }
     window_estimates_.Add(frame.model.n, frame.model.information,
@@ -180,6 +181,7 @@ SlidingWindowRefractiveIndexEstimator::Current() const {
   estimate.sigma_n = calibrated->sigma_n;
   estimate.sigma_n_noise = calibrated->sigma_n_noise;
   estimate.sigma_n_calibration = calibrated->sigma_n_calibration;
+  estimate.sigma_n_systematic = calibrated->sigma_n_systematic;
   estimate.crlb = locus.crlb;
   estimate.sigma_px = locus.sigma_px;
   estimate.consistency = calibrated->consistency;

@@ -248,26 +248,32 @@ StatusOr<ThickPortRefinementSummary> RefineRefractiveIndexThickPort(
   std::vector<StereoCorrespondence> raw;
   raw.reserve(matches.size());
   for (const int64_t i : prepared.source_index) raw.push_back(correspondences[i]);
-  const CalibrationParameterLayout layout = CalibrationParameterLayout::Of(*at);
+  const CalibrationParameterLayout layout =
+      CalibrationParameterLayout::Of(*at, options.base.systematic_px);
   LocusNormalEquations equations(layout.Size());
   std::vector<LocusNormalEquations> per_frame;
-  AccumulateLocusNormalEquations(*at, raw, matches, inliers, parameters.n,
+  AccumulateLocusNormalEquations(*at, layout, raw, matches, inliers,
+                                 parameters.n,
                                  Eigen::Vector3d::Zero(), &equations,
                                  &per_frame);
   summary.consistency = FrameConsistencyOf(per_frame, summary.sigma_px);
   if (summary.consistency) {
     summary.sigma_n_noise *= summary.consistency->inflation;
   }
-  if (at->calibration_uncertainty()) {
+  if (at->calibration_uncertainty() || layout.NumSystematic() > 0) {
     StatusOr<CalibrationPropagation> propagation = PropagateCalibration(
-        equations, layout, *at->calibration_uncertainty(), RotationMode::kHeld,
-        summary.sigma_px);
+        equations, layout,
+        at->calibration_uncertainty().value_or(CalibrationUncertainty()),
+        RotationMode::kHeld, summary.sigma_px);
     if (!propagation.ok()) return propagation.status();
     summary.sigma_n_calibration = propagation->sigma_n_calibration;
+    summary.sigma_n_systematic = propagation->sigma_n_systematic;
     summary.calibration = *propagation;
   }
   summary.sigma_n =
-      std::hypot(summary.sigma_n_noise, summary.sigma_n_calibration);
+      std::sqrt(summary.sigma_n_noise * summary.sigma_n_noise +
+                summary.sigma_n_calibration * summary.sigma_n_calibration +
+                summary.sigma_n_systematic * summary.sigma_n_systematic);
   RCM_RETURN_IF_ERROR(CheckNotPinnedAtUpperBound(summary.n));
 
   summary.inliers.reserve(inliers.size());

@@ -70,12 +70,16 @@ struct RefinementSummary {
   double n = 0.0;
   // Standard deviation of n, the total: pixel noise (sigma_n_noise, after
   // the frames' consistency test) and the rig's calibration uncertainty
-  // (sigma_n_calibration), sqrt(noise^2 + calibration^2); see
+  // (sigma_n_calibration), and the matches' systematic error floor
+  // (sigma_n_systematic), the root of the sum of their squares; see
   // calibration_propagation.h. A rig made in code has no calibration
   // uncertainty: then sigma_n = sigma_n_noise.
   double sigma_n = 0.0;
   double sigma_n_noise = 0.0;
   double sigma_n_calibration = 0.0;
+  // With options.systematic_px > 0: the systematic error floor's share
+  // (calibration_propagation.h), part of sigma_n.
+  double sigma_n_systematic = 0.0;
   double crlb = 0.0;      // Cramer-Rao bound of n (standard deviation)
   double sigma_px = 0.0;  // estimated pixel noise of the inliers
   // The seeds: the closed-form median (nullopt when no match passes the

@@ -48,6 +48,23 @@
 // with w, R^2 = 1 - 1 / (M_nn [M_{n,w}^-1]_nn), and the inflation of
 // sigma_n when w is estimated without a prior, 1 / sqrt(1 - R^2).
 //
+// A systematic error floor (RefinementOptions::systematic_px): the pixel
+// noise model takes the residuals' errors as independent, so that their
+// effect on n falls as 1 / sqrt(N). Matchers have smooth systematic errors
+// as well (a lamp's brightness gradient between the two views, sub-pixel
+// interpolation, a lens model's residual error) that no number of matches
+// averages away, and where n and cam1's rotation are nearly collinear
+// (a narrow field at near-constant depth) a few hundredths of a pixel of
+// them move n by several of its noise sigmas. They are modeled as a field
+// added to every residual,
+//
+//   r_i += sum_k c_k phi_k(x_i, y_i),   c_k ~ N(0, systematic_px^2),
+//   phi = (1, x, y, x^2, x y, y^2),
+//
+// (x, y) the left pixel scaled to [-1, 1] over the image, held at c = 0
+// and propagated like the calibration (its columns are part of p above).
+// Its share is reported as sigma_n_systematic.
+//
 // Consistency of frames: with s_f = sum_{i in f} r_i dr_i/dn and
 // G_f = sum_{i in f} (dr_i/dn)^2, frame f's own n is n_hat - s_f / G_f to
 // first order, with variance sigma^2 / G_f, so
@@ -79,26 +96,36 @@
 
 namespace rcm {
 
-// Columns of j_i: n, w (3), dt (3), then the lens parameters of each camera
-// whose covariance the rig's calibration uncertainty has.
+// Columns of j_i: n, w (3), dt (3), the lens parameters of each camera
+// whose covariance the rig's calibration uncertainty has, then with a
+// systematic error floor the kNumSystematic coefficients of the systematic
+// residual field (the file comment).
 struct CalibrationParameterLayout {
   static constexpr int kN = 0;
   static constexpr int kRotation = 1;
   static constexpr int kTranslation = 4;
+  static constexpr int kNumSystematic = 6;
   int num_left_lens = 0;
   int num_right_lens = 0;
+  // Standard deviation of each systematic coefficient, pixels; 0: none.
+  double systematic_px = 0.0;
 
-  // The layout of `rig`: lens columns for the lens covariances it has.
-  static CalibrationParameterLayout Of(const StereoRig& rig);
+  // The layout of `rig`: lens columns for the lens covariances it has, and
+  // the systematic field's when systematic_px > 0.
+  static CalibrationParameterLayout Of(const StereoRig& rig,
+                                       double systematic_px = 0.0);
   int LeftLens() const { return 7; }
   int RightLens() const { return 7 + num_left_lens; }
-  int Size() const { return 7 + num_left_lens + num_right_lens; }
+  int Systematic() const { return 7 + num_left_lens + num_right_lens; }
+  int NumSystematic() const { return systematic_px > 0.0 ? kNumSystematic : 0; }
+  int Size() const { return Systematic() + NumSystematic(); }
 };
 
 // The sums M, g, C above, of a set of residuals. Fixed-capacity storage
 // (no heap), so that the online estimators' memory stays constant.
 struct LocusNormalEquations {
-  static constexpr int kMaxSize = 7 + 2 * kMaxLensParams;
+  static constexpr int kMaxSize =
+      7 + 2 * kMaxLensParams + CalibrationParameterLayout::kNumSystematic;
   using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0,
                                kMaxSize, kMaxSize>;
   using Vector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxSize, 1>;
@@ -151,14 +178,16 @@ struct FrameEstimateSums {
   double WeightedSquares(double n, const Eigen::Vector3d& rotation) const;
 };
 
-// Adds the rows j_i of `matches[indices]` at (n, w) for `rig`
-// (`raw` the correspondences they were prepared from, same indexing, for
-// the lens columns). Residuals that are undefined at (n, w) or at a
+// Adds the rows j_i of `matches[indices]` at (n, w) for `rig` in
+// `layout` (CalibrationParameterLayout::Of(rig, ...)); `raw` are the
+// correspondences they were prepared from, same indexing, for the lens and
+// systematic columns. Residuals that are undefined at (n, w) or at a
 // difference step are skipped. Per-frame sums (for the consistency test)
 // go to `per_frame` when it is not null: one entry per distinct
 // raw[i].frame, in order of first appearance.
 void AccumulateLocusNormalEquations(
-    const StereoRig& rig, const std::vector<StereoCorrespondence>& raw,
+    const StereoRig& rig, const CalibrationParameterLayout& layout,
+    const std::vector<StereoCorrespondence>& raw,
     const std::vector<PreparedCorrespondence>& matches,
     const std::vector<int64_t>& indices, double n,
     const Eigen::Vector3d& rotation, LocusNormalEquations* equations,
@@ -227,6 +256,10 @@ struct CalibrationPropagation {
   double variance_rotation = 0.0;
   double variance_translation = 0.0;
   double variance_lenses = 0.0;
+  // The systematic residual field's share, sigma_n_systematic^2: part of
+  // sigma_n, reported apart from the calibration's.
+  double variance_systematic = 0.0;
+  double sigma_n_systematic = 0.0;
   // dn/dw and dn/dt with everything but n held (per radian, per meter).
   Eigen::Vector3d dn_drotation = Eigen::Vector3d::Zero();
   Eigen::Vector3d dn_dtranslation = Eigen::Vector3d::Zero();

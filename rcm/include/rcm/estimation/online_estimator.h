@@ -108,6 +108,7 @@ StatusOr<LocusEstimate> EstimateFromLocusCost(const LocusCostFunction& cost,
 // classifies with the rotation estimated. Otherwise the rotation is held
 // and its uncertainty propagated.
 struct CalibratedLocusEstimate {
+  double sigma_n_systematic = 0.0;  // options.systematic_px's share
   // n, sigma_px and crlb at the solution (n alone, or with the rotation);
   // locus.sigma_n = sigma_n.
   LocusEstimate locus;
@@ -180,6 +181,7 @@ class OnlineRefractiveIndexEstimator {
     double sigma_n = 0.0;
     double sigma_n_noise = 0.0;
     double sigma_n_calibration = 0.0;
+    double sigma_n_systematic = 0.0;
     double crlb = 0.0;     // of n alone with the calibration known
     double sigma_px = 0.0;
     std::optional<FrameConsistency> consistency;

@@ -73,6 +73,14 @@ struct RefinementOptions {
   // it. false: the rotation is held at the calibration's and its
   // uncertainty only propagated into sigma_n. Ignored with refine_rotation.
   bool self_calibrate_rotation = true;
+  // A systematic error floor of the matches, pixels, >= 0
+  // (calibration_propagation.h): the standard deviation of each
+  // coefficient of a smooth field of low order added to every residual,
+  // which no number of matches averages away; propagated into sigma_n
+  // (sigma_n_systematic). 0 (the default): the residuals' errors are
+  // independent, as simulated matches' are. rcm estimate gives matches of
+  // its image front end 0.03 px.
+  double systematic_px = 0.0;
   // Solver iterations per stage; >= 1.
   int max_num_iterations = 100;
   // Threads for evaluating residuals; >= 1.

@@ -113,6 +113,7 @@ class SlidingWindowRefractiveIndexEstimator {
     double sigma_n = 0.0;
     double sigma_n_noise = 0.0;
     double sigma_n_calibration = 0.0;
+    double sigma_n_systematic = 0.0;
     double crlb = 0.0;     // of n alone with the calibration known
     double sigma_px = 0.0;
     std::optional<FrameConsistency> consistency;
