@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "rcm/io/camchain.h"
@@ -143,6 +144,8 @@ TEST(CalibrationCovarianceFile, ReadStereoRigAttachesTheSidecar) {
   const StereoRig rig = test::AlphasenseRealisticRig();
   const std::string camchain =
       test::WriteTempFile("rig.yaml", FormatCamchain(CamchainFromStereoRig(rig)));
+  const std::string sidecar = CovarianceSidecarPath(camchain);
+  std::remove(sidecar.c_str());  // an earlier run's
   const StereoRig without = ReadStereoRig(camchain).value();
   ASSERT_TRUE(without.calibration_uncertainty().has_value());
   EXPECT_THAT(without.calibration_uncertainty()->source,
@@ -150,7 +153,6 @@ TEST(CalibrationCovarianceFile, ReadStereoRigAttachesTheSidecar) {
   EXPECT_NEAR(without.calibration_uncertainty()->extrinsics_covariance(0, 0),
               std::pow(0.1 * kDegree, 2), 1e-20);
 
-  const std::string sidecar = CovarianceSidecarPath(camchain);
   ASSERT_TRUE(WriteCalibrationCovariance(sidecar, SampleFile()).ok());
   const StereoRig with = ReadStereoRig(camchain).value();
   ASSERT_TRUE(with.calibration_uncertainty().has_value());
