@@ -494,13 +494,16 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
       },
       residual, &corners, &problem));
 
-  if (!std::isfinite(parameters.n) || parameters.n >= kMaxIndex - kOnBound) {
+  const auto upper_bound_error = [&] {
     return Status::Error(
         "n = " + FormatFixed(parameters.n, 4) +
         " ends at the upper bound of [1, 2], which is not a physical answer: "
         "the air calibration probably does not describe these cameras under "
         "water (another rig's file, a lens refocused or zoomed since, a dome "
         "rather than a flat port), or the corners are not the target's");
+  };
+  if (!std::isfinite(parameters.n) || parameters.n >= kMaxIndex - kOnBound) {
+    return upper_bound_error();
   }
   for (int c = 0; c < 2; ++c) {
     if (free.air_gap[c] &&
@@ -636,6 +639,9 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
         "negative or non-finite variance");
   }
   result.sigma_n = std::sqrt(result.covariance.matrix(0, 0));
+  // Within one sigma of the upper bound is the bound too: the data cannot
+  // tell the estimate from 2.
+  if (parameters.n >= kMaxIndex - result.sigma_n) return upper_bound_error();
 
   // At the lower bound, n = 1 is an answer when the data do not pull below
   // it (kMaxPullBelowAir).

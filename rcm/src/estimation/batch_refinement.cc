@@ -352,7 +352,7 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
   }
 
   // An estimate pinned at the upper bound is a failure, not a number.
-  RCM_RETURN_IF_ERROR(CheckNotPinnedAtUpperBound(summary.n));
+  RCM_RETURN_IF_ERROR(CheckNotPinnedAtUpperBound(summary.n, summary.sigma_n));
 
   summary.inliers.reserve(inliers.size());
   for (const int64_t i : inliers) {

@@ -181,6 +181,7 @@ StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
     const double inflation =
         estimate.consistency ? estimate.consistency->inflation : 1.0;
     estimate.sigma_n_noise = estimate.sigma_n = locus->sigma_n * inflation;
+    RCM_RETURN_IF_ERROR(CheckNotPinnedAtUpperBound(locus->n, estimate.sigma_n));
     return estimate;
   }
   const CalibrationUncertainty uncertainty =
@@ -228,6 +229,7 @@ StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
       estimate.sigma_n_systematic * estimate.sigma_n_systematic);
   estimate.locus.sigma_n = estimate.sigma_n;
   estimate.calibration = *propagation;
+  RCM_RETURN_IF_ERROR(CheckNotPinnedAtUpperBound(n, estimate.sigma_n));
   return estimate;
 }
 

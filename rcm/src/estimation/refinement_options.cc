@@ -1,5 +1,6 @@
 #include "rcm/estimation/refinement_options.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -71,10 +72,12 @@ Status RefinementOptions::Check() const {
   return Status::Error(error.str());
 }
 
-Status CheckNotPinnedAtUpperBound(double n) {
+Status CheckNotPinnedAtUpperBound(double n, double sigma_n) {
   constexpr double kUpperBound = 2.0;
   constexpr double kPinnedTolerance = 1e-6;
-  if (!(n >= kUpperBound - kPinnedTolerance)) return Status::Ok();
+  if (!(n >= kUpperBound - std::max(kPinnedTolerance, sigma_n))) {
+    return Status::Ok();
+  }
   std::ostringstream message;
   message.setf(std::ios::fixed);
   message.precision(4);

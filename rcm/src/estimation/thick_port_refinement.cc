@@ -274,7 +274,7 @@ StatusOr<ThickPortRefinementSummary> RefineRefractiveIndexThickPort(
       std::sqrt(summary.sigma_n_noise * summary.sigma_n_noise +
                 summary.sigma_n_calibration * summary.sigma_n_calibration +
                 summary.sigma_n_systematic * summary.sigma_n_systematic);
-  RCM_RETURN_IF_ERROR(CheckNotPinnedAtUpperBound(summary.n));
+  RCM_RETURN_IF_ERROR(CheckNotPinnedAtUpperBound(summary.n, summary.sigma_n));
 
   summary.inliers.reserve(inliers.size());
   for (const int64_t i : inliers) {

@@ -122,7 +122,8 @@ struct CalibratedLocusEstimate {
   std::optional<CalibrationPropagation> calibration;
 };
 // `normal_equations` and `frame_estimates` sum the frames of `cost`; a rig
-// without a calibration uncertainty ignores the former.
+// without a calibration uncertainty ignores the former. An n pinned at the
+// upper bound is an error (CheckNotPinnedAtUpperBound), never a number.
 bool SelfCalibrates(const StereoRig& rig, const RefinementOptions& options);
 StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
     const StereoRig& rig, const LocusCostFunction& cost,

@@ -95,12 +95,13 @@ struct RefinementOptions {
 // iterations, and the noise-free case must reach 1e-9 in n.
 ceres::Solver::Options RefinementSolverOptions(const RefinementOptions& options);
 
-// Ok unless n is pinned at the upper bound of [1, 2] (within 1e-6),
-// which no medium reaches: then the one-line failure that names the likely
+// Ok unless n is pinned at the upper bound of [1, 2], which no medium
+// reaches: within max(1e-6, sigma_n) of 2, so that the data cannot tell
+// it from the bound. Then the one-line failure that names the likely
 // causes (the rig moved since its calibration, a wrong rig file) and the
 // remedies (rcm calibrate --underwater, --refine-rotation). The lower
 // bound stays a valid answer (air).
-Status CheckNotPinnedAtUpperBound(double n);
+Status CheckNotPinnedAtUpperBound(double n, double sigma_n = 0.0);
 
 // A new Ceres loss of `loss` with scale `scale_px` (owned by the problem
 // it is given to); nullptr for kNone (least squares).
