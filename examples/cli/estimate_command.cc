@@ -143,13 +143,6 @@ constexpr char kUsage[] =
     "Exit status: 0 on success, 1 when the input cannot give an estimate, "
     "2 on\nwrong flags.";
 
-// The systematic error floor of the image front end's matches (the
-// default of --systematic-px with images): on renders of the dataset and
-// narrow rigs, n and cam1's rotation fitted freely with the true rig read
-// rotations of up to 0.005 degrees (0.04 px at f = 500 px) off the truth,
-// where their noise sigma was 0.001 degree; 0.03 px per coefficient of the
-// systematic field covers that.
-constexpr double kFrontEndSystematicPx = 0.03;
 
 // Matching again with the self-calibrated rotation when it moves pixels at
 // the focal length's distance from the center by more than this (the

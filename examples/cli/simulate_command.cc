@@ -35,12 +35,6 @@ DEFINE_string(depth_range, "",
               "MIN,MAX in meters: sample the matches at depths uniform in "
               "[MIN, MAX] on random left pixels' rays instead of on the "
               "tank's surfaces (needs --noimages)");
-DEFINE_string(extrinsic_drift, "",
-              "RX,RY,RZ[,TX,TY,TZ]: cam1 has moved since the air "
-              "calibration by this rotation (angle-axis, degrees, cam1 "
-              "frame) and change of cam1_from_cam0's translation (mm): the "
-              "images and matches are those of the moved rig, camchain.yaml "
-              "stays the calibration (StereoRig::WithCam1Moved)");
 DEFINE_string(board_distance, "0.6,2.0",
               "with --board: MIN,MAX in meters, the range of the board's "
               "distance in front of cam0");
@@ -113,25 +107,6 @@ bool FlagGiven(const char* name) {
   return gflags::GetCommandLineFlagInfo(name, &info) && !info.is_default;
 }
 
-// --extrinsic-drift into options->cam1_drift.
-Status DriftFromFlag(SequenceOptions* options) {
-  if (FLAGS_extrinsic_drift.empty()) return Status::Ok();
-  const std::string context =
-      FlagContext("extrinsic-drift", FLAGS_extrinsic_drift);
-  const StatusOr<std::vector<double>> values =
-      ParseNumberList(FLAGS_extrinsic_drift);
-  if (!values.ok() || (values->size() != 3 && values->size() != 6)) {
-    return Status::Error(context +
-                         ": expected RX,RY,RZ[,TX,TY,TZ] (degrees, "
-                         "millimetres), e.g. 0.5,0,0");
-  }
-  const std::vector<double>& v = values.value();
-  options->cam1_drift.rotation = Eigen::Vector3d(v[0], v[1], v[2]) * kDegree;
-  if (v.size() == 6) {
-    options->cam1_drift.translation = Eigen::Vector3d(v[3], v[4], v[5]) * 1e-3;
-  }
-  return options->cam1_drift.Check().WithContext(context);
-}
 
 // --board and --board-distance into options->board, board_motion.
 Status BoardFromFlags(SequenceOptions* options) {
@@ -225,7 +200,7 @@ int RunSimulate() {
       return kExitUsage;
     }
   }
-  if (const Status drift = DriftFromFlag(&options); !drift.ok()) {
+  if (const Status drift = ExtrinsicDriftFromFlag(&options); !drift.ok()) {
     PrintError(command, drift.message());
     return kExitUsage;
   }

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "index_flag.h"
+#include "number_list_flag.h"
 #include "rcm/io/stereo_rig_file.h"
 #include "rcm/sim/media_schedule.h"
 #include "rcm/sim/reference_rigs.h"
@@ -37,10 +38,40 @@ DEFINE_double(image_noise, 1.5,
 DEFINE_int32(supersampling, 2,
              "rays per pixel along each axis (anti-aliasing), 1-4");
 DEFINE_uint64(seed, 1, "random seed; the outputs depend only on the flags");
+DEFINE_string(extrinsic_drift, "",
+              "RX,RY,RZ[,TX,TY,TZ]: cam1 has moved since the air "
+              "calibration by this rotation (angle-axis, degrees, cam1 "
+              "frame) and change of cam1_from_cam0's translation (mm): the "
+              "images and matches are those of the moved rig, the "
+              "calibration stays as it was (StereoRig::WithCam1Moved)");
 
 namespace rcm::cli {
 
 extern const char kSimulationFlagsSource[] = __FILE__;
+
+namespace {
+
+constexpr double kDegree = M_PI / 180.0;
+
+}  // namespace
+
+Status ExtrinsicDriftFromFlag(SequenceOptions* options) {
+  if (FLAGS_extrinsic_drift.empty()) return Status::Ok();
+  const std::string context = "--extrinsic-drift " + FLAGS_extrinsic_drift;
+  const StatusOr<std::vector<double>> values =
+      ParseNumberList(FLAGS_extrinsic_drift);
+  if (!values.ok() || (values->size() != 3 && values->size() != 6)) {
+    return Status::Error(context +
+                         ": expected RX,RY,RZ[,TX,TY,TZ] (degrees, "
+                         "millimetres), e.g. 0.5,0,0");
+  }
+  const std::vector<double>& v = values.value();
+  options->cam1_drift.rotation = Eigen::Vector3d(v[0], v[1], v[2]) * kDegree;
+  if (v.size() == 6) {
+    options->cam1_drift.translation = Eigen::Vector3d(v[3], v[4], v[5]) * 1e-3;
+  }
+  return options->cam1_drift.Check().WithContext(context);
+}
 
 StatusOr<Simulation> SimulationFromFlags(const std::string& calib,
                                          const std::string& left,

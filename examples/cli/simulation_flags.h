@@ -23,6 +23,7 @@ DECLARE_double(port_tilt);
 DECLARE_double(image_noise);
 DECLARE_int32(supersampling);
 DECLARE_uint64(seed);
+DECLARE_string(extrinsic_drift);
 
 namespace rcm::cli {
 
@@ -41,6 +42,11 @@ struct Simulation {
 StatusOr<Simulation> SimulationFromFlags(const std::string& calib,
                                          const std::string& left = "cam0",
                                          const std::string& right = "cam1");
+
+// --extrinsic-drift into options->cam1_drift (the rig of the images moved
+// from the calibration). Errors (wrong flags): not 3 or 6 numbers, not
+// finite, beyond ExtrinsicDrift::Check's limits.
+Status ExtrinsicDriftFromFlag(SequenceOptions* options);
 
 // The flags' values, for the JSON a run writes next to its outputs.
 nlohmann::json SimulationFlagsJson(const Simulation& simulation);

@@ -38,6 +38,16 @@
 
 namespace rcm {
 
+// The systematic error floor of this front end's matches, for the
+// estimators' RefinementOptions::systematic_px (calibration_propagation.h):
+// on rendered dives of the dataset rig and of a narrow-field rig, n and
+// cam1's rotation fitted freely with the true rig read rotations up to
+// 0.005 degrees off the truth (0.04 px at f = 500 px) where their noise
+// sigma was 0.001 degree (lighting that differs between the two views,
+// sub-pixel interpolation); 0.03 px per coefficient of the systematic
+// field covers that.
+inline constexpr double kFrontEndSystematicPx = 0.03;
+
 struct StereoFrontEndOptions {
   ClaheOptions clahe;
   FeatureOptions features;
