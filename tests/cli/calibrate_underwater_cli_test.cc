@@ -16,6 +16,7 @@
 #include "cli/cli_runner.h"
 #include "rcm/io/camchain.h"
 #include "support/temp_file.h"
+#include "support/test_budget.h"
 
 namespace rcm {
 namespace {
@@ -60,11 +61,19 @@ std::string Board(double square) {
 }
 
 // A dive with the board: 20 views at 1 Hz (a diver's minute, thinned), the
-// rig in the water turned by kDriftDeg from the camchain it writes.
+// rig in the water turned by kDriftDeg from the camchain it writes. Under
+// the sanitizers (support/test_budget.h) 6 views, to cover the code.
 std::string DriftedDive(const std::string& rig, double square) {
   return "--rig " + rig + " " + Board(square) +
-         " --extrinsic-drift 0.25,0.41,0.08 --frames 20 --frame-rate 1 --n "
-         "1.342";
+         " --extrinsic-drift 0.25,0.41,0.08 --frames " +
+         std::to_string(test::kSanitizerBuild ? 6 : 20) +
+         " --frame-rate 1 --n 1.342";
+}
+
+// The leave-out folds of the end-to-end refinements (3 under the
+// sanitizers).
+std::string Folds() {
+  return std::string("--folds ") + (test::kSanitizerBuild ? "3" : "10");
 }
 
 nlohmann::json Json(const RunResult& result) {
@@ -107,13 +116,16 @@ void ExpectUnderwaterCalibrationRecoversTheDive(const nlohmann::json& json,
               "drift %.3f deg\n",
               json["n"].get<double>(), json["sigma_n"].get<double>(),
               leave_out, error, json["extrinsic_change_deg"].get<double>());
-  EXPECT_LE(std::abs(error), 3.0 * leave_out);
+  const double drift_tolerance = test::ChecksStatistics() ? 0.05 : 0.2;
+  if (test::ChecksStatistics()) {
+    EXPECT_LE(std::abs(error), 3.0 * leave_out);
+    EXPECT_GE(json["views_used"].get<int>(), 18);
+  }
   for (int k = 0; k < 3; ++k) {
     EXPECT_NEAR(json["extrinsic_change"]["rotation_deg"][k].get<double>(),
-                kDriftDeg[k], 0.05)
+                kDriftDeg[k], drift_tolerance)
         << k;
   }
-  EXPECT_GE(json["views_used"].get<int>(), 18);
   EXPECT_GT(json["rms_px"].get<double>(), 0.0);
   EXPECT_LT(json["rms_px"].get<double>(), 0.3);
   EXPECT_TRUE(json["conventional"]["ok"].get<bool>());
@@ -144,7 +156,9 @@ void ExpectRefusedOrCovered(const RunResult& result, const char* what) {
               json["sigma_n_noise"].get<double>(),
               json["sigma_n_calibration"].get<double>(),
               json["sigma_n_systematic"].get<double>(), error, error / sigma);
-  EXPECT_LE(std::abs(error), 3.0 * sigma) << what;
+  if (test::ChecksStatistics()) {
+    EXPECT_LE(std::abs(error), 3.0 * sigma) << what;
+  }
 }
 
 // The rig: a narrow-field housing whose cam1 turned 0.49 degrees.
@@ -157,10 +171,13 @@ TEST(UnderwaterCli, NarrowRigThatDriftedHalfADegree) {
   const std::string dive = Folder("dive");
   Simulate(dive, DriftedDive("narrow", 0.03));
   const std::string water = Folder("water");
-  const nlohmann::json json = Json(CalibrateUnderwater(dive, water, 0.03));
+  const nlohmann::json json =
+      Json(CalibrateUnderwater(dive, water, 0.03, Folds()));
   ExpectUnderwaterCalibrationRecoversTheDive(json, dive + "/camchain.yaml",
                                              water + "/camchain.yaml");
-  EXPECT_LE(std::abs(json["n"].get<double>() - kTrueN), 2e-3);
+  if (test::ChecksStatistics()) {
+    EXPECT_LE(std::abs(json["n"].get<double>() - kTrueN), 2e-3);
+  }
   EXPECT_TRUE(fs::exists(water + "/camchain-covariance.yaml"));
   for (const char* file : {"residuals_cam0.png", "residuals_cam1.png",
                            "coverage_cam0.png", "coverage_cam1.png",
@@ -172,8 +189,10 @@ TEST(UnderwaterCli, NarrowRigThatDriftedHalfADegree) {
                          "narrow, refined camchain");
   const RunResult stale = Estimate(dive, dive + "/camchain.yaml");
   ExpectRefusedOrCovered(stale, "narrow, stale camchain");
-  EXPECT_NE(stale.err.find("the calibration is stale"), std::string::npos)
-      << stale.err;
+  if (test::ChecksStatistics()) {
+    EXPECT_NE(stale.err.find("the calibration is stale"), std::string::npos)
+        << stale.err;
+  }
 }
 
 // The dataset rig (wide field): the same, and n from the images with the
@@ -182,14 +201,17 @@ TEST(UnderwaterCli, DatasetRigThatDriftedHalfADegree) {
   const std::string dive = Folder("dive");
   Simulate(dive, DriftedDive("alphasense", 0.04));
   const std::string water = Folder("water");
-  const nlohmann::json json = Json(CalibrateUnderwater(dive, water, 0.04));
+  const nlohmann::json json =
+      Json(CalibrateUnderwater(dive, water, 0.04, Folds()));
   ExpectUnderwaterCalibrationRecoversTheDive(json, dive + "/camchain.yaml",
                                              water + "/camchain.yaml");
   const RunResult refined = Estimate(dive, water + "/camchain.yaml");
   ExpectRefusedOrCovered(refined, "dataset rig, refined camchain");
   ASSERT_EQ(refined.exit_code, 0) << refined.err;
-  EXPECT_NEAR(nlohmann::json::parse(refined.out)["n"].get<double>(), kTrueN,
-              2e-3);
+  if (test::ChecksStatistics()) {
+    EXPECT_NEAR(nlohmann::json::parse(refined.out)["n"].get<double>(),
+                kTrueN, 2e-3);
+  }
   ExpectRefusedOrCovered(Estimate(dive, dive + "/camchain.yaml"),
                          "dataset rig, stale camchain");
 }

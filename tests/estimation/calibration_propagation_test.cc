@@ -13,6 +13,7 @@
 #include "rcm/estimation/sliding_window_estimator.h"
 #include "rcm/geometry/epipolar.h"
 #include "rcm/sim/stereo_sampler.h"
+#include "support/test_budget.h"
 #include "support/test_rigs.h"
 
 namespace rcm {
@@ -318,7 +319,7 @@ ZStatistics MonteCarloWithDrift(const DriftScene& scene, int trials,
 
 ZStatistics MonteCarloRefine(const DriftScene& scene) {
   return MonteCarloWithDrift(
-      scene, 100, 11,
+      scene, test::Trials(100), 11,
       [](const StereoRig& rig, const std::vector<StereoCorrespondence>& data,
          double* n, double* sigma) {
         const StatusOr<RefinementSummary> summary =
@@ -335,7 +336,7 @@ ZStatistics MonteCarloRefine(const DriftScene& scene) {
 // frame by frame.
 ZStatistics MonteCarloFrameByFrame(const DriftScene& scene, bool window) {
   return MonteCarloWithDrift(
-      scene, 100, 21,
+      scene, test::Trials(100), 21,
       [&](const StereoRig& rig, const std::vector<StereoCorrespondence>& data,
           double* n, double* sigma) {
         std::vector<std::vector<StereoCorrespondence>> frames(scene.frames);
@@ -374,6 +375,7 @@ void ExpectHonest(const ZStatistics& z, const char* what) {
               "%.5f\n",
               what, z.trials, z.failed, z.mean, z.sd, z.mean_sigma);
   EXPECT_EQ(z.failed, 0) << what;
+  if (!test::ChecksStatistics()) return;
   EXPECT_GE(z.sd, 0.7) << what;
   EXPECT_LE(z.sd, 1.3) << what;
 }
