@@ -140,6 +140,12 @@ constexpr char kUsage[] =
     "whose covariance gives\nsigma_n. It works on any calibrated rig. "
     "closed-form is the paper's baseline;\nit assumes a rectified rig and is "
     "biased under pixel noise (DESIGN.md Sec. 2).\n\n"
+    "sigma_n counts the calibration's uncertainty (the camchain's covariance\n"
+    "sidecar, or a drift prior of 0.1 deg, 0.1 mm per axis: --drift-prior)\n"
+    "and the matches' systematic error (--systematic-px) beside the pixel\n"
+    "noise; cam1's rotation is self-calibrated with its prior. An n at the\n"
+    "upper bound 2 is refused; a stale calibration is named (then\n"
+    "rcm calibrate --underwater).\n\n"
     "Exit status: 0 on success, 1 when the input cannot give an estimate, "
     "2 on\nwrong flags.";
 

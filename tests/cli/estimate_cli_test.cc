@@ -230,6 +230,31 @@ TEST(EstimateCli, RotationOnlyWithRefine) {
       2, "--refine-rotation works with --estimator refine");
 }
 
+// A narrow rig whose cam1 turned -0.15 degrees about x since the camchain:
+// with the rotation held, n alone is pinned at the upper bound, which is
+// refused in one line naming the causes and the remedies; self-calibrated
+// (the default), the turn is found and n is an answer.
+TEST(EstimateCli, PinnedAtTheUpperBoundIsRefused) {
+  const std::string dive = test::TempFilePath("dive");
+  std::filesystem::remove_all(dive);
+  const RunResult simulated =
+      Rcm({"simulate", "--out", dive, "--rig", "narrow", "--noimages",
+           "--depth-range", "0.9,1.1", "--matches-per-frame", "300",
+           "--frames", "2", "--n", "1.342", "--extrinsic-drift", "-0.15,0,0"});
+  ASSERT_EQ(simulated.exit_code, 0) << simulated.err;
+  const RunResult held = Rcm({"estimate", "--calib", dive + "/camchain.yaml",
+                              "--matches", dive + "/matches.csv",
+                              "--noself-calibrate", "--json"});
+  ExpectFailsWithOneLine(held, 1, "is at the upper bound of [1, 2]");
+  EXPECT_NE(held.err.find("rcm calibrate --underwater"), std::string::npos);
+  const RunResult calibrated =
+      Rcm({"estimate", "--calib", dive + "/camchain.yaml", "--matches",
+           dive + "/matches.csv", "--json"});
+  ASSERT_EQ(calibrated.exit_code, 0) << calibrated.err;
+  EXPECT_NEAR(nlohmann::json::parse(calibrated.out)["n"].get<double>(), 1.342,
+              1e-9);
+}
+
 TEST(EstimateCli, RefineDoesNotWarnOnUnrectifiedRig) {
   const RunResult result =
       Rcm({"estimate", "--calib",
