@@ -96,15 +96,6 @@ void LocusNormalEquations::Add(const LocusNormalEquations& other) {
   count += other.count;
 }
 
-void LocusNormalEquations::Subtract(const LocusNormalEquations& other) {
-  information -= other.information;
-  gradient -= other.gradient;
-  gradient_intercept -= other.gradient_intercept;
-  intercept_squares -= other.intercept_squares;
-  squared_residuals -= other.squared_residuals;
-  count -= other.count;
-}
-
 namespace {
 
 // The locus residual of a prepared match for extrinsics `cam1_from_cam0`
@@ -348,16 +339,6 @@ void FrameEstimateSums::Add(double n_f, double information,
     bb += rotation_coupling * rotation_coupling.transpose() / information;
   }
   ++frames;
-}
-
-void FrameEstimateSums::Add(const FrameEstimateSums& other) {
-  s0 += other.s0;
-  s1 += other.s1;
-  s2 += other.s2;
-  b += other.b;
-  bn += other.bn;
-  bb += other.bb;
-  frames += other.frames;
 }
 
 double FrameEstimateSums::WeightedSquares(double n,

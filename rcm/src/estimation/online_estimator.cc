@@ -233,6 +233,22 @@ StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
   return estimate;
 }
 
+PooledLocusEstimate PooledEstimateOf(const CalibratedLocusEstimate& estimate) {
+  PooledLocusEstimate pooled;
+  pooled.n = estimate.locus.n;
+  pooled.sigma_n = estimate.sigma_n;
+  pooled.sigma_n_noise = estimate.sigma_n_noise;
+  pooled.sigma_n_calibration = estimate.sigma_n_calibration;
+  pooled.sigma_n_systematic = estimate.sigma_n_systematic;
+  pooled.crlb = estimate.locus.crlb;
+  pooled.sigma_px = estimate.locus.sigma_px;
+  pooled.inliers = estimate.locus.inliers;
+  pooled.consistency = estimate.consistency;
+  pooled.calibration = estimate.calibration;
+  pooled.rotation = estimate.rotation;
+  return pooled;
+}
+
 OnlineRefractiveIndexEstimator::OnlineRefractiveIndexEstimator(
     const StereoRig& rig, const RefinementOptions& options)
     : rig_(rig),
@@ -284,19 +300,8 @@ OnlineRefractiveIndexEstimator::Current() const {
   const StatusOr<CalibratedLocusEstimate> calibrated = EstimateWithCalibration(
       rig_, cost_, normal_equations_, frame_estimates_, options_);
   if (!calibrated.ok()) return calibrated.status();
-  const LocusEstimate& locus = calibrated->locus;
   Estimate estimate;
-  estimate.n = locus.n;
-  estimate.sigma_n = calibrated->sigma_n;
-  estimate.sigma_n_noise = calibrated->sigma_n_noise;
-  estimate.sigma_n_calibration = calibrated->sigma_n_calibration;
-  estimate.sigma_n_systematic = calibrated->sigma_n_systematic;
-  estimate.crlb = locus.crlb;
-  estimate.sigma_px = locus.sigma_px;
-  estimate.consistency = calibrated->consistency;
-  estimate.calibration = calibrated->calibration;
-  estimate.rotation = calibrated->rotation;
-  estimate.inliers = locus.inliers;
+  static_cast<PooledLocusEstimate&>(estimate) = PooledEstimateOf(*calibrated);
   estimate.correspondences = num_correspondences_;
   estimate.frames = num_frames_;
   return estimate;

@@ -175,19 +175,8 @@ SlidingWindowRefractiveIndexEstimator::Current() const {
     return calibrated.status().WithContext(
         "window of " + std::to_string(window_count_) + " frames");
   }
-  const LocusEstimate& locus = calibrated->locus;
   Estimate estimate;
-  estimate.n = locus.n;
-  estimate.sigma_n = calibrated->sigma_n;
-  estimate.sigma_n_noise = calibrated->sigma_n_noise;
-  estimate.sigma_n_calibration = calibrated->sigma_n_calibration;
-  estimate.sigma_n_systematic = calibrated->sigma_n_systematic;
-  estimate.crlb = locus.crlb;
-  estimate.sigma_px = locus.sigma_px;
-  estimate.consistency = calibrated->consistency;
-  estimate.calibration = calibrated->calibration;
-  estimate.rotation = calibrated->rotation;
-  estimate.inliers = locus.inliers;
+  static_cast<PooledLocusEstimate&>(estimate) = PooledEstimateOf(*calibrated);
   estimate.frames = window_count_;
   estimate.first_frame = window_[window_begin_].frame;
   estimate.last_frame =

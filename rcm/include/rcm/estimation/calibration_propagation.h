@@ -149,7 +149,6 @@ struct LocusNormalEquations {
         gradient_intercept(Vector::Zero(size)) {}
   int size() const { return static_cast<int>(gradient.size()); }
   void Add(const LocusNormalEquations& other);
-  void Subtract(const LocusNormalEquations& other);
 };
 
 // Sums over frames of their own estimates n_f (cam1's rotation held), for
@@ -173,7 +172,6 @@ struct FrameEstimateSums {
 
   void Add(double n_f, double information,
            const Eigen::Vector3d& rotation_coupling = Eigen::Vector3d::Zero());
-  void Add(const FrameEstimateSums& other);
   // chi^2 sigma^2 above at (n, w).
   double WeightedSquares(double n, const Eigen::Vector3d& rotation) const;
 };

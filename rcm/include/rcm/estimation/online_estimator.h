@@ -78,6 +78,27 @@ struct LocusEstimate {
 StatusOr<LocusEstimate> EstimateFromLocusCost(const LocusCostFunction& cost,
                                               const RefinementOptions& options);
 
+// What the online and the sliding-window estimates report of their pooled
+// frames (CalibratedLocusEstimate, below).
+struct PooledLocusEstimate {
+  double n = 0.0;
+  // The total standard deviation, as the batch's: pixel noise (after the
+  // frames' consistency test), the calibration's uncertainty and the
+  // matches' systematic error floor (calibration_propagation.h).
+  double sigma_n = 0.0;
+  double sigma_n_noise = 0.0;
+  double sigma_n_calibration = 0.0;
+  double sigma_n_systematic = 0.0;
+  double crlb = 0.0;  // of n alone with the calibration known
+  double sigma_px = 0.0;
+  int64_t inliers = 0;  // pooled
+  std::optional<FrameConsistency> consistency;
+  std::optional<CalibrationPropagation> calibration;
+  // The self-calibrated rotation of cam1 (angle-axis, radians, the
+  // convention of StereoRig::WithCam1Moved), when it is estimated.
+  std::optional<Eigen::Vector3d> rotation;
+};
+
 // A LocusEstimate with the uncertainty of the calibration and the frames'
 // consistency (calibration_propagation.h), shared by the online and the
 // sliding-window estimators.
@@ -130,6 +151,8 @@ StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
     const LocusNormalEquations& normal_equations,
     const FrameEstimateSums& frame_estimates,
     const RefinementOptions& options);
+// Its fields as the estimators report them.
+PooledLocusEstimate PooledEstimateOf(const CalibratedLocusEstimate& estimate);
 
 // Steps 1-4 for one frame.
 struct FrameFit {
@@ -173,23 +196,9 @@ class OnlineRefractiveIndexEstimator {
   static StatusOr<OnlineRefractiveIndexEstimator> Create(
       const StereoRig& rig, const RefinementOptions& options);
 
-  // The estimate of all frames so far.
-  struct Estimate {
-    double n = 0.0;
-    // The total standard deviation, as the batch's: pixel noise (after the
-    // frames' consistency test) and the calibration's uncertainty with
-    // cam1's rotation held (calibration_propagation.h).
-    double sigma_n = 0.0;
-    double sigma_n_noise = 0.0;
-    double sigma_n_calibration = 0.0;
-    double sigma_n_systematic = 0.0;
-    double crlb = 0.0;     // of n alone with the calibration known
-    double sigma_px = 0.0;
-    std::optional<FrameConsistency> consistency;
-    std::optional<CalibrationPropagation> calibration;
-    // The self-calibrated rotation of cam1 (CalibratedLocusEstimate).
-    std::optional<Eigen::Vector3d> rotation;
-    int64_t inliers = 0;          // in the running sums
+  // The estimate of all frames so far: the pooled estimate, with the
+  // counts of the whole run.
+  struct Estimate : PooledLocusEstimate {
     int64_t correspondences = 0;  // every correspondence of every frame
     int64_t frames = 0;           // frames added, skipped ones included
   };

@@ -105,22 +105,8 @@ class SlidingWindowRefractiveIndexEstimator {
       const StereoRig& rig, const RefinementOptions& options,
       const SlidingWindowOptions& window_options);
 
-  struct Estimate {
-    double n = 0.0;
-    // The total standard deviation of the window's n, as the online
-    // estimator's (pixel noise after the window frames' consistency test,
-    // and the calibration's uncertainty with cam1's rotation held).
-    double sigma_n = 0.0;
-    double sigma_n_noise = 0.0;
-    double sigma_n_calibration = 0.0;
-    double sigma_n_systematic = 0.0;
-    double crlb = 0.0;     // of n alone with the calibration known
-    double sigma_px = 0.0;
-    std::optional<FrameConsistency> consistency;
-    std::optional<CalibrationPropagation> calibration;
-    // The self-calibrated rotation of cam1 (online_estimator.h).
-    std::optional<Eigen::Vector3d> rotation;
-    int64_t inliers = 0;      // in the window
+  // The window's pooled estimate, with which frames it holds.
+  struct Estimate : PooledLocusEstimate {
     int frames = 0;           // frames in the window
     int64_t first_frame = 0;  // oldest frame in the window
     int64_t last_frame = 0;   // newest frame in the window
