@@ -46,6 +46,11 @@ void PrintUsage(std::ostream& out) {
 int main(int argc, char** argv) {
   google::InitGoogleLogging(argv[0]);
   FLAGS_logtostderr = true;
+  // A subcommand's errors and warnings are its own one-line messages; the
+  // libraries' glog warnings (Ceres on a rank-deficient covariance, which
+  // the subcommands report in their own words) stay out of them. CHECK
+  // failures (programmer errors) still print.
+  FLAGS_minloglevel = google::GLOG_ERROR;
   gflags::SetVersionString("0.1.0");
 
   if (argc < 2) {

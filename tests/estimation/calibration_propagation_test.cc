@@ -317,13 +317,17 @@ ZStatistics MonteCarloWithDrift(const DriftScene& scene, int trials,
   return statistics;
 }
 
-ZStatistics MonteCarloRefine(const DriftScene& scene) {
+ZStatistics MonteCarloRefine(const DriftScene& scene,
+                             bool free_rotation = false) {
+  RefinementOptions options;
+  options.refine_rotation = free_rotation;
   return MonteCarloWithDrift(
       scene, test::Trials(100), 11,
-      [](const StereoRig& rig, const std::vector<StereoCorrespondence>& data,
-         double* n, double* sigma) {
+      [options](const StereoRig& rig,
+                const std::vector<StereoCorrespondence>& data, double* n,
+                double* sigma) {
         const StatusOr<RefinementSummary> summary =
-            RefineRefractiveIndex(rig, data, RefinementOptions());
+            RefineRefractiveIndex(rig, data, options);
         if (!summary.ok()) return false;
         *n = summary->n;
         *sigma = summary->sigma_n;
@@ -385,6 +389,16 @@ TEST(CalibrationPropagation, MonteCarloRefineSigmaHonestUnderDriftPool) {
 }
 TEST(CalibrationPropagation, MonteCarloRefineSigmaHonestUnderDriftBoard) {
   ExpectHonest(MonteCarloRefine(DriftScenes()[1]), "refine, board");
+}
+// --refine-rotation: the rotation free (no prior), its sigma from the data
+// and the rest of the calibration propagated; honest where the data
+// separate the two and where they hardly do (the board, R ~ 0.99: a large
+// sigma, but an honest one).
+TEST(CalibrationPropagation, MonteCarloFreeRotationSigmaHonestUnderDriftPool) {
+  ExpectHonest(MonteCarloRefine(DriftScenes()[0], true), "free, pool");
+}
+TEST(CalibrationPropagation, MonteCarloFreeRotationSigmaHonestUnderDriftBoard) {
+  ExpectHonest(MonteCarloRefine(DriftScenes()[1], true), "free, board");
 }
 TEST(CalibrationPropagation, MonteCarloOnlineSigmaHonestUnderDriftPool) {
   ExpectHonest(MonteCarloFrameByFrame(DriftScenes()[0], false), "online, pool");
