@@ -133,7 +133,10 @@ StatusOr<CalibrationCovarianceFile> ReadDocument(const YamlReader& reader,
   return file;
 }
 
-void AppendMatrix(const Eigen::MatrixXd& matrix, std::ostringstream* out) {
+// The rows of (M + M^T) / 2: a covariance computed as J C J^T is
+// symmetric only to rounding, and the file should be exactly.
+void AppendMatrix(const Eigen::MatrixXd& given, std::ostringstream* out) {
+  const Eigen::MatrixXd matrix = 0.5 * (given + given.transpose());
   for (int r = 0; r < matrix.rows(); ++r) {
     *out << "    - [";
     for (int c = 0; c < matrix.cols(); ++c) {

@@ -23,7 +23,8 @@
 // Every key but `medium` is optional (a camera without intrinsics_covariance
 // has lenses taken as exact; cam0 never has T_cn_cnm1_covariance). Numbers
 // are written as the shortest text that reads back to the same double, so
-// that a file reads back bit for bit. Reading never throws; errors are one
+// that a file reads back bit for bit; matrices are written symmetrized,
+// (M + M^T) / 2. Reading never throws; errors are one
 // line, "SOURCE[:LINE]: FIELD: MESSAGE" as for the camchain (yaml_fields.h).
 #ifndef RCM_IO_CALIBRATION_COVARIANCE_FILE_H_
 #define RCM_IO_CALIBRATION_COVARIANCE_FILE_H_
