@@ -198,6 +198,10 @@ TEST(UnderwaterCli, NarrowRigThatDriftedHalfADegree) {
 // The dataset rig (wide field): the same, and n from the images with the
 // refined camchain within 2e-3.
 TEST(UnderwaterCli, DatasetRigThatDriftedHalfADegree) {
+  if (test::kSanitizerBuild) {
+    GTEST_SKIP() << "the narrow rig's test covers the same code under the "
+                    "sanitizers; this one checks the dataset rig's figures";
+  }
   const std::string dive = Folder("dive");
   Simulate(dive, DriftedDive("alphasense", 0.04));
   const std::string water = Folder("water");
@@ -220,8 +224,9 @@ TEST(UnderwaterCli, DatasetRigThatDriftedHalfADegree) {
 // extrinsics kept.
 TEST(UnderwaterCli, OneCameraGivesN) {
   const std::string dive = Folder("dive");
-  Simulate(dive, "--rig narrow " + Board(0.03) +
-                     " --frames 12 --frame-rate 1 --n 1.342");
+  Simulate(dive, "--rig narrow " + Board(0.03) + " --frame-rate 1 --n 1.342" +
+                     (test::kSanitizerBuild ? " --frames 5 --supersampling 1"
+                                            : " --frames 12"));
   const std::string water = Folder("water");
   const RunResult result = Rcm(
       Words("calibrate --underwater --air " + dive + "/camchain.yaml --left " +
@@ -231,8 +236,10 @@ TEST(UnderwaterCli, OneCameraGivesN) {
   EXPECT_FALSE(json["extrinsics_estimated"].get<bool>());
   EXPECT_TRUE(json["extrinsic_change_deg"].is_null());
   // One camera pins n less well than two: 4 covariance sigmas.
-  EXPECT_LE(std::abs(json["n"].get<double>() - kTrueN),
-            std::max(4.0 * json["sigma_n"].get<double>(), 2e-3));
+  if (test::ChecksStatistics()) {
+    EXPECT_LE(std::abs(json["n"].get<double>() - kTrueN),
+              std::max(4.0 * json["sigma_n"].get<double>(), 2e-3));
+  }
   EXPECT_EQ(ReadCamchain(dive + "/camchain.yaml")
                 .value()
                 .cameras[1]
