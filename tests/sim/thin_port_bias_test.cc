@@ -80,8 +80,8 @@ std::vector<std::string> Cells(const std::string& row) {
   return cells;
 }
 
-TEST(ThinPortBias, ReadmeTableIsCurrent) {
-  // The README's approximation table is examples/api/thin_port_bias_table
+TEST(ThinPortBias, DocsTableIsCurrent) {
+  // The table of docs/thin_port_bias.md is examples/api/thin_port_bias_table
   // run with its defaults (the defaults of ThinPortBiasOptions). Every cell
   // is recomputed: the thin-port biases are printed with 4 decimals, so
   // they agree to 5e-5; the last column, the thick-port model's largest
@@ -89,14 +89,16 @@ TEST(ThinPortBias, ReadmeTableIsCurrent) {
   // 1e-9 of the exact tests, as must its recomputation.
   constexpr double kPrintedPrecision = 5e-5 + 1e-9;
   constexpr double kThickTolerance = 1e-9;
-  std::ifstream readme(std::string(RCM_SOURCE_DIR) + "/README.md");
-  ASSERT_TRUE(readme.good());
+  const std::string path =
+      std::string(RCM_SOURCE_DIR) + "/docs/thin_port_bias.md";
+  std::ifstream page(path);
+  ASSERT_TRUE(page.good()) << "cannot read " << path;
   std::string line;
-  while (std::getline(readme, line) &&
+  while (std::getline(page, line) &&
          line.find("<!-- thin-port-bias-table -->") == std::string::npos) {
   }
-  ASSERT_TRUE(readme.good()) << "README has no thin-port-bias-table marker";
-  std::getline(readme, line);  // | air gap \ glass | 0 mm | ... | thick |
+  ASSERT_TRUE(page.good()) << path << " has no thin-port-bias-table marker";
+  std::getline(page, line);  // | air gap \ glass | 0 mm | ... | thick |
   const std::vector<std::string> header = Cells(line);
   ASSERT_GE(header.size(), 4u);
   EXPECT_EQ(header.back(), "thick-port model, any glass");
@@ -104,9 +106,9 @@ TEST(ThinPortBias, ReadmeTableIsCurrent) {
   for (size_t i = 1; i + 1 < header.size(); ++i) {
     glass_mm.push_back(std::stod(header[i]));
   }
-  std::getline(readme, line);  // |---|---|
+  std::getline(page, line);  // |---|---|
   int rows = 0;
-  while (std::getline(readme, line) && line.rfind("|", 0) == 0) {
+  while (std::getline(page, line) && line.rfind("|", 0) == 0) {
     const std::vector<std::string> cells = Cells(line);
     ASSERT_EQ(cells.size(), glass_mm.size() + 2) << line;
     const double gap_mm = std::stod(cells[0]);
