@@ -6,7 +6,7 @@
 #
 #   scripts/test_sanitizers.sh [FUZZ_SECONDS]   (default 20 per target)
 #
-# scripts/fuzz.sh 600 is the long fuzzing run (README, "Sanitizers,
+# scripts/fuzz.sh 600 is the long fuzzing run (docs/testing.md, "Sanitizers,
 # fuzzing and bad input").
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,7 +15,8 @@ fuzz_seconds=${1:-20}
 cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_CXX_FLAGS=-gline-tables-only \
   -DRCM_SANITIZE=address,undefined -DRCM_BUILD_FUZZERS=ON \
-  -DRCM_BUILD_BENCHMARKS=OFF
+  -DRCM_BUILD_BENCHMARKS=OFF -DBUILD_SHARED_LIBS=OFF -DRCM_BUILD_PYTHON=OFF \
+  -DRCM_INSTALL=OFF
 cmake --build build-sanitize -j2
 
 # Reports abort the process (no recovery), with a symbolized stack.

@@ -5,7 +5,7 @@
 // the last column the largest |bias| over the glass thicknesses of the
 // estimate that is given the port (the thick-port model).
 //
-// The README's approximation table is its output with the defaults; a test
+// The approximation table of docs/thin_port_bias.md is its output with the defaults; a test
 // recomputes every cell of that table.
 #include <gflags/gflags.h>
 #include <glog/logging.h>

@@ -4,7 +4,7 @@
 
 DEFINE_string(target, "",
               "Kalibr target YAML (checkerboard, aprilgrid; or charuco, see "
-              "the README); instead of --board and its flags");
+              "docs/calibrate.md); instead of --board and its flags");
 DEFINE_string(board, "",
               "target type: chessboard (= checkerboard), aprilgrid, charuco");
 DEFINE_int32(cols, 0,

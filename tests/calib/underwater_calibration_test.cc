@@ -65,7 +65,7 @@ const Eigen::Vector3d kDriftRotation =
     0.5 * kDegree * Eigen::Vector3d(0.3, -1.0, 0.2).normalized();
 const Eigen::Vector3d kDriftTranslation(3e-4, -1e-4, 2e-4);
 
-// 8 mm air gap + 6 mm acrylic, the README's thick housing.
+// 8 mm air gap + 6 mm acrylic, the thick housing of docs/thick_ports.md.
 FlatPort ThickPort(double air_gap = 0.008) {
   FlatPort port;
   port.air_gap = air_gap;

@@ -452,7 +452,7 @@ std::optional<Eigen::Vector2d> ProjectThroughPort(
 }
 
 // Ports of every kind: thin, tilted thin, air gap only, glass only, thick
-// (8 mm gap + 6 mm glass, the README's housing), thick and tilted.
+// (8 mm gap + 6 mm glass, the housing of docs/thick_ports.md), thick and tilted.
 std::vector<FlatPort> PortsOfEveryKind() {
   FlatPort tilted_thin;
   tilted_thin.normal = TiltedPortNormal(2.0 * M_PI / 180.0, -1.1);

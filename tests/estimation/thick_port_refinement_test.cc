@@ -141,7 +141,7 @@ TEST(ThickPortRefinement, WithinOneAndAHalfCramerRaoBoundsWhereThinPortIsBiased)
 // evaluated at a noisy estimate overstates the spread. The test holds the
 // z-scores' sd within [0.5, 1.3] (never optimistic beyond sampling: its
 // sampling sd is 1/sqrt(60) = 0.13) and |mean| < 0.6 (3.3 sd of a mean of
-// 30). n and the gap are strongly correlated (the README's bias table: a
+// 30). n and the gap are strongly correlated (the bias table of docs/thin_port_bias.md: a
 // gap reads as a smaller n), which the reported correlation shows.
 TEST(ThickPortRefinement, MonteCarloJointAirGapSigmaIsHonest) {
   const StereoRig rig = test::AlphasenseRealisticRig();

@@ -3,7 +3,7 @@
 // exact, noise-free correspondences traced through a thick flat port
 // (flat_port.h), next to the estimate that is given the port (the
 // thick-port model). Noise-free, so the number is the model error alone; it is
-// what the README's approximation table reports, and what a user can
+// what the approximation table of docs/thin_port_bias.md reports, and what a user can
 // compute for their own rig and housing.
 #ifndef RCM_SIM_THIN_PORT_BIAS_H_
 #define RCM_SIM_THIN_PORT_BIAS_H_
