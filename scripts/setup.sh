@@ -25,6 +25,9 @@ packages=(
     libament-index-cpp-dev  # ROS 2 headers that rosbag's headers include
   clang-14 libclang-rt-14-dev  # sanitizer build and libFuzzer (test_sanitizers.sh)
   llvm-14              # llvm-symbolizer: source lines in sanitizer reports
+  pybind11-dev python3-dev python3-numpy  # the Python package (python/)
+  python3-pytest       # its tests
+  python3-opencv       # cv2.remap with rcm's maps, in the Python tests and docs
 )
 
 missing=()
