@@ -51,6 +51,19 @@ std::string PortRepr(const FlatPort& port) {
   return text.str();
 }
 
+DoubleArray IntrinsicsArray(const Camera& c) {
+  DoubleArray a(std::vector<py::ssize_t>{4});
+  for (int i = 0; i < 4; ++i) a.mutable_data()[i] = c.params()[i];
+  return a;
+}
+
+DoubleArray DistortionArray(const Camera& c) {
+  const std::vector<double> d = c.Distortion();
+  DoubleArray a(std::vector<py::ssize_t>{static_cast<py::ssize_t>(d.size())});
+  std::copy(d.begin(), d.end(), a.mutable_data());
+  return a;
+}
+
 // Applies `map` (input row -> optional output) to every row, without the
 // GIL; failed rows are NaN.
 template <int kIn, int kOut, typename Map>
@@ -130,21 +143,11 @@ message on a value outside the accepted ranges.
       .def_property_readonly("cy", &Camera::cy, "Principal point y, pixels.")
       .def_property_readonly(
           "intrinsics",
-          [](const Camera& c) {
-            DoubleArray a(std::vector<py::ssize_t>{4});
-            for (int i = 0; i < 4; ++i) a.mutable_data()[i] = c.params()[i];
-            return a;
-          },
+          &IntrinsicsArray,
           "[fx, fy, cx, cy] in pixels (float64 array).")
       .def_property_readonly(
           "distortion",
-          [](const Camera& c) {
-            const std::vector<double> d = c.Distortion();
-            DoubleArray a(std::vector<py::ssize_t>{
-                static_cast<py::ssize_t>(d.size())});
-            std::copy(d.begin(), d.end(), a.mutable_data());
-            return a;
-          },
+          &DistortionArray,
           "Distortion coefficients (0 or 4; float64 array).")
       .def_property_readonly(
           "K",
@@ -254,13 +257,11 @@ not: a pixel's ray starts on the outer glass face.
       .def_property_readonly("cx", [](const RigCamera& c) { return c.camera.cx(); })
       .def_property_readonly("cy", [](const RigCamera& c) { return c.camera.cy(); })
       .def_property_readonly("intrinsics",
-                             [](const RigCamera& c) {
-                               return py::cast(c.camera).attr("intrinsics");
-                             })
+                             [](const RigCamera& c) { return IntrinsicsArray(c.camera); },
+                             "[fx, fy, cx, cy] in pixels.")
       .def_property_readonly("distortion",
-                             [](const RigCamera& c) {
-                               return py::cast(c.camera).attr("distortion");
-                             })
+                             [](const RigCamera& c) { return DistortionArray(c.camera); },
+                             "Distortion coefficients (0 or 4).")
       .def(
           "pixel_to_ray",
           [](const RigCamera& c, const py::object& pixels, double n) {

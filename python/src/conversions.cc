@@ -128,11 +128,11 @@ Eigen::Vector3d Vector3FromPython(const py::handle& object,
 
 Eigen::Matrix4d Matrix4FromPython(const py::handle& object,
                                   const std::string& name) {
-  const Rows rows = RowsFromPython(object, name, 4, /*allow_single=*/false);
-  if (rows.rows != 4) {
-    ThrowValueError(name + " must have shape (4, 4), got (" +
-                    std::to_string(rows.rows) + ", 4)");
+  const py::array array = NumericArray(object, name);
+  if (array.ndim() != 2 || array.shape(0) != 4 || array.shape(1) != 4) {
+    ThrowValueError(name + " must have shape (4, 4), got " + ShapeText(array));
   }
+  const Rows rows = RowsFromPython(array, name, 4, /*allow_single=*/false);
   Eigen::Matrix4d matrix;
   for (int r = 0; r < 4; ++r) {
     for (int c = 0; c < 4; ++c) matrix(r, c) = rows.data()[4 * r + c];

@@ -177,11 +177,14 @@ struct ClosedFormResult {
   int64_t invalid = 0;
 };
 
+// As rcm estimate: the estimators but the batch assume the paper's thin
+// port, and a thick port (an air gap or glass) is refused, not estimated
+// with the wrong model.
 void RefuseThickPort(const StereoRig& rig, const std::string& what) {
   if (rig.HasThickPort()) {
-    ThrowValueError(what +
-                    " supports the thin port only; the rig has a thick port "
-                    "(use refine_refractive_index)");
+    ThrowValueError("the rig gives a thick port (an air gap or glass), which "
+                    "only refine_refractive_index models; " +
+                    what + " assumes the paper's thin port");
   }
 }
 
@@ -479,6 +482,7 @@ is in last_update.cumulative_error); current() returns it or raises
 ValueError with the reason. Thin ports only.
 )doc")
       .def(py::init([](const StereoRig& rig, const py::kwargs& kwargs) {
+             RefuseThickPort(rig, "the online estimator");
              const RefinementOptions options =
                  RefinementOptionsFrom(kwargs, "OnlineEstimator");
              return Online{ValueOrThrow(
@@ -587,6 +591,7 @@ Thin ports only.
       .def(py::init([](const StereoRig& rig, int window_frames,
                        double change_threshold, int confirm_frames,
                        const py::kwargs& kwargs) {
+             RefuseThickPort(rig, "the sliding-window estimator");
              const RefinementOptions options =
                  RefinementOptionsFrom(kwargs, "SlidingWindowEstimator");
              SlidingWindowOptions window;

@@ -67,3 +67,32 @@ def test_noisy_unrectified_data_with_options(tmp_path):
     assert py.sigma_n == pytest.approx(cpp["sigma_n"], rel=1e-12, abs=1e-15)
     assert py.num_inliers == cpp["inliers"]
     assert np.isfinite(py.n)
+
+
+def test_same_n_to_seventeen_digits(tmp_path):
+    # rcm_refine_timing (benchmarks/python/refine_timing.cc, built with the
+    # package next to rcm) prints n with %.17g: the exact double.
+    path = os.environ.get("RCM_REFINE_TIMING")
+    if not path and os.environ.get("RCM_EXECUTABLE"):
+        path = os.path.join(os.path.dirname(os.environ["RCM_EXECUTABLE"]),
+                            "rcm_refine_timing")
+    path = path or shutil.which("rcm_refine_timing")
+    if not path or not os.access(path, os.X_OK):
+        pytest.skip("rcm_refine_timing was not found (set RCM_REFINE_TIMING "
+                    "or RCM_EXECUTABLE=build/bin/rcm)")
+    rig = rcm.reference_rig("alphasense-unrectified")
+    rig_path = tmp_path / "rig.yaml"
+    rig.write(rig_path)
+    exact = rcm.sample_correspondences(rig, n=1.29, num_frames=4,
+                                       per_frame=250, seed=31)
+    csv_path = tmp_path / "m.csv"
+    rcm.write_correspondences(csv_path, rcm.add_pixel_noise(exact, 0.6,
+                                                            seed=32))
+    completed = subprocess.run([path, str(rig_path), str(csv_path)],
+                               capture_output=True, text=True, timeout=60,
+                               check=True)
+    cpp = json.loads(completed.stdout)
+    py = rcm.refine_refractive_index(rcm.read_stereo_rig(rig_path),
+                                     rcm.read_correspondences(csv_path))
+    assert abs(py.n - cpp["n"]) <= 1e-12
+    assert py.sigma_n == pytest.approx(cpp["sigma_n"], rel=1e-12)

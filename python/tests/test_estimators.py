@@ -17,11 +17,31 @@ def sample(rig, n, frames=2, per_frame=150, seed=3, **kwargs):
                                       per_frame=per_frame, seed=seed, **kwargs)
 
 
-@pytest.mark.parametrize("rig_name", ["alphasense-rectified",
-                                      "alphasense-unrectified", "narrow-field"])
+def ideal_rig_of(lens):
+    """Two copies of a lens on the ideal rectified extrinsics, 0.11 m."""
+    pose = np.eye(4)
+    pose[0, 3] = -0.11
+    return rcm.StereoRig(lens, lens, pose)
+
+
+# batch_refinement_test.cc's rigs: the dataset's (rectified and not), a
+# strongly distorted radtan lens (EuRoC cam0) and a pinhole.
+RIGS = {
+    "alphasense-rectified": lambda: rcm.reference_rig("alphasense-rectified"),
+    "alphasense-unrectified":
+        lambda: rcm.reference_rig("alphasense-unrectified"),
+    "euroc-radtan": lambda: ideal_rig_of(rcm.Camera(
+        "radtan", 752, 480, [458.654, 457.296, 367.215, 248.375],
+        [-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05])),
+    "pinhole": lambda: ideal_rig_of(
+        rcm.Camera("none", 640, 480, [400.0, 400.0, 319.5, 239.5])),
+}
+
+
+@pytest.mark.parametrize("rig_name", sorted(RIGS))
 @pytest.mark.parametrize("n", [1.0, 1.2, 1.333, 1.6])
 def test_exact_on_every_rig_and_index(rig_name, n):
-    rig = rcm.reference_rig(rig_name)
+    rig = RIGS[rig_name]()
     matches = sample(rig, n)
     result = rcm.refine_refractive_index(rig, matches)
     assert abs(result.n - n) < EXACT
