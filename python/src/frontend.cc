@@ -124,7 +124,8 @@ test, the cross check and the band verification.
         return Correspondences{m.matches};
       })
       .def_property_readonly("pixels", [](const StereoMatches& m) {
-        return py::cast(Correspondences{m.matches}).attr("pixels");
+        const py::object matches = py::cast(Correspondences{m.matches});
+        return py::object(matches.attr("pixels"));
       })
       .def("__len__", [](const StereoMatches& m) { return m.matches.size(); })
       .def_readonly("left_keypoints", &StereoMatches::left_keypoints)
