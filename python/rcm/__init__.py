@@ -27,6 +27,7 @@ Quick start::
 from ._version import __version__
 from . import _rcm
 from ._rcm import (
+    CalibrationTarget,
     Camera,
     ClosedFormResult,
     Correspondences,
@@ -40,48 +41,37 @@ from ._rcm import (
     RigCamera,
     SequenceSimulator,
     SlidingWindowEstimator,
+    StereoCalibrationResult,
+    StereoFrontEnd,
+    StereoMatches,
     StereoRig,
+    UnderwaterCalibrationResult,
     VirtualPinholeCamera,
     VirtualPinholeRig,
     WindowEstimate,
     WindowUpdate,
     add_outliers,
     add_pixel_noise,
+    calibrate_stereo,
+    calibrate_stereo_from_corners,
+    calibrate_underwater,
+    calibrate_underwater_from_corners,
     closed_form_n,
     closed_form_refractive_index,
     default_refinement_options,
+    match_stereo,
+    read_calibration_target,
     read_correspondences,
     read_stereo_rig,
     reference_rig,
     refine_refractive_index,
+    render_target,
     sample_correspondences,
     simulate,
     virtual_pinhole_maps,
     write_correspondences,
     write_stereo_rig,
 )
-
-
-def _optional(names):
-    """Re-exports the names the compiled module has (areas built later)."""
-    exported = []
-    for name in names:
-        if hasattr(_rcm, name):
-            globals()[name] = getattr(_rcm, name)
-            exported.append(name)
-    return exported
-
-
-_OPTIONAL = _optional([
-    "StereoFrontEnd",
-    "StereoMatches",
-    "match_stereo",
-    "CalibrationTarget",
-    "StereoCalibrationResult",
-    "calibrate_stereo",
-    "UnderwaterCalibrationResult",
-    "calibrate_underwater",
-])
 
 
 def remap(image, maps, interpolation=None):
