@@ -6,6 +6,8 @@
 #include <cmath>
 #include <iomanip>
 #include <limits>
+#include <memory>
+#include <mutex>
 #include <sstream>
 
 #include "bindings.h"
@@ -237,15 +239,19 @@ DoubleArray ClosedFormPerMatch(const StereoRig& rig, const py::object& matches) 
 }
 
 // The online and window estimators with the last update kept.
+// The estimators run without the GIL, so two Python threads may call one
+// object at once: `mutex` serializes them.
 struct Online {
   OnlineRefractiveIndexEstimator estimator;
   std::optional<OnlineRefractiveIndexEstimator::FrameUpdate> last;
+  std::shared_ptr<std::mutex> mutex = std::make_shared<std::mutex>();
 };
 
 struct Window {
   SlidingWindowRefractiveIndexEstimator estimator;
   std::optional<SlidingWindowRefractiveIndexEstimator::WindowUpdate> last;
   int64_t calls = 0;
+  std::shared_ptr<std::mutex> mutex = std::make_shared<std::mutex>();
 };
 
 template <typename T>
@@ -487,7 +493,7 @@ ValueError with the reason. Thin ports only.
                  RefinementOptionsFrom(kwargs, "OnlineEstimator");
              return Online{ValueOrThrow(
                                OnlineRefractiveIndexEstimator::Create(rig, options)),
-                           std::nullopt};
+                           std::nullopt, std::make_shared<std::mutex>()};
            }),
            py::arg("rig"))
       .def(
@@ -497,13 +503,20 @@ ValueError with the reason. Thin ports only.
                 MatchesFromPython(matches, "matches", /*allow_empty=*/true);
             {
               py::gil_scoped_release release;
+              const std::lock_guard<std::mutex> lock(*self.mutex);
               self.last = self.estimator.AddFrame(list);
             }
             return ValueOrNone(self.last->cumulative);
           },
-          py::arg("matches"))
+          py::arg("matches"),
+          "Adds one stereo pair's matches (any form refine_refractive_index "
+          "takes; an empty frame counts as skipped) and returns the "
+          "cumulative OnlineEstimate, or None while there is none (the "
+          "reason: last_update.cumulative_error). GIL released.")
       .def("current",
-           [](const Online& self) { return ValueOrThrow(self.estimator.Current()); })
+           [](const Online& self) { return ValueOrThrow(self.estimator.Current()); },
+           "The cumulative OnlineEstimate; ValueError with the reason while "
+           "there is none (too few inliers, n unobservable).")
       .def_property_readonly("last_update",
                              [](const Online& self) -> py::object {
                                if (!self.last) return py::none();
@@ -601,7 +614,7 @@ Thin ports only.
              ThrowIfError(window.Check());
              return Window{ValueOrThrow(SlidingWindowRefractiveIndexEstimator::Create(
                                rig, options, window)),
-                           std::nullopt, 0};
+                           std::nullopt, 0, std::make_shared<std::mutex>()};
            }),
            py::arg("rig"), py::arg("window_frames") = 20,
            py::arg("change_threshold") = 5.0, py::arg("confirm_frames") = 2)
@@ -610,17 +623,25 @@ Thin ports only.
           [](Window& self, const py::object& matches, std::optional<int64_t> frame) {
             const std::vector<StereoCorrespondence> list =
                 MatchesFromPython(matches, "matches", /*allow_empty=*/true);
-            const int64_t label = frame.value_or(self.calls);
-            ++self.calls;
             {
               py::gil_scoped_release release;
+              const std::lock_guard<std::mutex> lock(*self.mutex);
+              const int64_t label = frame.value_or(self.calls);
+              ++self.calls;
               self.last = self.estimator.AddFrame(label, list);
             }
             return ValueOrNone(self.last->window);
           },
-          py::arg("matches"), py::arg("frame") = py::none())
+          py::arg("matches"), py::arg("frame") = py::none(),
+          "Adds one stereo pair's matches and returns the window's "
+          "WindowEstimate after it, or None (reason: "
+          "last_update.window_error). `frame` labels the frame in the "
+          "reports and switches (default: the count of add_frame calls). "
+          "GIL released.")
       .def("current",
-           [](const Window& self) { return ValueOrThrow(self.estimator.Current()); })
+           [](const Window& self) { return ValueOrThrow(self.estimator.Current()); },
+           "The window's WindowEstimate; ValueError with the reason while "
+           "there is none.")
       .def_property_readonly("last_update",
                              [](const Window& self) -> py::object {
                                if (!self.last) return py::none();

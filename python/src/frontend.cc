@@ -2,6 +2,9 @@
 // pairs (NumPy uint8 images) to raw-pixel correspondences.
 #include <pybind11/stl.h>
 
+#include <memory>
+#include <mutex>
+
 #include "bindings.h"
 #include "conversions.h"
 #include "errors.h"
@@ -59,10 +62,11 @@ StereoFrontEndOptions FrontEndOptionsFrom(const py::dict& kwargs,
   return o;
 }
 
+// Match runs without the GIL and keeps state between frames: `mutex`
+// serializes calls from several Python threads.
 struct FrontEnd {
   StereoFrontEnd front_end;
-  int width = 0;
-  int height = 0;
+  std::shared_ptr<std::mutex> mutex = std::make_shared<std::mutex>();
 };
 
 StereoMatches Match(FrontEnd& self, const py::object& left,
@@ -85,6 +89,7 @@ StereoMatches Match(FrontEnd& self, const py::object& left,
   StatusOr<StereoMatches> matches = Status::Error("not matched");
   {
     py::gil_scoped_release release;
+    const std::lock_guard<std::mutex> lock(*self.mutex);
     matches = self.front_end.Match(left_image, right_image, frame, timestamp,
                                    interval);
   }
@@ -94,8 +99,7 @@ StereoMatches Match(FrontEnd& self, const py::object& left,
 FrontEnd MakeFrontEnd(const StereoRig& rig, const py::kwargs& kwargs) {
   return FrontEnd{
       ValueOrThrow(StereoFrontEnd::Create(
-          rig, FrontEndOptionsFrom(kwargs, "StereoFrontEnd"))),
-      rig.left().width(), rig.left().height()};
+          rig, FrontEndOptionsFrom(kwargs, "StereoFrontEnd")))};
 }
 
 constexpr const char* kOptionsDoc = R"doc(
@@ -165,7 +169,10 @@ the prior search_range). The GIL is released while it runs.
       .def(py::init(&MakeFrontEnd), py::arg("rig"))
       .def("match", &Match, py::arg("left"), py::arg("right"),
            py::arg("frame") = 0, py::arg("timestamp") = py::none(),
-           py::arg("guide") = py::none());
+           py::arg("guide") = py::none(),
+           "The matches of one stereo pair (StereoMatches), each with "
+           "`frame` and `timestamp` (seconds). guide: (min, max) n interval "
+           "of the current estimate, None for the prior search range.");
 
   static const std::string match_doc =
       std::string("StereoFrontEnd(rig, **options).match(left, right): the "
@@ -176,8 +183,7 @@ the prior search_range). The GIL is released while it runs.
       [](const StereoRig& rig, const py::object& left, const py::object& right,
          const py::kwargs& kwargs) {
         FrontEnd front_end{ValueOrThrow(StereoFrontEnd::Create(
-                               rig, FrontEndOptionsFrom(kwargs, "match_stereo"))),
-                           rig.left().width(), rig.left().height()};
+                               rig, FrontEndOptionsFrom(kwargs, "match_stereo")))};
         return Match(front_end, left, right, 0, std::nullopt, std::nullopt);
       },
       py::arg("rig"), py::arg("left"), py::arg("right"), match_doc.c_str());

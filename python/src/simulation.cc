@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <memory>
+#include <mutex>
 
 #include "bindings.h"
 #include "conversions.h"
@@ -147,8 +148,11 @@ SequenceOptions SequenceOptionsFrom(const py::kwargs& kwargs) {
   return options;
 }
 
+// Frame() is not thread-safe (the renderer caches rays) and runs without
+// the GIL: `mutex` serializes calls from several Python threads.
 struct Simulator {
   std::unique_ptr<SequenceSimulator> simulator;
+  std::shared_ptr<std::mutex> mutex = std::make_shared<std::mutex>();
 };
 
 py::dict FrameDict(const SequenceFrame& frame) {
@@ -179,6 +183,7 @@ py::dict FrameOf(Simulator& self, int index) {
   StatusOr<SequenceFrame> frame = Status::Error("not rendered");
   {
     py::gil_scoped_release release;
+    const std::lock_guard<std::mutex> lock(*self.mutex);
     frame = self.simulator->Frame(index);
   }
   return FrameDict(ValueOrThrow(std::move(frame)));
@@ -192,7 +197,8 @@ Simulator MakeSimulator(const StereoRig& rig, const py::kwargs& kwargs) {
     py::gil_scoped_release release;
     simulator = SequenceSimulator::Create(rig, options);
   }
-  return Simulator{ValueOrThrow(std::move(simulator))};
+  return Simulator{ValueOrThrow(std::move(simulator)),
+                   std::make_shared<std::mutex>()};
 }
 
 constexpr const char* kSequenceOptionsDoc = R"doc(
@@ -252,7 +258,9 @@ iterating renders every frame.
       kSequenceOptionsDoc;
   py::class_<Simulator>(module, "SequenceSimulator", simulator_doc.c_str())
       .def(py::init(&MakeSimulator), py::arg("rig"))
-      .def("frame", &FrameOf, py::arg("index"))
+      .def("frame", &FrameOf, py::arg("index"),
+           "Renders frame `index` in [0, len) and samples its matches: a dict "
+           "(see the class). IndexError out of range. GIL released.")
       .def("__len__", [](const Simulator& s) { return s.simulator->num_frames(); })
       .def_property_readonly("rig", [](const Simulator& s) { return s.simulator->rig(); },
                              "The in-air calibration (what a user has).")

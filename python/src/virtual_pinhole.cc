@@ -160,7 +160,7 @@ Kalibr camchain). Build it with rcm.virtual_pinhole_maps.
            [](const VirtualPinholeRig& r, int index) {
              if (index != 0 && index != 1) ThrowValueError("index must be 0 or 1");
              return index == 0 ? r.left() : r.right();
-           }, py::arg("index"))
+           }, py::arg("index"), "The corrected camera 0 (left) or 1 (right).")
       .def_property_readonly("corrected_rig", &VirtualPinholeRig::corrected_rig)
       .def_property_readonly("n", &VirtualPinholeRig::n)
       .def_property_readonly("build_ms", &VirtualPinholeRig::build_ms)
