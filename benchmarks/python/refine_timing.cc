@@ -43,18 +43,19 @@ int main(int argc, char** argv) {
   rcm::StatusOr<rcm::RefinementSummary> summary = rcm::Status::Error("not run");
   for (int i = 0; i < repeats; ++i) {
     const auto start = std::chrono::steady_clock::now();
-    summary = rcm::RefineRefractiveIndex(*rig, *matches,
-                                         rcm::RefinementOptions());
-    seconds.push_back(std::chrono::duration<double>(
-                          std::chrono::steady_clock::now() - start)
-                          .count());
+    summary =
+        rcm::RefineRefractiveIndex(*rig, *matches, rcm::RefinementOptions());
+    seconds.push_back(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+            .count());
     if (!summary.ok()) {
       std::fprintf(stderr, "%s\n", summary.status().message().c_str());
       return 1;
     }
   }
-  std::printf("{\"n\": %.17g, \"sigma_n\": %.17g, \"inliers\": %zu, \"seconds\": [",
-              summary->n, summary->sigma_n, summary->inliers.size());
+  std::printf(
+      "{\"n\": %.17g, \"sigma_n\": %.17g, \"inliers\": %zu, \"seconds\": [",
+      summary->n, summary->sigma_n, summary->inliers.size());
   for (size_t i = 0; i < seconds.size(); ++i) {
     std::printf("%s%.6f", i ? ", " : "", seconds[i]);
   }

@@ -60,8 +60,7 @@ Detections Detect(const CalibrationTarget& target, const py::sequence& left,
     for (int side = 0; side < 2; ++side) {
       const std::string name = std::string(side ? "right" : "left") +
                                "_images[" + std::to_string(i) + "]";
-      const cv::Mat image =
-          ImageOrFile((side ? right : left)[i], name, &keep);
+      const cv::Mat image = ImageOrFile((side ? right : left)[i], name, &keep);
       ImageSize& size = detections.sizes[side];
       if (i == 0) size = {image.cols, image.rows};
       if (image.cols != size.width || image.rows != size.height) {
@@ -95,8 +94,8 @@ std::optional<TargetObservation> ObservationFrom(const py::handle& item,
     ThrowValueError(name + " must be None or (point_ids, pixels)");
   }
   const py::array ids_array = py::array::ensure(pair[0]);
-  if (!ids_array || (ids_array.dtype().kind() != 'i' &&
-                     ids_array.dtype().kind() != 'u')) {
+  if (!ids_array ||
+      (ids_array.dtype().kind() != 'i' && ids_array.dtype().kind() != 'u')) {
     ThrowTypeError(name + " point ids must be integers");
   }
   const auto ids =
@@ -130,8 +129,10 @@ std::vector<StereoView> ViewsFromCorners(const CalibrationTarget& target,
     view.left_name = "view " + std::to_string(v);
     view.right_name = view.left_name;
     view.left = ObservationFrom(pair[0], "views[" + std::to_string(v) + "][0]");
-    view.right = ObservationFrom(pair[1], "views[" + std::to_string(v) + "][1]");
-    for (const std::optional<TargetObservation>* o : {&view.left, &view.right}) {
+    view.right =
+        ObservationFrom(pair[1], "views[" + std::to_string(v) + "][1]");
+    for (const std::optional<TargetObservation>* o :
+         {&view.left, &view.right}) {
       if (!*o) continue;
       for (const int id : (*o)->point_ids) {
         if (id < 0 || id >= num_points) {
@@ -160,18 +161,18 @@ calib::StereoCalibrationOptions StereoOptionsFrom(const std::string& model,
                     "'");
   }
   o.model = *lens;
-  ApplyOptions(kwargs,
-               {DoubleOption("huber_px", &o.huber_px),
-                DoubleOption("outlier_sigmas", &o.outlier_sigmas),
-                DoubleOption("min_outlier_threshold_px",
-                             &o.min_outlier_threshold_px),
-                IntOption("max_outlier_rounds", &o.max_outlier_rounds),
-                IntOption("max_num_iterations", &o.max_num_iterations),
-                BoolOption("use_single_camera_views", &o.use_single_camera_views),
-                IntOption("min_corners_per_view", &o.min_corners_per_view),
-                BoolOption("compute_covariance", &o.compute_covariance),
-                IntOption("num_threads", &o.num_threads)},
-               "calibrate_stereo");
+  ApplyOptions(
+      kwargs,
+      {DoubleOption("huber_px", &o.huber_px),
+       DoubleOption("outlier_sigmas", &o.outlier_sigmas),
+       DoubleOption("min_outlier_threshold_px", &o.min_outlier_threshold_px),
+       IntOption("max_outlier_rounds", &o.max_outlier_rounds),
+       IntOption("max_num_iterations", &o.max_num_iterations),
+       BoolOption("use_single_camera_views", &o.use_single_camera_views),
+       IntOption("min_corners_per_view", &o.min_corners_per_view),
+       BoolOption("compute_covariance", &o.compute_covariance),
+       IntOption("num_threads", &o.num_threads)},
+      "calibrate_stereo");
   ThrowIfError(o.Check());
   return o;
 }
@@ -179,22 +180,22 @@ calib::StereoCalibrationOptions StereoOptionsFrom(const std::string& model,
 calib::UnderwaterCalibrationOptions UnderwaterOptionsFrom(
     const py::kwargs& kwargs) {
   calib::UnderwaterCalibrationOptions o;
-  ApplyOptions(kwargs,
-               {DoubleOption("initial_n", &o.initial_n),
-                BoolOption("estimate_air_gap", &o.estimate_air_gap),
-                BoolOption("estimate_port_tilt", &o.estimate_port_tilt),
-                DoubleOption("huber_px", &o.huber_px),
-                DoubleOption("outlier_sigmas", &o.outlier_sigmas),
-                DoubleOption("min_outlier_threshold_px",
-                             &o.min_outlier_threshold_px),
-                IntOption("max_outlier_rounds", &o.max_outlier_rounds),
-                IntOption("max_num_iterations", &o.max_num_iterations),
-                BoolOption("use_single_camera_views", &o.use_single_camera_views),
-                IntOption("min_corners_per_view", &o.min_corners_per_view),
-                IntOption("folds", &o.folds),
-                BoolOption("fit_conventional_model", &o.fit_conventional_model),
-                IntOption("num_threads", &o.num_threads)},
-               "calibrate_underwater");
+  ApplyOptions(
+      kwargs,
+      {DoubleOption("initial_n", &o.initial_n),
+       BoolOption("estimate_air_gap", &o.estimate_air_gap),
+       BoolOption("estimate_port_tilt", &o.estimate_port_tilt),
+       DoubleOption("huber_px", &o.huber_px),
+       DoubleOption("outlier_sigmas", &o.outlier_sigmas),
+       DoubleOption("min_outlier_threshold_px", &o.min_outlier_threshold_px),
+       IntOption("max_outlier_rounds", &o.max_outlier_rounds),
+       IntOption("max_num_iterations", &o.max_num_iterations),
+       BoolOption("use_single_camera_views", &o.use_single_camera_views),
+       IntOption("min_corners_per_view", &o.min_corners_per_view),
+       IntOption("folds", &o.folds),
+       BoolOption("fit_conventional_model", &o.fit_conventional_model),
+       IntOption("num_threads", &o.num_threads)},
+      "calibrate_underwater");
   ThrowIfError(o.Check());
   return o;
 }
@@ -206,10 +207,10 @@ struct StereoCalibrationResult {
   std::vector<std::string> notes;
 };
 
-StereoCalibrationResult RunStereo(const CalibrationTarget& target,
-                                  const std::vector<StereoView>& views,
-                                  const ImageSize& cam0, const ImageSize& cam1,
-                                  const calib::StereoCalibrationOptions& options) {
+StereoCalibrationResult RunStereo(
+    const CalibrationTarget& target, const std::vector<StereoView>& views,
+    const ImageSize& cam0, const ImageSize& cam1,
+    const calib::StereoCalibrationOptions& options) {
   StatusOr<calib::StereoCalibration> calibration = Status::Error("not run");
   {
     py::gil_scoped_release release;
@@ -230,11 +231,10 @@ struct UnderwaterResult {
   std::vector<std::string> notes;
 };
 
-UnderwaterResult RunUnderwater(const CalibrationTarget& target,
-                               const std::vector<StereoView>& views,
-                               const ImageSize& cam0, const ImageSize& cam1,
-                               const StereoRig& air_rig,
-                               const calib::UnderwaterCalibrationOptions& options) {
+UnderwaterResult RunUnderwater(
+    const CalibrationTarget& target, const std::vector<StereoView>& views,
+    const ImageSize& cam0, const ImageSize& cam1, const StereoRig& air_rig,
+    const calib::UnderwaterCalibrationOptions& options) {
   StatusOr<calib::UnderwaterCalibration> calibration = Status::Error("not run");
   {
     py::gil_scoped_release release;
@@ -253,7 +253,8 @@ UnderwaterResult RunUnderwater(const CalibrationTarget& target,
 
 DoubleArray Sigmas(const calib::CameraCalibration& c) {
   DoubleArray a(std::vector<py::ssize_t>{c.camera.num_params()});
-  for (int i = 0; i < c.camera.num_params(); ++i) a.mutable_data()[i] = c.sigma[i];
+  for (int i = 0; i < c.camera.num_params(); ++i)
+    a.mutable_data()[i] = c.sigma[i];
   return a;
 }
 
@@ -288,7 +289,8 @@ point-id order.
       .def_static(
           "checkerboard",
           [](int cols, int rows, double square) {
-            return ValueOrThrow(calib::MakeCheckerboardTarget(cols, rows, square));
+            return ValueOrThrow(
+                calib::MakeCheckerboardTarget(cols, rows, square));
           },
           py::arg("cols"), py::arg("rows"), py::arg("square"))
       .def_static(
@@ -361,11 +363,12 @@ point-id order.
         if (!(pixels_per_metre > 0.0) || !std::isfinite(pixels_per_metre) ||
             extent.x() * extent.y() * pixels_per_metre * pixels_per_metre >
                 1e8) {
-          ThrowValueError("pixels_per_metre must be > 0 and keep the texture "
-                          "below 1e8 pixels");
+          ThrowValueError(
+              "pixels_per_metre must be > 0 and keep the texture "
+              "below 1e8 pixels");
         }
-        const calib::TargetRenderer renderer = ValueOrThrow(
-            calib::TargetRenderer::Create(
+        const calib::TargetRenderer renderer =
+            ValueOrThrow(calib::TargetRenderer::Create(
                 camera, calib::DrawTargetImage(target, pixels_per_metre)));
         cv::Mat image;
         {
@@ -375,9 +378,9 @@ point-id order.
         return ImageToNumpy(image);
       },
       py::arg("camera"), py::arg("target"), py::arg("cam_from_target"),
-      py::kw_only(), py::arg("supersampling") = 4, py::arg("blur_sigma_px") = 0.0,
-      py::arg("noise_sigma") = 0.0, py::arg("seed") = 0,
-      py::arg("pixels_per_metre") = 4000.0,
+      py::kw_only(), py::arg("supersampling") = 4,
+      py::arg("blur_sigma_px") = 0.0, py::arg("noise_sigma") = 0.0,
+      py::arg("seed") = 0, py::arg("pixels_per_metre") = 4000.0,
       R"doc(
 A synthetic 8-bit image (uint8 (H, W)) of the target seen in air by an
 rcm.Camera at cam_from_target (4x4, meters; target points map into the
@@ -396,57 +399,79 @@ num_stereo_views, num_inliers, num_outliers, num_parameters,
 cam0_from_target (per input view: 4x4 or None), notes (why views were
 dropped).
 )doc")
-      .def_property_readonly("rig", [](const StereoCalibrationResult& r) { return r.rig; })
-      .def_property_readonly("rms_px", [](const StereoCalibrationResult& r) { return r.calibration.rms_px; })
-      .def_property_readonly("inlier_rms_px", [](const StereoCalibrationResult& r) {
-        return r.calibration.inlier_rms_px;
-      })
-      .def_property_readonly("pixel_sigma", [](const StereoCalibrationResult& r) {
-        return r.calibration.pixel_sigma;
-      })
-      .def_property_readonly("initial_rms_px", [](const StereoCalibrationResult& r) {
-        return r.calibration.initial_rms_px;
-      })
-      .def_property_readonly("baseline", [](const StereoCalibrationResult& r) {
-        return r.calibration.baseline;
-      })
-      .def_property_readonly("baseline_sigma", [](const StereoCalibrationResult& r) {
-        return r.calibration.baseline_sigma;
-      })
-      .def_property_readonly("cam0_sigma", [](const StereoCalibrationResult& r) {
-        return Sigmas(r.calibration.cam0);
-      })
-      .def_property_readonly("cam1_sigma", [](const StereoCalibrationResult& r) {
-        return Sigmas(r.calibration.cam1);
-      })
-      .def_property_readonly("extrinsics_covariance", [](const StereoCalibrationResult& r) {
-        return ToNumpy(r.calibration.extrinsics_covariance);
-      })
-      .def_property_readonly("num_views_used", [](const StereoCalibrationResult& r) {
-        return r.calibration.num_views_used;
-      })
-      .def_property_readonly("num_stereo_views", [](const StereoCalibrationResult& r) {
-        return r.calibration.num_stereo_views;
-      })
-      .def_property_readonly("num_inliers", [](const StereoCalibrationResult& r) {
-        return r.calibration.num_inliers;
-      })
-      .def_property_readonly("num_outliers", [](const StereoCalibrationResult& r) {
-        return r.calibration.num_outliers;
-      })
-      .def_property_readonly("num_parameters", [](const StereoCalibrationResult& r) {
-        return r.calibration.num_parameters;
-      })
-      .def_property_readonly("cam0_from_target", [](const StereoCalibrationResult& r) {
-        py::list poses;
-        for (const std::optional<Rigid3d>& pose : r.calibration.cam0_from_target) {
-          poses.append(pose ? py::object(ToNumpy(pose->ToMatrix())) : py::object(py::none()));
-        }
-        return poses;
-      })
+      .def_property_readonly(
+          "rig", [](const StereoCalibrationResult& r) { return r.rig; })
+      .def_property_readonly(
+          "rms_px",
+          [](const StereoCalibrationResult& r) { return r.calibration.rms_px; })
+      .def_property_readonly("inlier_rms_px",
+                             [](const StereoCalibrationResult& r) {
+                               return r.calibration.inlier_rms_px;
+                             })
+      .def_property_readonly("pixel_sigma",
+                             [](const StereoCalibrationResult& r) {
+                               return r.calibration.pixel_sigma;
+                             })
+      .def_property_readonly("initial_rms_px",
+                             [](const StereoCalibrationResult& r) {
+                               return r.calibration.initial_rms_px;
+                             })
+      .def_property_readonly("baseline",
+                             [](const StereoCalibrationResult& r) {
+                               return r.calibration.baseline;
+                             })
+      .def_property_readonly("baseline_sigma",
+                             [](const StereoCalibrationResult& r) {
+                               return r.calibration.baseline_sigma;
+                             })
+      .def_property_readonly("cam0_sigma",
+                             [](const StereoCalibrationResult& r) {
+                               return Sigmas(r.calibration.cam0);
+                             })
+      .def_property_readonly("cam1_sigma",
+                             [](const StereoCalibrationResult& r) {
+                               return Sigmas(r.calibration.cam1);
+                             })
+      .def_property_readonly(
+          "extrinsics_covariance",
+          [](const StereoCalibrationResult& r) {
+            return ToNumpy(r.calibration.extrinsics_covariance);
+          })
+      .def_property_readonly("num_views_used",
+                             [](const StereoCalibrationResult& r) {
+                               return r.calibration.num_views_used;
+                             })
+      .def_property_readonly("num_stereo_views",
+                             [](const StereoCalibrationResult& r) {
+                               return r.calibration.num_stereo_views;
+                             })
+      .def_property_readonly("num_inliers",
+                             [](const StereoCalibrationResult& r) {
+                               return r.calibration.num_inliers;
+                             })
+      .def_property_readonly("num_outliers",
+                             [](const StereoCalibrationResult& r) {
+                               return r.calibration.num_outliers;
+                             })
+      .def_property_readonly("num_parameters",
+                             [](const StereoCalibrationResult& r) {
+                               return r.calibration.num_parameters;
+                             })
+      .def_property_readonly(
+          "cam0_from_target",
+          [](const StereoCalibrationResult& r) {
+            py::list poses;
+            for (const std::optional<Rigid3d>& pose :
+                 r.calibration.cam0_from_target) {
+              poses.append(pose ? py::object(ToNumpy(pose->ToMatrix()))
+                                : py::object(py::none()));
+            }
+            return poses;
+          })
       .def_readonly("notes", &StereoCalibrationResult::notes)
       .def("__repr__", [](const StereoCalibrationResult& r) {
-        return "StereoCalibrationResult(rms_px=" + std::to_string(r.calibration.rms_px) +
+        return "StereoCalibrationResult(rms_px=" +
+               std::to_string(r.calibration.rms_px) +
                ", views_used=" + std::to_string(r.calibration.num_views_used) +
                ", baseline=" + std::to_string(r.calibration.baseline) + " m)";
       });
@@ -508,68 +533,86 @@ tilt_estimated, tilt_deg), rms_px, inlier_rms_px, pixel_sigma,
 initial_rms_px, num_views_used, num_stereo_views, num_inliers,
 num_outliers, num_parameters, notes.
 )doc")
-      .def_property_readonly("n", [](const UnderwaterResult& r) { return r.calibration.n; })
-      .def_property_readonly("sigma_n", [](const UnderwaterResult& r) { return r.calibration.sigma_n; })
-      .def_property_readonly("sigma_n_leave_out", [](const UnderwaterResult& r) -> py::object {
-        if (!r.calibration.sigma_n_leave_out) return py::none();
-        return py::float_(*r.calibration.sigma_n_leave_out);
-      })
-      .def_property_readonly("rig", [](const UnderwaterResult& r) { return r.calibration.rig; })
-      .def_property_readonly("extrinsics_estimated", [](const UnderwaterResult& r) {
-        return r.calibration.extrinsics_estimated;
-      })
-      .def_property_readonly("extrinsic_change", [](const UnderwaterResult& r) {
-        const calib::ExtrinsicChange& c = r.calibration.extrinsic_change;
-        py::dict d;
-        d["rotation_deg"] = ToNumpy(c.rotation_deg);
-        d["rotation_sigma_deg"] = ToNumpy(c.rotation_sigma_deg);
-        d["angle_deg"] = c.angle_deg;
-        d["angle_sigma_deg"] = c.angle_sigma_deg;
-        d["translation_mm"] = ToNumpy(c.translation_mm);
-        d["translation_sigma_mm"] = ToNumpy(c.translation_sigma_mm);
-        return d;
-      })
-      .def_property_readonly("ports", [](const UnderwaterResult& r) {
-        py::list ports;
-        for (const calib::PortEstimate& p : r.calibration.ports) {
-          py::dict d;
-          d["port"] = p.port;
-          d["air_gap_estimated"] = p.air_gap_estimated;
-          d["air_gap_sigma"] = p.air_gap_sigma;
-          d["tilt_estimated"] = p.tilt_estimated;
-          d["tilt_deg"] = p.tilt_deg;
-          ports.append(d);
-        }
-        return ports;
-      })
-      .def_property_readonly("rms_px", [](const UnderwaterResult& r) { return r.calibration.rms_px; })
-      .def_property_readonly("inlier_rms_px", [](const UnderwaterResult& r) {
-        return r.calibration.inlier_rms_px;
-      })
-      .def_property_readonly("pixel_sigma", [](const UnderwaterResult& r) {
-        return r.calibration.pixel_sigma;
-      })
-      .def_property_readonly("initial_rms_px", [](const UnderwaterResult& r) {
-        return r.calibration.initial_rms_px;
-      })
-      .def_property_readonly("num_views_used", [](const UnderwaterResult& r) {
-        return r.calibration.num_views_used;
-      })
-      .def_property_readonly("num_stereo_views", [](const UnderwaterResult& r) {
-        return r.calibration.num_stereo_views;
-      })
-      .def_property_readonly("num_inliers", [](const UnderwaterResult& r) {
-        return r.calibration.num_inliers;
-      })
-      .def_property_readonly("num_outliers", [](const UnderwaterResult& r) {
-        return r.calibration.num_outliers;
-      })
-      .def_property_readonly("num_parameters", [](const UnderwaterResult& r) {
-        return r.calibration.num_parameters;
-      })
+      .def_property_readonly(
+          "n", [](const UnderwaterResult& r) { return r.calibration.n; })
+      .def_property_readonly(
+          "sigma_n",
+          [](const UnderwaterResult& r) { return r.calibration.sigma_n; })
+      .def_property_readonly(
+          "sigma_n_leave_out",
+          [](const UnderwaterResult& r) -> py::object {
+            if (!r.calibration.sigma_n_leave_out) return py::none();
+            return py::float_(*r.calibration.sigma_n_leave_out);
+          })
+      .def_property_readonly(
+          "rig", [](const UnderwaterResult& r) { return r.calibration.rig; })
+      .def_property_readonly("extrinsics_estimated",
+                             [](const UnderwaterResult& r) {
+                               return r.calibration.extrinsics_estimated;
+                             })
+      .def_property_readonly(
+          "extrinsic_change",
+          [](const UnderwaterResult& r) {
+            const calib::ExtrinsicChange& c = r.calibration.extrinsic_change;
+            py::dict d;
+            d["rotation_deg"] = ToNumpy(c.rotation_deg);
+            d["rotation_sigma_deg"] = ToNumpy(c.rotation_sigma_deg);
+            d["angle_deg"] = c.angle_deg;
+            d["angle_sigma_deg"] = c.angle_sigma_deg;
+            d["translation_mm"] = ToNumpy(c.translation_mm);
+            d["translation_sigma_mm"] = ToNumpy(c.translation_sigma_mm);
+            return d;
+          })
+      .def_property_readonly(
+          "ports",
+          [](const UnderwaterResult& r) {
+            py::list ports;
+            for (const calib::PortEstimate& p : r.calibration.ports) {
+              py::dict d;
+              d["port"] = p.port;
+              d["air_gap_estimated"] = p.air_gap_estimated;
+              d["air_gap_sigma"] = p.air_gap_sigma;
+              d["tilt_estimated"] = p.tilt_estimated;
+              d["tilt_deg"] = p.tilt_deg;
+              ports.append(d);
+            }
+            return ports;
+          })
+      .def_property_readonly(
+          "rms_px",
+          [](const UnderwaterResult& r) { return r.calibration.rms_px; })
+      .def_property_readonly(
+          "inlier_rms_px",
+          [](const UnderwaterResult& r) { return r.calibration.inlier_rms_px; })
+      .def_property_readonly(
+          "pixel_sigma",
+          [](const UnderwaterResult& r) { return r.calibration.pixel_sigma; })
+      .def_property_readonly("initial_rms_px",
+                             [](const UnderwaterResult& r) {
+                               return r.calibration.initial_rms_px;
+                             })
+      .def_property_readonly("num_views_used",
+                             [](const UnderwaterResult& r) {
+                               return r.calibration.num_views_used;
+                             })
+      .def_property_readonly("num_stereo_views",
+                             [](const UnderwaterResult& r) {
+                               return r.calibration.num_stereo_views;
+                             })
+      .def_property_readonly(
+          "num_inliers",
+          [](const UnderwaterResult& r) { return r.calibration.num_inliers; })
+      .def_property_readonly(
+          "num_outliers",
+          [](const UnderwaterResult& r) { return r.calibration.num_outliers; })
+      .def_property_readonly("num_parameters",
+                             [](const UnderwaterResult& r) {
+                               return r.calibration.num_parameters;
+                             })
       .def_readonly("notes", &UnderwaterResult::notes)
       .def("__repr__", [](const UnderwaterResult& r) {
-        return "UnderwaterCalibrationResult(n=" + std::to_string(r.calibration.n) +
+        return "UnderwaterCalibrationResult(n=" +
+               std::to_string(r.calibration.n) +
                ", sigma_n=" + std::to_string(r.calibration.sigma_n) +
                ", rms_px=" + std::to_string(r.calibration.rms_px) + ")";
       });

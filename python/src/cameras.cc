@@ -46,8 +46,9 @@ std::string PortRepr(const FlatPort& port) {
   text.precision(10);
   text << "FlatPort(air_gap=" << port.air_gap
        << ", glass_thickness=" << port.glass_thickness
-       << ", glass_index=" << port.glass_index << ", normal=[" << port.normal.x()
-       << ", " << port.normal.y() << ", " << port.normal.z() << "])";
+       << ", glass_index=" << port.glass_index << ", normal=["
+       << port.normal.x() << ", " << port.normal.y() << ", " << port.normal.z()
+       << "])";
   return text.str();
 }
 
@@ -78,8 +79,7 @@ DoubleArray MapRows(const py::handle& input, const std::string& name,
     for (int64_t i = 0; i < rows.rows; ++i) {
       const Eigen::Map<const Eigen::Matrix<double, kIn, 1>> x(in + kIn * i);
       const std::optional<Eigen::Matrix<double, kOut, 1>> y =
-          x.allFinite() ? map(Eigen::Matrix<double, kIn, 1>(x))
-                        : std::nullopt;
+          x.allFinite() ? map(Eigen::Matrix<double, kIn, 1>(x)) : std::nullopt;
       for (int k = 0; k < kOut; ++k) out[kOut * i + k] = y ? (*y)[k] : kNaN;
     }
   }
@@ -131,8 +131,7 @@ message on a value outside the accepted ranges.
           [](const Camera& c) { return std::string(LensModelName(c.model())); },
           "Lens model name: 'none', 'radtan' or 'equidistant'.")
       .def_property_readonly("width", &Camera::width, "Image width, pixels.")
-      .def_property_readonly("height", &Camera::height,
-                             "Image height, pixels.")
+      .def_property_readonly("height", &Camera::height, "Image height, pixels.")
       .def_property_readonly(
           "image_size",
           [](const Camera& c) { return py::make_tuple(c.width(), c.height()); },
@@ -141,14 +140,10 @@ message on a value outside the accepted ranges.
       .def_property_readonly("fy", &Camera::fy, "Focal length y, pixels.")
       .def_property_readonly("cx", &Camera::cx, "Principal point x, pixels.")
       .def_property_readonly("cy", &Camera::cy, "Principal point y, pixels.")
-      .def_property_readonly(
-          "intrinsics",
-          &IntrinsicsArray,
-          "[fx, fy, cx, cy] in pixels (float64 array).")
-      .def_property_readonly(
-          "distortion",
-          &DistortionArray,
-          "Distortion coefficients (0 or 4; float64 array).")
+      .def_property_readonly("intrinsics", &IntrinsicsArray,
+                             "[fx, fy, cx, cy] in pixels (float64 array).")
+      .def_property_readonly("distortion", &DistortionArray,
+                             "Distortion coefficients (0 or 4; float64 array).")
       .def_property_readonly(
           "K",
           [](const Camera& c) {
@@ -160,9 +155,10 @@ message on a value outside the accepted ranges.
       .def(
           "normalized_from_image",
           [](const Camera& c, const py::object& pixels) {
-            return MapRows<2, 2>(pixels, "pixels", [&](const Eigen::Vector2d& p) {
-              return c.NormalizedFromImage(p);
-            });
+            return MapRows<2, 2>(pixels, "pixels",
+                                 [&](const Eigen::Vector2d& p) {
+                                   return c.NormalizedFromImage(p);
+                                 });
           },
           py::arg("pixels"),
           "Lens-undistorted normalized coordinates (z = 1 plane) of raw "
@@ -181,12 +177,12 @@ message on a value outside the accepted ranges.
       .def(
           "in_image",
           [](const Camera& c, const py::object& pixels) {
-            const Rows rows = RowsFromPython(pixels, "pixels", 2, true, true,
-                                             false);
+            const Rows rows =
+                RowsFromPython(pixels, "pixels", 2, true, true, false);
             py::array_t<bool> out(std::vector<py::ssize_t>{rows.rows});
             for (int64_t i = 0; i < rows.rows; ++i) {
-              out.mutable_data()[i] = c.InImage(
-                  {rows.data()[2 * i], rows.data()[2 * i + 1]});
+              out.mutable_data()[i] =
+                  c.InImage({rows.data()[2 * i], rows.data()[2 * i + 1]});
             }
             return out;
           },
@@ -222,7 +218,8 @@ paper's thin port. Raises ValueError with the library's message.
       .def_property_readonly("is_thin", &FlatPort::IsThin,
                              "True for the paper's thin port (no gap, no "
                              "glass, normal +z).")
-      .def("__eq__", [](const FlatPort& a, const FlatPort& b) { return a == b; })
+      .def("__eq__",
+           [](const FlatPort& a, const FlatPort& b) { return a == b; })
       .def("__repr__", &PortRepr);
 
   py::class_<RigCamera>(module, "RigCamera", R"doc(
@@ -243,25 +240,31 @@ not: a pixel's ray starts on the outer glass face.
           [](const RigCamera& c) {
             return std::string(LensModelName(c.camera.model()));
           })
-      .def_property_readonly("width",
-                             [](const RigCamera& c) { return c.camera.width(); })
+      .def_property_readonly(
+          "width", [](const RigCamera& c) { return c.camera.width(); })
       .def_property_readonly(
           "height", [](const RigCamera& c) { return c.camera.height(); })
+      .def_property_readonly("image_size",
+                             [](const RigCamera& c) {
+                               return py::make_tuple(c.camera.width(),
+                                                     c.camera.height());
+                             })
+      .def_property_readonly("fx",
+                             [](const RigCamera& c) { return c.camera.fx(); })
+      .def_property_readonly("fy",
+                             [](const RigCamera& c) { return c.camera.fy(); })
+      .def_property_readonly("cx",
+                             [](const RigCamera& c) { return c.camera.cx(); })
+      .def_property_readonly("cy",
+                             [](const RigCamera& c) { return c.camera.cy(); })
       .def_property_readonly(
-          "image_size",
-          [](const RigCamera& c) {
-            return py::make_tuple(c.camera.width(), c.camera.height());
-          })
-      .def_property_readonly("fx", [](const RigCamera& c) { return c.camera.fx(); })
-      .def_property_readonly("fy", [](const RigCamera& c) { return c.camera.fy(); })
-      .def_property_readonly("cx", [](const RigCamera& c) { return c.camera.cx(); })
-      .def_property_readonly("cy", [](const RigCamera& c) { return c.camera.cy(); })
-      .def_property_readonly("intrinsics",
-                             [](const RigCamera& c) { return IntrinsicsArray(c.camera); },
-                             "[fx, fy, cx, cy] in pixels.")
-      .def_property_readonly("distortion",
-                             [](const RigCamera& c) { return DistortionArray(c.camera); },
-                             "Distortion coefficients (0 or 4).")
+          "intrinsics",
+          [](const RigCamera& c) { return IntrinsicsArray(c.camera); },
+          "[fx, fy, cx, cy] in pixels.")
+      .def_property_readonly(
+          "distortion",
+          [](const RigCamera& c) { return DistortionArray(c.camera); },
+          "Distortion coefficients (0 or 4).")
       .def(
           "pixel_to_ray",
           [](const RigCamera& c, const py::object& pixels, double n) {
@@ -326,9 +329,10 @@ gives arrays (3,).
             }
             const FlatPortCamera camera =
                 ValueOrThrow(FlatPortCamera::Create(c.camera, c.port, n));
-            return MapRows<3, 2>(
-                points, "points",
-                [&](const Eigen::Vector3d& x) { return camera.ImageFromPoint(x); });
+            return MapRows<3, 2>(points, "points",
+                                 [&](const Eigen::Vector3d& x) {
+                                   return camera.ImageFromPoint(x);
+                                 });
           },
           py::arg("points"), py::arg("n"),
           R"doc(
@@ -340,9 +344,8 @@ A pixel may lie outside the image (see Camera.in_image). n in [1, 2].
       .def(
           "virtual_pinhole_matrix",
           [](const RigCamera& c, double n) {
-            return ToNumpy(
-                ValueOrThrow(RefractiveCamera::Create(c.camera, n))
-                    .VirtualPinholeMatrix());
+            return ToNumpy(ValueOrThrow(RefractiveCamera::Create(c.camera, n))
+                               .VirtualPinholeMatrix());
           },
           py::arg("n"),
           "K_n = [n fx, 0, cx; 0, n fy, cy; 0, 0, 1] (paper eq. 9), the "

@@ -53,19 +53,18 @@ DoubleArray AsDoubleArray(const py::array& array) {
 
 }  // namespace
 
-Rows RowsFromPython(const py::handle& object, const std::string& name,
-                    int cols, bool allow_single, bool allow_empty,
-                    bool finite) {
+Rows RowsFromPython(const py::handle& object, const std::string& name, int cols,
+                    bool allow_single, bool allow_empty, bool finite) {
   const py::array array = NumericArray(object, name);
   Rows rows;
   const std::string expected = "(N, " + std::to_string(cols) + ")";
   if (array.ndim() == 1 && allow_single && array.shape(0) == cols) {
     rows.single = true;
   } else if (array.ndim() != 2 || array.shape(1) != cols) {
-    ThrowValueError(name + " must have shape " + expected +
-                    (allow_single ? " or (" + std::to_string(cols) + ",)"
-                                  : std::string()) +
-                    ", got " + ShapeText(array));
+    ThrowValueError(
+        name + " must have shape " + expected +
+        (allow_single ? " or (" + std::to_string(cols) + ",)" : std::string()) +
+        ", got " + ShapeText(array));
   }
   rows.rows = rows.single ? 1 : array.shape(0);
   if (rows.rows == 0 && !allow_empty) {
@@ -175,7 +174,8 @@ Rows Column(const py::handle& mapping, const char* key, const std::string& name,
   const py::object column = mapping[py::str(key)];
   const py::array array = NumericArray(column, name + "['" + key + "']");
   if (array.ndim() != 1) {
-    ThrowValueError(name + "['" + key + "'] must be one-dimensional, got shape " +
+    ThrowValueError(name + "['" + key +
+                    "'] must be one-dimensional, got shape " +
                     ShapeText(array));
   }
   Rows rows;
@@ -184,7 +184,8 @@ Rows Column(const py::handle& mapping, const char* key, const std::string& name,
   if (finite) {
     for (int64_t i = 0; i < rows.rows; ++i) {
       if (!std::isfinite(rows.data()[i])) {
-        ThrowValueError(name + "['" + key + "'] has a non-finite value in row " +
+        ThrowValueError(name + "['" + key +
+                        "'] has a non-finite value in row " +
                         std::to_string(i));
       }
     }
@@ -262,9 +263,8 @@ std::vector<StereoCorrespondence> MatchesFromPython(const py::handle& object,
                       ShapeText(array));
     }
     const int cols = static_cast<int>(array.shape(1));
-    const Rows rows =
-        RowsFromPython(array, name, cols, /*allow_single=*/false,
-                       /*allow_empty=*/true, /*finite=*/true);
+    const Rows rows = RowsFromPython(array, name, cols, /*allow_single=*/false,
+                                     /*allow_empty=*/true, /*finite=*/true);
     matches.resize(rows.rows);
     const int offset = cols == 5 ? 1 : 0;
     for (int64_t i = 0; i < rows.rows; ++i) {
@@ -296,21 +296,24 @@ std::string PathFromPython(const py::handle& object) {
 cv::Mat ImageFromPython(const py::handle& object, const std::string& name,
                         py::object* keep) {
   if (!py::isinstance<py::array>(object)) {
-    ThrowTypeError(name + " must be a NumPy uint8 array (H, W) or (H, W, 3), got " +
+    ThrowTypeError(name +
+                   " must be a NumPy uint8 array (H, W) or (H, W, 3), got " +
                    py::str(py::type::of(object)).cast<std::string>());
   }
   const py::array array = py::reinterpret_borrow<py::array>(object);
   if (!array.dtype().is(py::dtype::of<uint8_t>())) {
-    ThrowValueError(name + " must be a uint8 image (H, W) or (H, W, 3), got dtype " +
+    ThrowValueError(name +
+                    " must be a uint8 image (H, W) or (H, W, 3), got dtype " +
                     DtypeText(array) +
                     " (convert with np.clip(image, 0, 255).astype(np.uint8))");
   }
   const bool gray = array.ndim() == 2;
-  const bool color = array.ndim() == 3 &&
-                     (array.shape(2) == 1 || array.shape(2) == 3 ||
-                      array.shape(2) == 4);
+  const bool color =
+      array.ndim() == 3 &&
+      (array.shape(2) == 1 || array.shape(2) == 3 || array.shape(2) == 4);
   if (!gray && !color) {
-    ThrowValueError(name + " must have shape (H, W), (H, W, 3) or (H, W, 4), got " +
+    ThrowValueError(name +
+                    " must have shape (H, W), (H, W, 3) or (H, W, 4), got " +
                     ShapeText(array));
   }
   if (array.shape(0) == 0 || array.shape(1) == 0) {
@@ -327,7 +330,8 @@ cv::Mat ImageFromPython(const py::handle& object, const std::string& name,
 }
 
 py::array ImageToNumpy(const cv::Mat& image) {
-  if (image.empty()) return py::array_t<uint8_t>(std::vector<py::ssize_t>{0, 0});
+  if (image.empty())
+    return py::array_t<uint8_t>(std::vector<py::ssize_t>{0, 0});
   const cv::Mat continuous = image.isContinuous() ? image : image.clone();
   std::vector<py::ssize_t> shape = {continuous.rows, continuous.cols};
   if (continuous.channels() > 1) shape.push_back(continuous.channels());

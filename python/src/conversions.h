@@ -37,9 +37,9 @@ struct Rows {
   bool single = false;
   const double* data() const { return array.data(); }
 };
-Rows RowsFromPython(const py::handle& object, const std::string& name,
-                    int cols, bool allow_single = true,
-                    bool allow_empty = false, bool finite = true);
+Rows RowsFromPython(const py::handle& object, const std::string& name, int cols,
+                    bool allow_single = true, bool allow_empty = false,
+                    bool finite = true);
 
 // A 1-D array-like of finite numbers of any length (a list, a tuple).
 std::vector<double> VectorFromPython(const py::handle& object,
@@ -61,8 +61,9 @@ DoubleArray ToNumpy(const Eigen::MatrixBase<Derived>& value) {
   const Eigen::MatrixXd matrix = value.template cast<double>();
   const bool vector = Derived::ColsAtCompileTime == 1;
   DoubleArray array =
-      vector ? DoubleArray(std::vector<py::ssize_t>{matrix.rows()})
-             : DoubleArray(std::vector<py::ssize_t>{matrix.rows(), matrix.cols()});
+      vector
+          ? DoubleArray(std::vector<py::ssize_t>{matrix.rows()})
+          : DoubleArray(std::vector<py::ssize_t>{matrix.rows(), matrix.cols()});
   double* data = array.mutable_data();
   for (Eigen::Index r = 0; r < matrix.rows(); ++r) {
     for (Eigen::Index c = 0; c < matrix.cols(); ++c) {

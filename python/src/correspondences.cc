@@ -13,8 +13,8 @@ namespace rcm::python {
 namespace {
 
 py::array_t<int64_t> Frames(const Correspondences& c) {
-  py::array_t<int64_t> a(std::vector<py::ssize_t>{
-      static_cast<py::ssize_t>(c.matches.size())});
+  py::array_t<int64_t> a(
+      std::vector<py::ssize_t>{static_cast<py::ssize_t>(c.matches.size())});
   for (size_t i = 0; i < c.matches.size(); ++i) {
     a.mutable_data()[i] = c.matches[i].frame;
   }
@@ -23,8 +23,8 @@ py::array_t<int64_t> Frames(const Correspondences& c) {
 
 // Coordinate k of every match: 0 xl, 1 yl, 2 xr, 3 yr.
 DoubleArray Coordinate(const Correspondences& c, int k) {
-  DoubleArray a(std::vector<py::ssize_t>{
-      static_cast<py::ssize_t>(c.matches.size())});
+  DoubleArray a(
+      std::vector<py::ssize_t>{static_cast<py::ssize_t>(c.matches.size())});
   for (size_t i = 0; i < c.matches.size(); ++i) {
     const StereoCorrespondence& m = c.matches[i];
     a.mutable_data()[i] = k < 2 ? m.left_pixel[k] : m.right_pixel[k - 2];
@@ -43,8 +43,8 @@ py::object Timestamps(const Correspondences& c) {
   bool any = false;
   for (const StereoCorrespondence& m : c.matches) any = any || m.timestamp;
   if (!any) return py::none();
-  DoubleArray a(std::vector<py::ssize_t>{
-      static_cast<py::ssize_t>(c.matches.size())});
+  DoubleArray a(
+      std::vector<py::ssize_t>{static_cast<py::ssize_t>(c.matches.size())});
   for (size_t i = 0; i < c.matches.size(); ++i) {
     a.mutable_data()[i] = c.matches[i].timestamp.value_or(
         std::numeric_limits<double>::quiet_NaN());
@@ -75,7 +75,8 @@ Correspondences Select(const Correspondences& c, const py::object& selection) {
   const int64_t size = static_cast<int64_t>(c.matches.size());
   if (array.dtype().kind() == 'b') {
     const auto mask =
-        py::array_t<bool, py::array::c_style | py::array::forcecast>::ensure(array);
+        py::array_t<bool, py::array::c_style | py::array::forcecast>::ensure(
+            array);
     if (mask.ndim() != 1 || mask.shape(0) != size) {
       ThrowValueError("mask must have one entry per correspondence (" +
                       std::to_string(size) + ")");
@@ -89,7 +90,8 @@ Correspondences Select(const Correspondences& c, const py::object& selection) {
     ThrowTypeError("selection must be a bool mask or an integer index array");
   }
   const auto indices =
-      py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(array);
+      py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(
+          array);
   if (indices.ndim() != 1) ThrowValueError("indices must be one-dimensional");
   for (py::ssize_t k = 0; k < indices.shape(0); ++k) {
     int64_t i = indices.data()[k];
@@ -123,24 +125,31 @@ t), an (N, 4) array [xl, yl, xr, yr] (all frame 0) or an (N, 5) array
 decrease. Arrays: frame (int64), xl, yl, xr, yr (float64, pixels), t
 (float64 seconds, NaN where a match has none; None when none has one).
 )doc")
-      .def(py::init([](const py::object& matches) {
-             return Correspondences{MatchesFromPython(matches, "matches", true)};
-           }),
-           py::arg("matches"))
+      .def(
+          py::init([](const py::object& matches) {
+            return Correspondences{MatchesFromPython(matches, "matches", true)};
+          }),
+          py::arg("matches"))
       .def("__len__", [](const Correspondences& c) { return c.matches.size(); })
       .def_property_readonly("frame", &Frames, "Frame of each match (int64).")
-      .def_property_readonly("xl", [](const Correspondences& c) { return Coordinate(c, 0); })
-      .def_property_readonly("yl", [](const Correspondences& c) { return Coordinate(c, 1); })
-      .def_property_readonly("xr", [](const Correspondences& c) { return Coordinate(c, 2); })
-      .def_property_readonly("yr", [](const Correspondences& c) { return Coordinate(c, 3); })
-      .def_property_readonly("t", &Timestamps,
-                             "Timestamps in seconds (NaN where absent), or None.")
+      .def_property_readonly(
+          "xl", [](const Correspondences& c) { return Coordinate(c, 0); })
+      .def_property_readonly(
+          "yl", [](const Correspondences& c) { return Coordinate(c, 1); })
+      .def_property_readonly(
+          "xr", [](const Correspondences& c) { return Coordinate(c, 2); })
+      .def_property_readonly(
+          "yr", [](const Correspondences& c) { return Coordinate(c, 3); })
+      .def_property_readonly(
+          "t", &Timestamps,
+          "Timestamps in seconds (NaN where absent), or None.")
       .def_property_readonly("has_timestamps", &HasTimestamps)
       .def_property_readonly(
           "pixels", [](const Correspondences& c) { return Pixels(c, false); },
           "(N, 4) float64 [xl, yl, xr, yr], pixels.")
-      .def("to_array", [](const Correspondences& c) { return Pixels(c, true); },
-           "(N, 5) float64 [frame, xl, yl, xr, yr].")
+      .def(
+          "to_array", [](const Correspondences& c) { return Pixels(c, true); },
+          "(N, 5) float64 [frame, xl, yl, xr, yr].")
       .def(
           "to_dict",
           [](const Correspondences& c) {
@@ -216,7 +225,8 @@ fields, got 4").
         const std::vector<StereoCorrespondence> list =
             MatchesFromPython(matches, "matches");
         size_t with_time = 0;
-        for (const StereoCorrespondence& m : list) with_time += m.timestamp ? 1 : 0;
+        for (const StereoCorrespondence& m : list)
+          with_time += m.timestamp ? 1 : 0;
         if (with_time != 0 && with_time != list.size()) {
           ThrowValueError("matches: either all or none need a timestamp");
         }

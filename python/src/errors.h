@@ -48,7 +48,6 @@ T ReadOrThrow(const std::string& path, StatusOr<T> status_or) {
   return std::move(status_or).value();
 }
 
-
 }  // namespace rcm::python
 
 #endif  // RCM_PYTHON_SRC_ERRORS_H_

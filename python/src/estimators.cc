@@ -42,7 +42,9 @@ std::vector<OptionField> RefinementFields(RefinementOptions* o) {
         }
         o->loss = *loss;
       },
-      [o]() { return py::object(py::str(std::string(RobustLossName(o->loss)))); }};
+      [o]() {
+        return py::object(py::str(std::string(RobustLossName(o->loss))));
+      }};
   return {loss,
           DoubleOption("loss_scale_px", &o->loss_scale_px),
           DoubleOption("inlier_threshold_px", &o->inlier_threshold_px, true),
@@ -123,18 +125,19 @@ std::string Fixed(double value, int digits) {
 }
 
 std::string SummaryRepr(const RefinementSummary& s) {
-  return "RefinementResult(n=" + Fixed(s.n, 9) + ", sigma_n=" +
-         Fixed(s.sigma_n, 6) + " (noise " + Fixed(s.sigma_n_noise, 6) +
-         ", calibration " + Fixed(s.sigma_n_calibration, 6) + "), crlb=" +
-         Fixed(s.crlb, 6) + ", sigma_px=" + Fixed(s.sigma_px, 4) +
+  return "RefinementResult(n=" + Fixed(s.n, 9) +
+         ", sigma_n=" + Fixed(s.sigma_n, 6) + " (noise " +
+         Fixed(s.sigma_n_noise, 6) + ", calibration " +
+         Fixed(s.sigma_n_calibration, 6) + "), crlb=" + Fixed(s.crlb, 6) +
+         ", sigma_px=" + Fixed(s.sigma_px, 4) +
          ", inliers=" + std::to_string(s.inliers.size()) + "/" +
          std::to_string(s.num_correspondences) +
          ", iterations=" + std::to_string(s.num_iterations) + ")";
 }
 
 py::array_t<int64_t> IndexArray(const std::vector<int64_t>& indices) {
-  py::array_t<int64_t> a(std::vector<py::ssize_t>{
-      static_cast<py::ssize_t>(indices.size())});
+  py::array_t<int64_t> a(
+      std::vector<py::ssize_t>{static_cast<py::ssize_t>(indices.size())});
   std::copy(indices.begin(), indices.end(), a.mutable_data());
   return a;
 }
@@ -184,9 +187,10 @@ struct ClosedFormResult {
 // with the wrong model.
 void RefuseThickPort(const StereoRig& rig, const std::string& what) {
   if (rig.HasThickPort()) {
-    ThrowValueError("the rig gives a thick port (an air gap or glass), which "
-                    "only refine_refractive_index models; " +
-                    what + " assumes the paper's thin port");
+    ThrowValueError(
+        "the rig gives a thick port (an air gap or glass), which "
+        "only refine_refractive_index models; " +
+        what + " assumes the paper's thin port");
   }
 }
 
@@ -210,22 +214,25 @@ ClosedFormResult ClosedForm(const StereoRig& rig, const py::object& matches,
   result.masked = estimator.num_masked();
   result.invalid = estimator.num_invalid();
   if (!estimate) {
-    ThrowValueError("no usable correspondence: " + std::to_string(result.masked) +
-                    " removed by the observability mask, " +
-                    std::to_string(result.invalid) +
-                    " invalid; matches near the image axes do not observe n "
-                    "(lower mask_eta to keep more)");
+    ThrowValueError(
+        "no usable correspondence: " + std::to_string(result.masked) +
+        " removed by the observability mask, " +
+        std::to_string(result.invalid) +
+        " invalid; matches near the image axes do not observe n "
+        "(lower mask_eta to keep more)");
   }
   result.n = estimate->n;
   result.standard_error = estimate->standard_error;
   return result;
 }
 
-DoubleArray ClosedFormPerMatch(const StereoRig& rig, const py::object& matches) {
+DoubleArray ClosedFormPerMatch(const StereoRig& rig,
+                               const py::object& matches) {
   RefuseThickPort(rig, "the closed form");
   const std::vector<StereoCorrespondence> list =
       MatchesFromPython(matches, "matches");
-  DoubleArray n(std::vector<py::ssize_t>{static_cast<py::ssize_t>(list.size())});
+  DoubleArray n(
+      std::vector<py::ssize_t>{static_cast<py::ssize_t>(list.size())});
   double* out = n.mutable_data();
   py::gil_scoped_release release;
   for (size_t i = 0; i < list.size(); ++i) {
@@ -281,10 +288,12 @@ void BindPooledFields(Class& cls) {
       .def_readonly("sigma_px", &Estimate::sigma_px,
                     "Estimated pixel noise of the inliers, pixels.")
       .def_readonly("inliers", &Estimate::inliers, "Pooled inlier count.")
-      .def_property_readonly("consistency",
-                             [](const Estimate& e) { return ConsistencyDict(e.consistency); })
-      .def_property_readonly("calibration",
-                             [](const Estimate& e) { return CalibrationDict(e.calibration); })
+      .def_property_readonly(
+          "consistency",
+          [](const Estimate& e) { return ConsistencyDict(e.consistency); })
+      .def_property_readonly(
+          "calibration",
+          [](const Estimate& e) { return CalibrationDict(e.calibration); })
       .def_property_readonly("rotation", [](const Estimate& e) -> py::object {
         if (!e.rotation) return py::none();
         return ToNumpy(*e.rotation);
@@ -324,38 +333,46 @@ rotation, calibration, consistency (dicts or None).
       .def_readonly("n", &RefinementSummary::n)
       .def_readonly("sigma_n", &RefinementSummary::sigma_n)
       .def_readonly("sigma_n_noise", &RefinementSummary::sigma_n_noise)
-      .def_readonly("sigma_n_calibration", &RefinementSummary::sigma_n_calibration)
-      .def_readonly("sigma_n_systematic", &RefinementSummary::sigma_n_systematic)
+      .def_readonly("sigma_n_calibration",
+                    &RefinementSummary::sigma_n_calibration)
+      .def_readonly("sigma_n_systematic",
+                    &RefinementSummary::sigma_n_systematic)
       .def_readonly("crlb", &RefinementSummary::crlb)
       .def_readonly("sigma_px", &RefinementSummary::sigma_px)
-      .def_property_readonly("n_closed_form", [](const RefinementSummary& s) {
-        return OptionalDouble(s.n_closed_form);
-      })
+      .def_property_readonly("n_closed_form",
+                             [](const RefinementSummary& s) {
+                               return OptionalDouble(s.n_closed_form);
+                             })
       .def_readonly("n_seed", &RefinementSummary::n_seed)
       .def_readonly("n_robust", &RefinementSummary::n_robust)
       .def_readonly("robust_cost", &RefinementSummary::robust_cost)
       .def_readonly("cost", &RefinementSummary::cost)
-      .def_property_readonly("inliers", [](const RefinementSummary& s) {
-        return MaskArray(s.inliers, s.num_correspondences);
-      })
-      .def_property_readonly("inlier_indices", [](const RefinementSummary& s) {
-        return IndexArray(s.inliers);
-      })
-      .def_property_readonly("num_inliers", [](const RefinementSummary& s) {
-        return s.inliers.size();
-      })
-      .def_readonly("num_correspondences", &RefinementSummary::num_correspondences)
+      .def_property_readonly("inliers",
+                             [](const RefinementSummary& s) {
+                               return MaskArray(s.inliers,
+                                                s.num_correspondences);
+                             })
+      .def_property_readonly(
+          "inlier_indices",
+          [](const RefinementSummary& s) { return IndexArray(s.inliers); })
+      .def_property_readonly(
+          "num_inliers",
+          [](const RefinementSummary& s) { return s.inliers.size(); })
+      .def_readonly("num_correspondences",
+                    &RefinementSummary::num_correspondences)
       .def_readonly("num_invalid", &RefinementSummary::num_invalid)
       .def_readonly("num_iterations", &RefinementSummary::num_iterations)
-      .def_property_readonly("rotation", [](const RefinementSummary& s) {
-        return RotationDict(s.rotation);
-      })
-      .def_property_readonly("calibration", [](const RefinementSummary& s) {
-        return CalibrationDict(s.calibration);
-      })
-      .def_property_readonly("consistency", [](const RefinementSummary& s) {
-        return ConsistencyDict(s.consistency);
-      })
+      .def_property_readonly(
+          "rotation",
+          [](const RefinementSummary& s) { return RotationDict(s.rotation); })
+      .def_property_readonly("calibration",
+                             [](const RefinementSummary& s) {
+                               return CalibrationDict(s.calibration);
+                             })
+      .def_property_readonly("consistency",
+                             [](const RefinementSummary& s) {
+                               return ConsistencyDict(s.consistency);
+                             })
       .def("__repr__", &SummaryRepr);
 
   module.def("refine_refractive_index", &Refine, py::arg("rig"),
@@ -399,8 +416,9 @@ runs.
       .def_readonly("masked", &ClosedFormResult::masked)
       .def_readonly("invalid", &ClosedFormResult::invalid)
       .def("__repr__", [](const ClosedFormResult& r) {
-        return "ClosedFormResult(n=" + Fixed(r.n, 9) + ", standard_error=" +
-               Fixed(r.standard_error, 6) + ", used=" + std::to_string(r.used) +
+        return "ClosedFormResult(n=" + Fixed(r.n, 9) +
+               ", standard_error=" + Fixed(r.standard_error, 6) +
+               ", used=" + std::to_string(r.used) +
                ", masked=" + std::to_string(r.masked) +
                ", invalid=" + std::to_string(r.invalid) + ")";
       });
@@ -429,9 +447,9 @@ noise: a seed, not the estimator of record. Thin ports only.
       .def_readonly("sigma_px", &LocusEstimate::sigma_px)
       .def_readonly("inliers", &LocusEstimate::inliers)
       .def("__repr__", [](const LocusEstimate& e) {
-        return "LocusEstimate(n=" + Fixed(e.n, 9) + ", sigma_n=" +
-               Fixed(e.sigma_n, 6) + ", inliers=" + std::to_string(e.inliers) +
-               ")";
+        return "LocusEstimate(n=" + Fixed(e.n, 9) +
+               ", sigma_n=" + Fixed(e.sigma_n, 6) +
+               ", inliers=" + std::to_string(e.inliers) + ")";
       });
 
   using OnlineEstimate = OnlineRefractiveIndexEstimator::Estimate;
@@ -442,11 +460,13 @@ noise: a seed, not the estimator of record. Thin ports only.
       "sigma_n_systematic, crlb, sigma_px (pixels), inliers, correspondences, "
       "frames.");
   BindPooledFields<OnlineEstimate>(online_estimate);
-  online_estimate.def_readonly("correspondences", &OnlineEstimate::correspondences)
+  online_estimate
+      .def_readonly("correspondences", &OnlineEstimate::correspondences)
       .def_readonly("frames", &OnlineEstimate::frames)
       .def("__repr__", [](const OnlineEstimate& e) {
-        return "OnlineEstimate(n=" + Fixed(e.n, 9) + ", sigma_n=" +
-               Fixed(e.sigma_n, 6) + ", frames=" + std::to_string(e.frames) +
+        return "OnlineEstimate(n=" + Fixed(e.n, 9) +
+               ", sigma_n=" + Fixed(e.sigma_n, 6) +
+               ", frames=" + std::to_string(e.frames) +
                ", inliers=" + std::to_string(e.inliers) + ")";
       });
 
@@ -460,17 +480,17 @@ noise: a seed, not the estimator of record. Thin ports only.
       .def_readonly("correspondences", &FrameUpdate::correspondences)
       .def_readonly("usable", &FrameUpdate::usable)
       .def_readonly("skipped", &FrameUpdate::skipped)
-      .def_property_readonly("inliers",
-                             [](const FrameUpdate& u) { return IndexArray(u.inliers); })
-      .def_property_readonly("frame_estimate", [](const FrameUpdate& u) {
-        return ValueOrNone(u.frame_estimate);
-      })
-      .def_property_readonly("frame_estimate_error", [](const FrameUpdate& u) {
-        return ErrorOrNone(u.frame_estimate);
-      })
-      .def_property_readonly("cumulative", [](const FrameUpdate& u) {
-        return ValueOrNone(u.cumulative);
-      })
+      .def_property_readonly(
+          "inliers", [](const FrameUpdate& u) { return IndexArray(u.inliers); })
+      .def_property_readonly(
+          "frame_estimate",
+          [](const FrameUpdate& u) { return ValueOrNone(u.frame_estimate); })
+      .def_property_readonly(
+          "frame_estimate_error",
+          [](const FrameUpdate& u) { return ErrorOrNone(u.frame_estimate); })
+      .def_property_readonly(
+          "cumulative",
+          [](const FrameUpdate& u) { return ValueOrNone(u.cumulative); })
       .def_property_readonly("cumulative_error", [](const FrameUpdate& u) {
         return ErrorOrNone(u.cumulative);
       });
@@ -491,8 +511,8 @@ ValueError with the reason. Thin ports only.
              RefuseThickPort(rig, "the online estimator");
              const RefinementOptions options =
                  RefinementOptionsFrom(kwargs, "OnlineEstimator");
-             return Online{ValueOrThrow(
-                               OnlineRefractiveIndexEstimator::Create(rig, options)),
+             return Online{ValueOrThrow(OnlineRefractiveIndexEstimator::Create(
+                               rig, options)),
                            std::nullopt, std::make_shared<std::mutex>()};
            }),
            py::arg("rig"))
@@ -513,17 +533,21 @@ ValueError with the reason. Thin ports only.
           "takes; an empty frame counts as skipped) and returns the "
           "cumulative OnlineEstimate, or None while there is none (the "
           "reason: last_update.cumulative_error). GIL released.")
-      .def("current",
-           [](const Online& self) { return ValueOrThrow(self.estimator.Current()); },
-           "The cumulative OnlineEstimate; ValueError with the reason while "
-           "there is none (too few inliers, n unobservable).")
+      .def(
+          "current",
+          [](const Online& self) {
+            return ValueOrThrow(self.estimator.Current());
+          },
+          "The cumulative OnlineEstimate; ValueError with the reason while "
+          "there is none (too few inliers, n unobservable).")
       .def_property_readonly("last_update",
                              [](const Online& self) -> py::object {
                                if (!self.last) return py::none();
                                return py::cast(*self.last);
                              })
-      .def_property_readonly("num_frames",
-                             [](const Online& self) { return self.estimator.num_frames(); })
+      .def_property_readonly(
+          "num_frames",
+          [](const Online& self) { return self.estimator.num_frames(); })
       .def_property_readonly("num_skipped_frames", [](const Online& self) {
         return self.estimator.num_skipped_frames();
       });
@@ -539,9 +563,10 @@ ValueError with the reason. Thin ports only.
       .def_readonly("first_frame", &WindowEstimate::first_frame)
       .def_readonly("last_frame", &WindowEstimate::last_frame)
       .def("__repr__", [](const WindowEstimate& e) {
-        return "WindowEstimate(n=" + Fixed(e.n, 9) + ", sigma_n=" +
-               Fixed(e.sigma_n, 6) + ", frames " + std::to_string(e.first_frame) +
-               "-" + std::to_string(e.last_frame) + ")";
+        return "WindowEstimate(n=" + Fixed(e.n, 9) +
+               ", sigma_n=" + Fixed(e.sigma_n, 6) + ", frames " +
+               std::to_string(e.first_frame) + "-" +
+               std::to_string(e.last_frame) + ")";
       });
 
   py::class_<MediumSwitch>(module, "MediumSwitch",
@@ -555,8 +580,8 @@ ValueError with the reason. Thin ports only.
       .def("__repr__", [](const MediumSwitch& s) {
         return "MediumSwitch(first_frame=" + std::to_string(s.first_frame) +
                ", detected_at_frame=" + std::to_string(s.detected_at_frame) +
-               ", n_before=" + Fixed(s.n_before, 6) + ", n_after=" +
-               Fixed(s.n_after, 6) + ")";
+               ", n_before=" + Fixed(s.n_before, 6) +
+               ", n_after=" + Fixed(s.n_after, 6) + ")";
       });
 
   using WindowUpdate = SlidingWindowRefractiveIndexEstimator::WindowUpdate;
@@ -568,24 +593,28 @@ ValueError with the reason. Thin ports only.
       .def_readonly("frame", &WindowUpdate::frame)
       .def_readonly("correspondences", &WindowUpdate::correspondences)
       .def_readonly("usable", &WindowUpdate::usable)
-      .def_property_readonly("decision", [](const WindowUpdate& u) {
-        return std::string(DecisionName(u.decision));
-      })
-      .def_property_readonly("frame_estimate", [](const WindowUpdate& u) {
-        return ValueOrNone(u.frame_estimate);
-      })
-      .def_property_readonly("frame_estimate_error", [](const WindowUpdate& u) {
-        return ErrorOrNone(u.frame_estimate);
-      })
-      .def_property_readonly("z", [](const WindowUpdate& u) { return OptionalDouble(u.z); })
-      .def_property_readonly("window",
-                             [](const WindowUpdate& u) { return ValueOrNone(u.window); })
-      .def_property_readonly("window_error",
-                             [](const WindowUpdate& u) { return ErrorOrNone(u.window); })
-      .def_property_readonly("medium_switch", [](const WindowUpdate& u) -> py::object {
-        if (!u.medium_switch) return py::none();
-        return py::cast(*u.medium_switch);
-      });
+      .def_property_readonly("decision",
+                             [](const WindowUpdate& u) {
+                               return std::string(DecisionName(u.decision));
+                             })
+      .def_property_readonly(
+          "frame_estimate",
+          [](const WindowUpdate& u) { return ValueOrNone(u.frame_estimate); })
+      .def_property_readonly(
+          "frame_estimate_error",
+          [](const WindowUpdate& u) { return ErrorOrNone(u.frame_estimate); })
+      .def_property_readonly(
+          "z", [](const WindowUpdate& u) { return OptionalDouble(u.z); })
+      .def_property_readonly(
+          "window", [](const WindowUpdate& u) { return ValueOrNone(u.window); })
+      .def_property_readonly(
+          "window_error",
+          [](const WindowUpdate& u) { return ErrorOrNone(u.window); })
+      .def_property_readonly("medium_switch",
+                             [](const WindowUpdate& u) -> py::object {
+                               if (!u.medium_switch) return py::none();
+                               return py::cast(*u.medium_switch);
+                             });
 
   py::class_<Window>(module, "SlidingWindowEstimator", R"doc(
 The sliding-window estimator (paper Sec. V-D; C++
@@ -612,15 +641,17 @@ Thin ports only.
              window.change_threshold = change_threshold;
              window.confirm_frames = confirm_frames;
              ThrowIfError(window.Check());
-             return Window{ValueOrThrow(SlidingWindowRefractiveIndexEstimator::Create(
-                               rig, options, window)),
-                           std::nullopt, 0, std::make_shared<std::mutex>()};
+             return Window{
+                 ValueOrThrow(SlidingWindowRefractiveIndexEstimator::Create(
+                     rig, options, window)),
+                 std::nullopt, 0, std::make_shared<std::mutex>()};
            }),
            py::arg("rig"), py::arg("window_frames") = 20,
            py::arg("change_threshold") = 5.0, py::arg("confirm_frames") = 2)
       .def(
           "add_frame",
-          [](Window& self, const py::object& matches, std::optional<int64_t> frame) {
+          [](Window& self, const py::object& matches,
+             std::optional<int64_t> frame) {
             const std::vector<StereoCorrespondence> list =
                 MatchesFromPython(matches, "matches", /*allow_empty=*/true);
             {
@@ -638,20 +669,25 @@ Thin ports only.
           "last_update.window_error). `frame` labels the frame in the "
           "reports and switches (default: the count of add_frame calls). "
           "GIL released.")
-      .def("current",
-           [](const Window& self) { return ValueOrThrow(self.estimator.Current()); },
-           "The window's WindowEstimate; ValueError with the reason while "
-           "there is none.")
+      .def(
+          "current",
+          [](const Window& self) {
+            return ValueOrThrow(self.estimator.Current());
+          },
+          "The window's WindowEstimate; ValueError with the reason while "
+          "there is none.")
       .def_property_readonly("last_update",
                              [](const Window& self) -> py::object {
                                if (!self.last) return py::none();
                                return py::cast(*self.last);
                              })
-      .def_property_readonly("switches",
-                             [](const Window& self) { return self.estimator.switches(); })
-      .def_property_readonly("num_dropped_frames", [](const Window& self) {
-        return self.estimator.num_dropped_frames();
-      })
+      .def_property_readonly(
+          "switches",
+          [](const Window& self) { return self.estimator.switches(); })
+      .def_property_readonly("num_dropped_frames",
+                             [](const Window& self) {
+                               return self.estimator.num_dropped_frames();
+                             })
       .def_property_readonly("num_skipped_frames", [](const Window& self) {
         return self.estimator.num_skipped_frames();
       });

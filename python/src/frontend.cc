@@ -46,13 +46,17 @@ StereoFrontEndOptions FrontEndOptionsFrom(const py::dict& kwargs,
       DoubleOption("subpixel_max_shift_px", &o.subpixel.max_shift_px),
       {"search_range",
        [&](const py::handle& value) {
-         const std::vector<double> range = VectorFromPython(value, "search_range");
+         const std::vector<double> range =
+             VectorFromPython(value, "search_range");
          if (range.size() != 2) {
            ThrowValueError("search_range must be (min, max)");
          }
          o.search_range = {range[0], range[1]};
        },
-       [&] { return py::object(py::make_tuple(o.search_range.min, o.search_range.max)); }},
+       [&] {
+         return py::object(
+             py::make_tuple(o.search_range.min, o.search_range.max));
+       }},
       DoubleOption("reacquire_fraction", &o.reacquire_fraction),
       IntOption("num_threads", &o.num_threads),
   };
@@ -97,9 +101,8 @@ StereoMatches Match(FrontEnd& self, const py::object& left,
 }
 
 FrontEnd MakeFrontEnd(const StereoRig& rig, const py::kwargs& kwargs) {
-  return FrontEnd{
-      ValueOrThrow(StereoFrontEnd::Create(
-          rig, FrontEndOptionsFrom(kwargs, "StereoFrontEnd")))};
+  return FrontEnd{ValueOrThrow(StereoFrontEnd::Create(
+      rig, FrontEndOptionsFrom(kwargs, "StereoFrontEnd")))};
 }
 
 constexpr const char* kOptionsDoc = R"doc(
@@ -124,30 +127,34 @@ matches were searched in), reacquired, timings_ms (dict per stage). The
 library keeps no per-match score; every returned match passed the ratio
 test, the cross check and the band verification.
 )doc")
-      .def_property_readonly("matches", [](const StereoMatches& m) {
-        return Correspondences{m.matches};
-      })
-      .def_property_readonly("pixels", [](const StereoMatches& m) {
-        const py::object matches = py::cast(Correspondences{m.matches});
-        return py::object(matches.attr("pixels"));
-      })
+      .def_property_readonly(
+          "matches",
+          [](const StereoMatches& m) { return Correspondences{m.matches}; })
+      .def_property_readonly("pixels",
+                             [](const StereoMatches& m) {
+                               const py::object matches =
+                                   py::cast(Correspondences{m.matches});
+                               return py::object(matches.attr("pixels"));
+                             })
       .def("__len__", [](const StereoMatches& m) { return m.matches.size(); })
       .def_readonly("left_keypoints", &StereoMatches::left_keypoints)
       .def_readonly("right_keypoints", &StereoMatches::right_keypoints)
       .def_readonly("descriptor_matches", &StereoMatches::descriptor_matches)
-      .def_property_readonly("band", [](const StereoMatches& m) {
-        return py::make_tuple(m.band.min, m.band.max);
-      })
+      .def_property_readonly("band",
+                             [](const StereoMatches& m) {
+                               return py::make_tuple(m.band.min, m.band.max);
+                             })
       .def_readonly("reacquired", &StereoMatches::reacquired)
-      .def_property_readonly("timings_ms", [](const StereoMatches& m) {
-        py::dict d;
-        d["preprocess"] = m.timings.preprocess_ms;
-        d["detect"] = m.timings.detect_ms;
-        d["match"] = m.timings.match_ms;
-        d["refine"] = m.timings.refine_ms;
-        d["total"] = m.timings.total_ms;
-        return d;
-      })
+      .def_property_readonly("timings_ms",
+                             [](const StereoMatches& m) {
+                               py::dict d;
+                               d["preprocess"] = m.timings.preprocess_ms;
+                               d["detect"] = m.timings.detect_ms;
+                               d["match"] = m.timings.match_ms;
+                               d["refine"] = m.timings.refine_ms;
+                               d["total"] = m.timings.total_ms;
+                               return d;
+                             })
       .def("__repr__", [](const StereoMatches& m) {
         return "StereoMatches(" + std::to_string(m.matches.size()) +
                " matches, keypoints " + std::to_string(m.left_keypoints) + "/" +
@@ -175,15 +182,16 @@ the prior search_range). The GIL is released while it runs.
            "of the current estimate, None for the prior search range.");
 
   static const std::string match_doc =
-      std::string("StereoFrontEnd(rig, **options).match(left, right): the "
-                  "matches of one stereo pair (StereoMatches).\n") +
+      std::string(
+          "StereoFrontEnd(rig, **options).match(left, right): the "
+          "matches of one stereo pair (StereoMatches).\n") +
       kOptionsDoc;
   module.def(
       "match_stereo",
       [](const StereoRig& rig, const py::object& left, const py::object& right,
          const py::kwargs& kwargs) {
         FrontEnd front_end{ValueOrThrow(StereoFrontEnd::Create(
-                               rig, FrontEndOptionsFrom(kwargs, "match_stereo")))};
+            rig, FrontEndOptionsFrom(kwargs, "match_stereo")))};
         return Match(front_end, left, right, 0, std::nullopt, std::nullopt);
       },
       py::arg("rig"), py::arg("left"), py::arg("right"), match_doc.c_str());

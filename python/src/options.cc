@@ -20,8 +20,7 @@ OptionField BoolOption(const std::string& name, bool* field) {
   return {name,
           [name, field](const py::handle& value) {
             // NumPy bools are accepted; ints are not (a typo-prone 0/1).
-            if (!PyBool_Check(value.ptr()) &&
-                TypeName(value) != "bool_") {
+            if (!PyBool_Check(value.ptr()) && TypeName(value) != "bool_") {
               ThrowTypeError(name + " must be True or False, got " +
                              TypeName(value));
             }
@@ -49,24 +48,25 @@ OptionField IntOption(const std::string& name, int* field) {
 
 OptionField DoubleOption(const std::string& name, double* field,
                          bool allow_inf) {
-  return {name,
-          [name, field, allow_inf](const py::handle& value) {
-            const bool numeric = PyFloat_Check(value.ptr()) ||
-                                 PyLong_Check(value.ptr()) ||
-                                 py::hasattr(value, "__float__");
-            if (PyBool_Check(value.ptr()) || PyComplex_Check(value.ptr()) ||
-                !numeric || TypeName(value) == "bool_") {
-              ThrowTypeError(name + " must be a number, got " + TypeName(value));
-            }
-            const double number = PyFloat_AsDouble(value.ptr());
-            if (PyErr_Occurred()) throw py::error_already_set();
-            if (std::isnan(number) || (!allow_inf && std::isinf(number))) {
-              ThrowValueError(name + " must be finite, got " +
-                              py::str(value).cast<std::string>());
-            }
-            *field = number;
-          },
-          [field]() { return py::object(py::float_(*field)); }};
+  return {
+      name,
+      [name, field, allow_inf](const py::handle& value) {
+        const bool numeric = PyFloat_Check(value.ptr()) ||
+                             PyLong_Check(value.ptr()) ||
+                             py::hasattr(value, "__float__");
+        if (PyBool_Check(value.ptr()) || PyComplex_Check(value.ptr()) ||
+            !numeric || TypeName(value) == "bool_") {
+          ThrowTypeError(name + " must be a number, got " + TypeName(value));
+        }
+        const double number = PyFloat_AsDouble(value.ptr());
+        if (PyErr_Occurred()) throw py::error_already_set();
+        if (std::isnan(number) || (!allow_inf && std::isinf(number))) {
+          ThrowValueError(name + " must be finite, got " +
+                          py::str(value).cast<std::string>());
+        }
+        *field = number;
+      },
+      [field]() { return py::object(py::float_(*field)); }};
 }
 
 void ApplyOptions(const py::dict& kwargs,
@@ -92,7 +92,8 @@ void ApplyOptions(const py::dict& kwargs,
 
 py::dict OptionValues(const std::vector<OptionField>& fields) {
   py::dict values;
-  for (const OptionField& field : fields) values[py::str(field.name)] = field.get();
+  for (const OptionField& field : fields)
+    values[py::str(field.name)] = field.get();
   return values;
 }
 

@@ -1,10 +1,10 @@
 // rcm.StereoRig, rcm.read_stereo_rig, StereoRig.write and the reference
 // rigs of the simulator.
 #include <pybind11/stl.h>
-
-#include <sstream>
 #include <sys/stat.h>
 #include <unistd.h>
+
+#include <sstream>
 
 #include "bindings.h"
 #include "conversions.h"
@@ -47,7 +47,8 @@ StereoRig ReadRig(const py::object& path, const py::object& right_info,
     }
     options.drift_prior = drift_prior;
   }
-  const std::string spec = paths.size() == 1 ? paths[0] : paths[0] + "," + paths[1];
+  const std::string spec =
+      paths.size() == 1 ? paths[0] : paths[0] + "," + paths[1];
   StatusOr<StereoRig> rig = Status::Error("not read");
   {
     py::gil_scoped_release release;
@@ -70,8 +71,9 @@ void WriteRig(const StereoRig& rig, const py::object& path) {
 
 RigCamera CameraOf(const StereoRig& rig, int index) {
   if (index != 0 && index != 1) {
-    ThrowValueError("camera index must be 0 (left, cam0) or 1 (right, cam1), got " +
-                    std::to_string(index));
+    ThrowValueError(
+        "camera index must be 0 (left, cam0) or 1 (right, cam1), got " +
+        std::to_string(index));
   }
   const bool left = index == 0;
   RigCamera camera{left ? rig.left() : rig.right(), FlatPort()};
@@ -95,10 +97,11 @@ std::string RigRepr(const StereoRig& rig) {
   text.precision(6);
   text << "StereoRig(baseline=" << rig.Baseline() << " m, rotation="
        << rig.right_from_left().RotationAngle() * 180.0 / M_PI << " deg, "
-       << (rig.HasThickPort() ? "thick" : "thin") << " port, left="
-       << LensModelName(rig.left().model()) << " " << rig.left().width() << "x"
-       << rig.left().height() << ", right=" << LensModelName(rig.right().model())
-       << " " << rig.right().width() << "x" << rig.right().height() << ")";
+       << (rig.HasThickPort() ? "thick" : "thin")
+       << " port, left=" << LensModelName(rig.left().model()) << " "
+       << rig.left().width() << "x" << rig.left().height()
+       << ", right=" << LensModelName(rig.right().model()) << " "
+       << rig.right().width() << "x" << rig.right().height() << ")";
   return text.str();
 }
 
@@ -137,14 +140,18 @@ exact); one read from a file carries the default drift prior (0.1 degree,
       .def("camera", &CameraOf, py::arg("index"),
            "The camera `index` (0: left/cam0, 1: right/cam1) behind its port, "
            "an rcm.RigCamera.")
-      .def_property_readonly("cam0", [](const StereoRig& r) { return CameraOf(r, 0); },
-                             "The left camera (rcm.RigCamera).")
-      .def_property_readonly("cam1", [](const StereoRig& r) { return CameraOf(r, 1); },
-                             "The right camera (rcm.RigCamera).")
-      .def_property_readonly("left", [](const StereoRig& r) { return CameraOf(r, 0); },
-                             "Same as cam0.")
-      .def_property_readonly("right", [](const StereoRig& r) { return CameraOf(r, 1); },
-                             "Same as cam1.")
+      .def_property_readonly(
+          "cam0", [](const StereoRig& r) { return CameraOf(r, 0); },
+          "The left camera (rcm.RigCamera).")
+      .def_property_readonly(
+          "cam1", [](const StereoRig& r) { return CameraOf(r, 1); },
+          "The right camera (rcm.RigCamera).")
+      .def_property_readonly(
+          "left", [](const StereoRig& r) { return CameraOf(r, 0); },
+          "Same as cam0.")
+      .def_property_readonly(
+          "right", [](const StereoRig& r) { return CameraOf(r, 1); },
+          "Same as cam1.")
       .def_property_readonly(
           "cam1_from_cam0",
           [](const StereoRig& r) {
@@ -160,7 +167,9 @@ exact); one read from a file carries the default drift prior (0.1 degree,
           "3x3 rotation of cam1_from_cam0.")
       .def_property_readonly(
           "translation",
-          [](const StereoRig& r) { return ToNumpy(r.right_from_left().translation); },
+          [](const StereoRig& r) {
+            return ToNumpy(r.right_from_left().translation);
+          },
           "Translation of cam1_from_cam0, meters (cam0's origin in cam1).")
       .def_property_readonly("baseline", &StereoRig::Baseline,
                              "|translation|, meters.")
@@ -179,7 +188,8 @@ exact); one read from a file carries the default drift prior (0.1 degree,
       .def_property_readonly(
           "deviation_from_rectified",
           [](const StereoRig& r) {
-            const StereoRig::RectificationDeviation d = r.DeviationFromRectified();
+            const StereoRig::RectificationDeviation d =
+                r.DeviationFromRectified();
             return py::make_tuple(d.rotation, d.baseline_off_axis);
           },
           "(rotation angle, baseline angle off the x axis), radians: how far "
@@ -222,12 +232,13 @@ exact); one read from a file carries the default drift prior (0.1 degree,
                 !std::isfinite(translation_sigma)) {
               ThrowValueError("drift prior sigmas must be finite and >= 0");
             }
-            return ValueOrThrow(r.WithCalibrationUncertainty(
-                CalibrationUncertainty::DriftPrior(rotation_sigma,
-                                                   translation_sigma)));
+            return ValueOrThrow(
+                r.WithCalibrationUncertainty(CalibrationUncertainty::DriftPrior(
+                    rotation_sigma, translation_sigma)));
           },
           py::arg("rotation_sigma"), py::arg("translation_sigma"),
-          "A copy whose calibration uncertainty is only a drift prior: per-axis "
+          "A copy whose calibration uncertainty is only a drift prior: "
+          "per-axis "
           "standard deviations in radians and meters.")
       .def("write", &WriteRig, py::arg("path"),
            "Writes the rig as a two-camera Kalibr camchain (cam0 left, cam1 "
@@ -252,10 +263,10 @@ replacing the default drift prior of the calibration uncertainty.
 Raises FileNotFoundError/PermissionError (OSError) for a file that cannot be
 read and ValueError for bad contents, with the library's one-line message.
 )doc");
-  module.def("write_stereo_rig",
-             [](const py::object& path, const StereoRig& rig) { WriteRig(rig, path); },
-             py::arg("path"), py::arg("rig"),
-             "Same as rig.write(path).");
+  module.def(
+      "write_stereo_rig",
+      [](const py::object& path, const StereoRig& rig) { WriteRig(rig, path); },
+      py::arg("path"), py::arg("rig"), "Same as rig.write(path).");
   module.def("reference_rig", &ReferenceRig, py::arg("name"),
              R"doc(
 A rig of the simulator's presets, made in code (no calibration uncertainty):

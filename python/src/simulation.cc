@@ -43,13 +43,14 @@ Correspondences Sample(const StereoRig& rig, double n, double min_depth,
   options.seed = SeedFrom(seed);
   ThrowIfError(options.Check());
   const bool through_ports = exact_ports.value_or(rig.HasThickPort());
-  StatusOr<std::vector<StereoCorrespondence>> matches = Status::Error("not run");
+  StatusOr<std::vector<StereoCorrespondence>> matches =
+      Status::Error("not run");
   {
     py::gil_scoped_release release;
     if (through_ports) {
       const StereoRig::Ports ports = rig.ports().value_or(StereoRig::Ports{});
-      matches = SampleFlatPortCorrespondences(rig, ports.left, ports.right,
-                                              options);
+      matches =
+          SampleFlatPortCorrespondences(rig, ports.left, ports.right, options);
     } else {
       matches = SampleStereoCorrespondences(rig, options);
     }
@@ -75,8 +76,8 @@ py::tuple WithOutliers(const StereoRig& rig, const py::object& matches,
   Correspondences result{MatchesFromPython(matches, "matches", true)};
   const std::vector<int64_t> replaced =
       AddOutliers(rig, fraction, SeedFrom(seed), &result.matches);
-  py::array_t<int64_t> indices(std::vector<py::ssize_t>{
-      static_cast<py::ssize_t>(replaced.size())});
+  py::array_t<int64_t> indices(
+      std::vector<py::ssize_t>{static_cast<py::ssize_t>(replaced.size())});
   std::copy(replaced.begin(), replaced.end(), indices.mutable_data());
   return py::make_tuple(result, indices);
 }
@@ -100,17 +101,21 @@ SequenceOptions SequenceOptionsFrom(const py::kwargs& kwargs) {
            if (pair.size() != 2) {
              ThrowValueError("media must be a list of (n, frames) pairs");
            }
-           segments.push_back({FiniteDouble(pair[0], "media n"),
-                               pair[1].cast<int>()});
+           segments.push_back(
+               {FiniteDouble(pair[0], "media n"), pair[1].cast<int>()});
          }
          media = segments;
        },
        [] { return py::object(py::none()); }},
       {"left_port",
-       [&](const py::handle& value) { options.left_port = value.cast<FlatPort>(); },
+       [&](const py::handle& value) {
+         options.left_port = value.cast<FlatPort>();
+       },
        [&] { return py::cast(options.left_port); }},
       {"right_port",
-       [&](const py::handle& value) { options.right_port = value.cast<FlatPort>(); },
+       [&](const py::handle& value) {
+         options.right_port = value.cast<FlatPort>();
+       },
        [&] { return py::cast(options.right_port); }},
       {"port",
        [&](const py::handle& value) {
@@ -141,7 +146,8 @@ SequenceOptions SequenceOptionsFrom(const py::kwargs& kwargs) {
        [&] { return py::object(py::int_(options.seed)); }},
   };
   ApplyOptions(kwargs, fields, "SequenceSimulator");
-  options.media = media.value_or(std::vector<MediaSegment>{MediaSegment{n, frames}});
+  options.media =
+      media.value_or(std::vector<MediaSegment>{MediaSegment{n, frames}});
   options.cam1_drift.rotation = drift_rotation;
   options.cam1_drift.translation = drift_translation;
   ThrowIfError(options.Check());
@@ -253,22 +259,27 @@ world_from_cam0 (4x4), left, right (uint8 (H, W) arrays or None), matches
 iterating renders every frame.
 )doc") + kSequenceOptionsDoc;
   static const std::string simulate_doc =
-      std::string("Every frame of SequenceSimulator(rig, **options), as a "
-                  "list of dicts (see SequenceSimulator).\n") +
+      std::string(
+          "Every frame of SequenceSimulator(rig, **options), as a "
+          "list of dicts (see SequenceSimulator).\n") +
       kSequenceOptionsDoc;
   py::class_<Simulator>(module, "SequenceSimulator", simulator_doc.c_str())
       .def(py::init(&MakeSimulator), py::arg("rig"))
       .def("frame", &FrameOf, py::arg("index"),
            "Renders frame `index` in [0, len) and samples its matches: a dict "
            "(see the class). IndexError out of range. GIL released.")
-      .def("__len__", [](const Simulator& s) { return s.simulator->num_frames(); })
-      .def_property_readonly("rig", [](const Simulator& s) { return s.simulator->rig(); },
-                             "The in-air calibration (what a user has).")
-      .def_property_readonly("true_rig",
-                             [](const Simulator& s) { return s.simulator->true_rig(); },
-                             "The rig as it is in the water (with the drift).")
-      .def_property_readonly("n_of_frame",
-                             [](const Simulator& s) { return s.simulator->n_of_frame(); });
+      .def("__len__",
+           [](const Simulator& s) { return s.simulator->num_frames(); })
+      .def_property_readonly(
+          "rig", [](const Simulator& s) { return s.simulator->rig(); },
+          "The in-air calibration (what a user has).")
+      .def_property_readonly(
+          "true_rig",
+          [](const Simulator& s) { return s.simulator->true_rig(); },
+          "The rig as it is in the water (with the drift).")
+      .def_property_readonly("n_of_frame", [](const Simulator& s) {
+        return s.simulator->n_of_frame();
+      });
 
   module.def(
       "simulate",

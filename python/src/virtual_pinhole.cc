@@ -27,12 +27,14 @@ py::array_t<float> FloatMap(const cv::Mat& map) {
   return array;
 }
 
-VirtualPinholeRig MakeRig(const StereoRig& rig, double n, const std::string& fit,
+VirtualPinholeRig MakeRig(const StereoRig& rig, double n,
+                          const std::string& fit,
                           const std::optional<std::pair<int, int>>& output_size,
                           const std::optional<double>& focal_px, bool rectify,
                           double reference_depth, int num_threads) {
   VirtualPinholeRigOptions options;
-  const std::optional<VirtualPinholeFit> parsed = VirtualPinholeFitFromName(fit);
+  const std::optional<VirtualPinholeFit> parsed =
+      VirtualPinholeFitFromName(fit);
   if (!parsed) {
     ThrowValueError("unknown fit '" + fit +
                     "' (available: virtual-pinhole, no-border, full)");
@@ -80,30 +82,37 @@ the output size (h', w') holding the raw pixel behind every output pixel,
 cv2.INTER_LINEAR) gives the corrected image. pinhole: the corrected image's
 camera (rcm.Camera, model 'none', K' and size). K: its 3x3 matrix.
 )doc")
-      .def_property_readonly("map_x", [](const VirtualPinholeCamera& c) {
-        return FloatMap(c.maps.map_x);
-      })
-      .def_property_readonly("map_y", [](const VirtualPinholeCamera& c) {
-        return FloatMap(c.maps.map_y);
-      })
-      .def_property_readonly("maps", [](const VirtualPinholeCamera& c) {
-        return py::make_tuple(FloatMap(c.maps.map_x), FloatMap(c.maps.map_y));
-      }, "(map_x, map_y).")
-      .def_property_readonly("pinhole",
-                             [](const VirtualPinholeCamera& c) { return c.pinhole; })
-      .def_property_readonly("K", [](const VirtualPinholeCamera& c) {
-        return ToNumpy(c.view.k);
-      })
-      .def_property_readonly("camera_from_view", [](const VirtualPinholeCamera& c) {
-        return ToNumpy(c.view.camera_from_view);
-      }, "Rotation taking view (corrected) coordinates to camera coordinates.")
+      .def_property_readonly(
+          "map_x",
+          [](const VirtualPinholeCamera& c) { return FloatMap(c.maps.map_x); })
+      .def_property_readonly(
+          "map_y",
+          [](const VirtualPinholeCamera& c) { return FloatMap(c.maps.map_y); })
+      .def_property_readonly(
+          "maps",
+          [](const VirtualPinholeCamera& c) {
+            return py::make_tuple(FloatMap(c.maps.map_x),
+                                  FloatMap(c.maps.map_y));
+          },
+          "(map_x, map_y).")
+      .def_property_readonly(
+          "pinhole", [](const VirtualPinholeCamera& c) { return c.pinhole; })
+      .def_property_readonly(
+          "K", [](const VirtualPinholeCamera& c) { return ToNumpy(c.view.k); })
+      .def_property_readonly(
+          "camera_from_view",
+          [](const VirtualPinholeCamera& c) {
+            return ToNumpy(c.view.camera_from_view);
+          },
+          "Rotation taking view (corrected) coordinates to camera coordinates.")
       .def_property_readonly("focal_scale", &VirtualPinholeCamera::FocalScale,
                              "fx' / (n fx).")
-      .def_property_readonly("black_fraction", &VirtualPinholeCamera::BlackFraction,
+      .def_property_readonly("black_fraction",
+                             &VirtualPinholeCamera::BlackFraction,
                              "Fraction of output pixels that see nothing.")
-      .def_property_readonly("num_invalid", [](const VirtualPinholeCamera& c) {
-        return c.maps.num_invalid;
-      })
+      .def_property_readonly(
+          "num_invalid",
+          [](const VirtualPinholeCamera& c) { return c.maps.num_invalid; })
       .def(
           "correct",
           [](const VirtualPinholeCamera& c, const py::object& image) {
@@ -156,11 +165,14 @@ Kalibr camchain). Build it with rcm.virtual_pinhole_maps.
 )doc")
       .def_property_readonly("left", &VirtualPinholeRig::left)
       .def_property_readonly("right", &VirtualPinholeRig::right)
-      .def("camera",
-           [](const VirtualPinholeRig& r, int index) {
-             if (index != 0 && index != 1) ThrowValueError("index must be 0 or 1");
-             return index == 0 ? r.left() : r.right();
-           }, py::arg("index"), "The corrected camera 0 (left) or 1 (right).")
+      .def(
+          "camera",
+          [](const VirtualPinholeRig& r, int index) {
+            if (index != 0 && index != 1)
+              ThrowValueError("index must be 0 or 1");
+            return index == 0 ? r.left() : r.right();
+          },
+          py::arg("index"), "The corrected camera 0 (left) or 1 (right).")
       .def_property_readonly("corrected_rig", &VirtualPinholeRig::corrected_rig)
       .def_property_readonly("n", &VirtualPinholeRig::n)
       .def_property_readonly("build_ms", &VirtualPinholeRig::build_ms)
