@@ -348,7 +348,7 @@ point-id order.
         options.supersampling = supersampling;
         options.blur_sigma_px = blur_sigma_px;
         options.noise_sigma = noise_sigma;
-        options.seed = seed.cast<uint64_t>();
+        options.seed = SeedFromPython(seed, "seed");
         ThrowIfError(options.Check());
         // DrawTargetImage CHECKs the texture's size: refuse a density that
         // would exceed it (the board's extent plus its quiet zone).

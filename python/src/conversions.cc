@@ -21,6 +21,14 @@ std::string ShapeText(const py::array& array) {
   return text.str();
 }
 
+// A number as the shortest text that reads back to it ("1e+300", "nan").
+std::string NumberText(double value) {
+  std::ostringstream text;
+  text.precision(17);
+  text << value;
+  return text.str();
+}
+
 std::string DtypeText(const py::array& array) {
   return py::str(array.dtype()).cast<std::string>();
 }
@@ -77,7 +85,7 @@ Rows RowsFromPython(const py::handle& object, const std::string& name, int cols,
     for (int64_t i = 0; i < size; ++i) {
       if (!std::isfinite(data[i])) {
         ThrowValueError(name + " has a non-finite value (" +
-                        std::to_string(data[i]) + ") in row " +
+                        NumberText(data[i]) + ") in row " +
                         std::to_string(i / cols));
       }
     }
@@ -102,6 +110,29 @@ std::vector<double> VectorFromPython(const py::handle& object,
   return result;
 }
 
+uint64_t SeedFromPython(const py::handle& object, const std::string& name) {
+  if (PyBool_Check(object.ptr()) || !PyIndex_Check(object.ptr())) {
+    ThrowTypeError(name + " must be a non-negative int");
+  }
+  const py::int_ number = py::reinterpret_borrow<py::object>(object);
+  if (number < py::int_(0) || number > py::int_(UINT64_MAX)) {
+    ThrowValueError(name + " must be an int in [0, 2^64)");
+  }
+  return number.cast<uint64_t>();
+}
+
+int IntFromPython(const py::handle& object, const std::string& name) {
+  if (PyBool_Check(object.ptr()) || !PyIndex_Check(object.ptr())) {
+    ThrowTypeError(name + " must be an int, got " +
+                   py::str(py::type::of(object)).cast<std::string>());
+  }
+  const py::int_ number = py::reinterpret_borrow<py::object>(object);
+  if (number < py::int_(INT32_MIN) || number > py::int_(INT32_MAX)) {
+    ThrowValueError(name + " is out of range");
+  }
+  return number.cast<int>();
+}
+
 double FiniteDouble(const py::handle& object, const std::string& name) {
   if (PyBool_Check(object.ptr()) || !PyNumber_Check(object.ptr()) ||
       PyComplex_Check(object.ptr())) {
@@ -111,7 +142,7 @@ double FiniteDouble(const py::handle& object, const std::string& name) {
   const double value = PyFloat_AsDouble(object.ptr());
   if (PyErr_Occurred()) throw py::error_already_set();
   if (!std::isfinite(value)) {
-    ThrowValueError(name + " must be finite, got " + std::to_string(value));
+    ThrowValueError(name + " must be finite, got " + NumberText(value));
   }
   return value;
 }
@@ -163,7 +194,7 @@ int64_t FrameFromDouble(double value, const std::string& name, int64_t row) {
   if (!(value >= 0.0) || value != std::floor(value) || value > 9.0e15) {
     ThrowValueError(name + ": frame in row " + std::to_string(row) +
                     " must be a non-negative integer, got " +
-                    std::to_string(value));
+                    NumberText(value));
   }
   return static_cast<int64_t>(value);
 }

@@ -49,6 +49,11 @@ Eigen::Vector3d Vector3FromPython(const py::handle& object,
                                   const std::string& name);
 Eigen::Matrix4d Matrix4FromPython(const py::handle& object,
                                   const std::string& name);
+// A seed: an int in [0, 2^64) (TypeError for another type, ValueError out
+// of range).
+uint64_t SeedFromPython(const py::handle& object, const std::string& name);
+// An int (not a bool) in the range of int.
+int IntFromPython(const py::handle& object, const std::string& name);
 // One finite number (ValueError for NaN/inf, TypeError for a non-number).
 double FiniteDouble(const py::handle& object, const std::string& name);
 

@@ -19,14 +19,16 @@ namespace rcm::python {
 namespace {
 
 uint64_t SeedFrom(const py::handle& value) {
-  if (PyBool_Check(value.ptr()) || !PyIndex_Check(value.ptr())) {
-    ThrowTypeError("seed must be a non-negative int");
+  return SeedFromPython(value, "seed");
+}
+
+// A FlatPort argument (TypeError for anything else).
+FlatPort PortFrom(const py::handle& value, const std::string& name) {
+  if (!py::isinstance<FlatPort>(value)) {
+    ThrowTypeError(name + " must be an rcm.FlatPort, got " +
+                   py::str(py::type::of(value)).cast<std::string>());
   }
-  const py::int_ number = py::reinterpret_borrow<py::object>(value);
-  if (number.cast<py::object>() < py::int_(0)) {
-    ThrowValueError("seed must be a non-negative int");
-  }
-  return number.cast<uint64_t>();
+  return value.cast<FlatPort>();
 }
 
 Correspondences Sample(const StereoRig& rig, double n, double min_depth,
@@ -101,25 +103,25 @@ SequenceOptions SequenceOptionsFrom(const py::kwargs& kwargs) {
            if (pair.size() != 2) {
              ThrowValueError("media must be a list of (n, frames) pairs");
            }
-           segments.push_back(
-               {FiniteDouble(pair[0], "media n"), pair[1].cast<int>()});
+           segments.push_back({FiniteDouble(pair[0], "media n"),
+                               IntFromPython(pair[1], "media frames")});
          }
          media = segments;
        },
        [] { return py::object(py::none()); }},
       {"left_port",
        [&](const py::handle& value) {
-         options.left_port = value.cast<FlatPort>();
+         options.left_port = PortFrom(value, "left_port");
        },
        [&] { return py::cast(options.left_port); }},
       {"right_port",
        [&](const py::handle& value) {
-         options.right_port = value.cast<FlatPort>();
+         options.right_port = PortFrom(value, "right_port");
        },
        [&] { return py::cast(options.right_port); }},
       {"port",
        [&](const py::handle& value) {
-         options.left_port = options.right_port = value.cast<FlatPort>();
+         options.left_port = options.right_port = PortFrom(value, "port");
        },
        [&] { return py::cast(options.left_port); }},
       BoolOption("render_images", &options.render_images),
