@@ -7,6 +7,7 @@
 
 #include "rcm/camera/camera.h"
 #include "rcm/camera/flat_port_geometry.h"
+#include "rcm/geometry/stereo_rig.h"
 
 namespace rcm::python {
 
@@ -16,6 +17,10 @@ struct RigCamera {
   Camera camera;
   FlatPort port;
 };
+
+// A StereoRig argument that may also be the name of a reference rig
+// ("alphasense-rectified", ...; rcm.reference_rig).
+StereoRig RigFromPython(const pybind11::handle& object);
 
 void BindCameras(pybind11::module_& module);          // cameras.cc
 void BindVirtualPinhole(pybind11::module_& module);   // virtual_pinhole.cc

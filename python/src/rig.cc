@@ -116,6 +116,18 @@ StereoRig ReferenceRig(const std::string& name) {
 
 }  // namespace
 
+StereoRig RigFromPython(const py::handle& object) {
+  if (py::isinstance<py::str>(object)) {
+    return ReferenceRig(object.cast<std::string>());
+  }
+  if (!py::isinstance<StereoRig>(object)) {
+    ThrowTypeError(
+        "rig must be an rcm.StereoRig or a reference rig name, got " +
+        py::str(py::type::of(object)).cast<std::string>());
+  }
+  return object.cast<StereoRig>();
+}
+
 void BindRig(py::module_& module) {
   py::class_<StereoRig>(module, "StereoRig", R"doc(
 The two in-air calibrated cameras of a stereo pair, the transform between

@@ -31,10 +31,11 @@ FlatPort PortFrom(const py::handle& value, const std::string& name) {
   return value.cast<FlatPort>();
 }
 
-Correspondences Sample(const StereoRig& rig, double n, double min_depth,
+Correspondences Sample(const py::object& rig_object, double n, double min_depth,
                        double max_depth, int num_frames, int per_frame,
                        double frame_rate, const py::object& seed,
                        const std::optional<bool>& exact_ports) {
+  const StereoRig rig = RigFromPython(rig_object);
   StereoSamplerOptions options;
   options.n = n;
   options.min_depth = min_depth;
@@ -197,7 +198,9 @@ py::dict FrameOf(Simulator& self, int index) {
   return FrameDict(ValueOrThrow(std::move(frame)));
 }
 
-Simulator MakeSimulator(const StereoRig& rig, const py::kwargs& kwargs) {
+Simulator MakeSimulator(const py::object& rig_object,
+                        const py::kwargs& kwargs) {
+  const StereoRig rig = RigFromPython(rig_object);
   const SequenceOptions options = SequenceOptionsFrom(kwargs);
   StatusOr<std::unique_ptr<SequenceSimulator>> simulator =
       Status::Error("not built");
@@ -255,7 +258,9 @@ SequenceSimulator): a robot moving through a textured tank, the rig behind
 exact flat ports, per frame two rendered 8-bit images and exact
 correspondences consistent with them.
 
-SequenceSimulator(rig, **options); frame(i) -> dict(index, t (s), n_true,
+SequenceSimulator(rig, **options), rig an rcm.StereoRig or a reference rig
+name ('alphasense-rectified', 'alphasense-unrectified', 'narrow-field');
+frame(i) -> dict(index, t (s), n_true,
 world_from_cam0 (4x4), left, right (uint8 (H, W) arrays or None), matches
 (rcm.Correspondences), outlier_indices); len() is the number of frames;
 iterating renders every frame.
@@ -285,7 +290,7 @@ iterating renders every frame.
 
   module.def(
       "simulate",
-      [](const StereoRig& rig, const py::kwargs& kwargs) {
+      [](const py::object& rig, const py::kwargs& kwargs) {
         Simulator simulator = MakeSimulator(rig, kwargs);
         py::list frames;
         for (int i = 0; i < simulator.simulator->num_frames(); ++i) {

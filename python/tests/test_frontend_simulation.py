@@ -134,3 +134,20 @@ def test_front_end_bad_images_and_options(rendered, realistic_rig):
     with pytest.raises(ValueError) as error:
         rcm.StereoFrontEnd(realistic_rig, search_range=(1.5, 1.2))
     one_line(error)
+
+
+def test_rig_presets_by_name():
+    frames = rcm.simulate("narrow-field", frames=2, matches_per_frame=100,
+                          render_images=False, seed=2)
+    assert [len(f["matches"]) for f in frames] == [100, 100]
+    result = rcm.refine_refractive_index(
+        rcm.reference_rig("narrow-field"),
+        rcm.Correspondences(np.vstack([f["matches"].to_array()
+                                       for f in frames])))
+    assert abs(result.n - 1.333) < 1e-9
+    with pytest.raises(ValueError) as error:
+        rcm.simulate("alphasense", frames=1)
+    assert "alphasense-rectified" in one_line(error)
+    with pytest.raises(TypeError) as error:
+        rcm.SequenceSimulator(3)
+    one_line(error)
