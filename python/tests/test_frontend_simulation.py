@@ -137,11 +137,11 @@ def test_front_end_bad_images_and_options(rendered, realistic_rig):
 
 
 def test_rig_presets_by_name():
-    frames = rcm.simulate("narrow-field", frames=2, matches_per_frame=100,
-                          render_images=False, seed=2)
+    frames = rcm.simulate("alphasense-rectified", frames=2,
+                          matches_per_frame=100, render_images=False, seed=2)
     assert [len(f["matches"]) for f in frames] == [100, 100]
     result = rcm.refine_refractive_index(
-        rcm.reference_rig("narrow-field"),
+        rcm.reference_rig("alphasense-rectified"),
         rcm.Correspondences(np.vstack([f["matches"].to_array()
                                        for f in frames])))
     assert abs(result.n - 1.333) < 1e-9
