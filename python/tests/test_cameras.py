@@ -142,3 +142,21 @@ def test_virtual_pinhole_correct_and_remap_agree(ideal_rig):
     with pytest.raises(ValueError) as error:
         rcm.virtual_pinhole_maps(ideal_rig, 1.333, fit="widest")
     assert "widest" in one_line(error)
+
+
+def test_rectified_virtual_pinhole_rig_writes_its_camchain(tmp_path,
+                                                           realistic_rig):
+    corrected = rcm.virtual_pinhole_maps(realistic_rig, 1.333, rectify=True)
+    rig = corrected.corrected_rig
+    # The ideal rectified pair: R = I, t = (-b, 0, 0), one K' for both.
+    np.testing.assert_allclose(rig.rotation, np.eye(3), atol=1e-15)
+    np.testing.assert_allclose(rig.translation[1:], 0.0, atol=1e-15)
+    assert rig.translation[0] == pytest.approx(-realistic_rig.baseline,
+                                               rel=1e-12)
+    np.testing.assert_array_equal(corrected.left.K, corrected.right.K)
+    assert corrected.left.pinhole.model == "none"
+    path = tmp_path / "corrected.yaml"
+    corrected.write(path)
+    back = rcm.read_stereo_rig(path)
+    np.testing.assert_array_equal(back.cam1_from_cam0, rig.cam1_from_cam0)
+    assert back.cam0.lens == corrected.left.pinhole
