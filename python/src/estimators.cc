@@ -151,8 +151,9 @@ py::array_t<bool> MaskArray(const std::vector<int64_t>& indices, int64_t size) {
   return a;
 }
 
-RefinementSummary Refine(const StereoRig& rig, const py::object& matches,
-                         const py::kwargs& kwargs) {
+RefinementSummary Refine(const py::object& rig_object,
+                         const py::object& matches, const py::kwargs& kwargs) {
+  const StereoRig rig = RigFromPython(rig_object);
   const RefinementOptions options =
       RefinementOptionsFrom(kwargs, "refine_refractive_index");
   const Correspondences* held = py::isinstance<Correspondences>(matches)
@@ -194,8 +195,9 @@ void RefuseThickPort(const StereoRig& rig, const std::string& what) {
   }
 }
 
-ClosedFormResult ClosedForm(const StereoRig& rig, const py::object& matches,
-                            double mask_eta) {
+ClosedFormResult ClosedForm(const py::object& rig_object,
+                            const py::object& matches, double mask_eta) {
+  const StereoRig rig = RigFromPython(rig_object);
   RefuseThickPort(rig, "the closed form");
   PaperOnlineEstimatorOptions options;
   options.eta = mask_eta;
@@ -226,8 +228,9 @@ ClosedFormResult ClosedForm(const StereoRig& rig, const py::object& matches,
   return result;
 }
 
-DoubleArray ClosedFormPerMatch(const StereoRig& rig,
+DoubleArray ClosedFormPerMatch(const py::object& rig_object,
                                const py::object& matches) {
+  const StereoRig rig = RigFromPython(rig_object);
   RefuseThickPort(rig, "the closed form");
   const std::vector<StereoCorrespondence> list =
       MatchesFromPython(matches, "matches");
@@ -380,8 +383,8 @@ rotation, calibration, consistency (dicts or None).
 n by robust least squares on the refractive epipolar loci (the estimator of
 record; C++ RefineRefractiveIndex), over all matches of all frames.
 
-rig: rcm.StereoRig (a rig with a thick port is refined with the thick-port
-model); matches: rcm.Correspondences, a dict of arrays xl, yl, xr, yr
+rig: rcm.StereoRig or a reference rig name (a rig with a thick port is
+refined with the thick-port model); matches: rcm.Correspondences, a dict of arrays xl, yl, xr, yr
 [, frame, t], an (N, 4) [xl, yl, xr, yr] or (N, 5) [frame, xl, yl, xr, yr]
 array of raw pixels.
 
@@ -507,7 +510,8 @@ estimate (an OnlineEstimate), or None while there is none yet (the reason
 is in last_update.cumulative_error); current() returns it or raises
 ValueError with the reason. Thin ports only.
 )doc")
-      .def(py::init([](const StereoRig& rig, const py::kwargs& kwargs) {
+      .def(py::init([](const py::object& rig_object, const py::kwargs& kwargs) {
+             const StereoRig rig = RigFromPython(rig_object);
              RefuseThickPort(rig, "the online estimator");
              const RefinementOptions options =
                  RefinementOptionsFrom(kwargs, "OnlineEstimator");
@@ -630,9 +634,10 @@ estimate (WindowEstimate) or None; `frame` labels the frame in the reports
 (default: the count of add_frame calls). switches: the MediumSwitch list.
 Thin ports only.
 )doc")
-      .def(py::init([](const StereoRig& rig, int window_frames,
+      .def(py::init([](const py::object& rig_object, int window_frames,
                        double change_threshold, int confirm_frames,
                        const py::kwargs& kwargs) {
+             const StereoRig rig = RigFromPython(rig_object);
              RefuseThickPort(rig, "the sliding-window estimator");
              const RefinementOptions options =
                  RefinementOptionsFrom(kwargs, "SlidingWindowEstimator");

@@ -100,7 +100,8 @@ StereoMatches Match(FrontEnd& self, const py::object& left,
   return ValueOrThrow(std::move(matches));
 }
 
-FrontEnd MakeFrontEnd(const StereoRig& rig, const py::kwargs& kwargs) {
+FrontEnd MakeFrontEnd(const py::object& rig_object, const py::kwargs& kwargs) {
+  const StereoRig rig = RigFromPython(rig_object);
   return FrontEnd{ValueOrThrow(StereoFrontEnd::Create(
       rig, FrontEndOptionsFrom(kwargs, "StereoFrontEnd")))};
 }
@@ -188,8 +189,9 @@ the prior search_range). The GIL is released while it runs.
       kOptionsDoc;
   module.def(
       "match_stereo",
-      [](const StereoRig& rig, const py::object& left, const py::object& right,
-         const py::kwargs& kwargs) {
+      [](const py::object& rig_object, const py::object& left,
+         const py::object& right, const py::kwargs& kwargs) {
+        const StereoRig rig = RigFromPython(rig_object);
         FrontEnd front_end{ValueOrThrow(StereoFrontEnd::Create(
             rig, FrontEndOptionsFrom(kwargs, "match_stereo")))};
         return Match(front_end, left, right, 0, std::nullopt, std::nullopt);

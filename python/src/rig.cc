@@ -111,7 +111,7 @@ StereoRig ReferenceRig(const std::string& name) {
   if (name == "narrow-field") return NarrowFieldRig();
   ThrowValueError("unknown reference rig '" + name +
                   "' (available: alphasense-rectified, alphasense-unrectified, "
-                  "narrow-field)");
+                  "narrow-field; a rig file is read with rcm.read_stereo_rig)");
 }
 
 }  // namespace

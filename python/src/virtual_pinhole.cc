@@ -27,11 +27,12 @@ py::array_t<float> FloatMap(const cv::Mat& map) {
   return array;
 }
 
-VirtualPinholeRig MakeRig(const StereoRig& rig, double n,
+VirtualPinholeRig MakeRig(const py::object& rig_object, double n,
                           const std::string& fit,
                           const std::optional<std::pair<int, int>>& output_size,
                           const std::optional<double>& focal_px, bool rectify,
                           double reference_depth, int num_threads) {
+  const StereoRig rig = RigFromPython(rig_object);
   VirtualPinholeRigOptions options;
   const std::optional<VirtualPinholeFit> parsed =
       VirtualPinholeFitFromName(fit);

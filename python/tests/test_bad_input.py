@@ -20,6 +20,9 @@ CASES = [
      ValueError),
     ("not a rotation", lambda: rcm.StereoRig(RIG.cam0.lens, RIG.cam1.lens,
                                              np.ones((4, 4))), ValueError),
+    ("rig is None", lambda: rcm.refine_refractive_index(None, np.ones((20, 4))),
+     TypeError),
+    ("rig is a path", lambda: rcm.OnlineEstimator("rig.yaml"), ValueError),
     ("path is an int", lambda: rcm.read_stereo_rig(123), TypeError),
     ("path with a comma", lambda: rcm.read_stereo_rig("a,b"), ValueError),
     ("negative drift prior", lambda: rcm.read_stereo_rig(
