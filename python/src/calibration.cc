@@ -1,0 +1,664 @@
+// Calibration (rcm::calib): targets, stereo calibration in air and the
+// underwater refinement, from images (NumPy arrays or files) or from corner
+// observations; and the target renderer for synthetic views.
+#include <pybind11/stl.h>
+
+#include <cmath>
+
+#include "bindings.h"
+#include "conversions.h"
+#include "errors.h"
+#include "options.h"
+#include "rcm/calib/calibration_target.h"
+#include "rcm/calib/stereo_calibration.h"
+#include "rcm/calib/target_detector.h"
+#include "rcm/calib/target_image.h"
+#include "rcm/calib/target_renderer.h"
+#include "rcm/calib/underwater_calibration.h"
+#include "rcm/io/image_file.h"
+
+namespace rcm::python {
+namespace {
+
+using calib::CalibrationTarget;
+using calib::ImageSize;
+using calib::StereoView;
+using calib::TargetObservation;
+
+// One image of a list: a NumPy uint8 array (viewed, kept alive by `keep`)
+// or a path (read as 8-bit gray by the library).
+cv::Mat ImageOrFile(const py::handle& item, const std::string& name,
+                    std::vector<py::object>* keep) {
+  if (py::isinstance<py::array>(item)) {
+    py::object holder;
+    const cv::Mat image = ImageFromPython(item, name, &holder);
+    keep->push_back(holder);
+    return image;
+  }
+  const std::string path = PathFromPython(item);
+  return ReadOrThrow(path, ReadImage(path, /*grayscale=*/true));
+}
+
+// Detects the target in every pair (GIL released), with the image sizes.
+struct Detections {
+  std::vector<StereoView> views;
+  ImageSize sizes[2];
+};
+
+Detections Detect(const CalibrationTarget& target, const py::sequence& left,
+                  const py::sequence& right) {
+  if (py::len(left) != py::len(right)) {
+    ThrowValueError("left_images and right_images differ in length (" +
+                    std::to_string(py::len(left)) + " and " +
+                    std::to_string(py::len(right)) + ")");
+  }
+  if (py::len(left) == 0) ThrowValueError("no images");
+  std::vector<py::object> keep;
+  std::vector<cv::Mat> images[2];
+  Detections detections;
+  for (size_t i = 0; i < py::len(left); ++i) {
+    for (int side = 0; side < 2; ++side) {
+      const std::string name = std::string(side ? "right" : "left") +
+                               "_images[" + std::to_string(i) + "]";
+      const cv::Mat image = ImageOrFile((side ? right : left)[i], name, &keep);
+      ImageSize& size = detections.sizes[side];
+      if (i == 0) size = {image.cols, image.rows};
+      if (image.cols != size.width || image.rows != size.height) {
+        ThrowValueError(name + " is " + std::to_string(image.cols) + " x " +
+                        std::to_string(image.rows) + ", the first image " +
+                        std::to_string(size.width) + " x " +
+                        std::to_string(size.height));
+      }
+      images[side].push_back(image);
+    }
+  }
+  {
+    py::gil_scoped_release release;
+    for (size_t i = 0; i < images[0].size(); ++i) {
+      StereoView view =
+          calib::DetectTargetPair(images[0][i], images[1][i], target);
+      view.left_name = "left " + std::to_string(i);
+      view.right_name = "right " + std::to_string(i);
+      detections.views.push_back(std::move(view));
+    }
+  }
+  return detections;
+}
+
+// A corner list (ids (M,), pixels (M, 2)) or None.
+std::optional<TargetObservation> ObservationFrom(const py::handle& item,
+                                                 const std::string& name) {
+  if (item.is_none()) return std::nullopt;
+  const py::tuple pair = py::reinterpret_borrow<py::object>(item);
+  if (pair.size() != 2) {
+    ThrowValueError(name + " must be None or (point_ids, pixels)");
+  }
+  const py::array ids_array = py::array::ensure(pair[0]);
+  if (!ids_array ||
+      (ids_array.dtype().kind() != 'i' && ids_array.dtype().kind() != 'u')) {
+    ThrowTypeError(name + " point ids must be integers");
+  }
+  const auto ids =
+      py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(
+          ids_array);
+  const Rows pixels = RowsFromPython(pair[1], name + " pixels", 2, false, true);
+  if (ids.ndim() != 1 || ids.shape(0) != pixels.rows) {
+    ThrowValueError(name + ": one point id per pixel");
+  }
+  TargetObservation observation;
+  observation.detector = "python";
+  for (int64_t i = 0; i < pixels.rows; ++i) {
+    observation.point_ids.push_back(static_cast<int>(ids.data()[i]));
+    observation.pixels.emplace_back(pixels.data()[2 * i],
+                                    pixels.data()[2 * i + 1]);
+  }
+  return observation;
+}
+
+std::vector<StereoView> ViewsFromCorners(const CalibrationTarget& target,
+                                         const py::sequence& views) {
+  const int num_points = calib::NumTargetPoints(target);
+  std::vector<StereoView> result;
+  for (size_t v = 0; v < py::len(views); ++v) {
+    const py::tuple pair = py::reinterpret_borrow<py::object>(views[v]);
+    if (pair.size() != 2) {
+      ThrowValueError("views[" + std::to_string(v) +
+                      "] must be (left corners, right corners)");
+    }
+    StereoView view;
+    view.left_name = "view " + std::to_string(v);
+    view.right_name = view.left_name;
+    view.left = ObservationFrom(pair[0], "views[" + std::to_string(v) + "][0]");
+    view.right =
+        ObservationFrom(pair[1], "views[" + std::to_string(v) + "][1]");
+    for (const std::optional<TargetObservation>* o :
+         {&view.left, &view.right}) {
+      if (!*o) continue;
+      for (const int id : (*o)->point_ids) {
+        if (id < 0 || id >= num_points) {
+          ThrowValueError("views[" + std::to_string(v) + "]: point id " +
+                          std::to_string(id) + " outside [0, " +
+                          std::to_string(num_points) + ")");
+        }
+      }
+    }
+    result.push_back(std::move(view));
+  }
+  if (result.empty()) ThrowValueError("no views");
+  return result;
+}
+
+ImageSize SizeFrom(const std::pair<int, int>& size) {
+  return {size.first, size.second};
+}
+
+calib::StereoCalibrationOptions StereoOptionsFrom(const std::string& model,
+                                                  const py::kwargs& kwargs) {
+  calib::StereoCalibrationOptions o;
+  const std::optional<LensModelId> lens = LensModelFromName(model);
+  if (!lens || *lens == LensModelId::kPinhole) {
+    ThrowValueError("model must be 'radtan' or 'equidistant', got '" + model +
+                    "'");
+  }
+  o.model = *lens;
+  ApplyOptions(
+      kwargs,
+      {DoubleOption("huber_px", &o.huber_px),
+       DoubleOption("outlier_sigmas", &o.outlier_sigmas),
+       DoubleOption("min_outlier_threshold_px", &o.min_outlier_threshold_px),
+       IntOption("max_outlier_rounds", &o.max_outlier_rounds),
+       IntOption("max_num_iterations", &o.max_num_iterations),
+       BoolOption("use_single_camera_views", &o.use_single_camera_views),
+       IntOption("min_corners_per_view", &o.min_corners_per_view),
+       BoolOption("compute_covariance", &o.compute_covariance),
+       IntOption("num_threads", &o.num_threads)},
+      "calibrate_stereo");
+  ThrowIfError(o.Check());
+  return o;
+}
+
+calib::UnderwaterCalibrationOptions UnderwaterOptionsFrom(
+    const py::kwargs& kwargs) {
+  calib::UnderwaterCalibrationOptions o;
+  ApplyOptions(
+      kwargs,
+      {DoubleOption("initial_n", &o.initial_n),
+       BoolOption("estimate_air_gap", &o.estimate_air_gap),
+       BoolOption("estimate_port_tilt", &o.estimate_port_tilt),
+       DoubleOption("huber_px", &o.huber_px),
+       DoubleOption("outlier_sigmas", &o.outlier_sigmas),
+       DoubleOption("min_outlier_threshold_px", &o.min_outlier_threshold_px),
+       IntOption("max_outlier_rounds", &o.max_outlier_rounds),
+       IntOption("max_num_iterations", &o.max_num_iterations),
+       BoolOption("use_single_camera_views", &o.use_single_camera_views),
+       IntOption("min_corners_per_view", &o.min_corners_per_view),
+       IntOption("folds", &o.folds),
+       BoolOption("fit_conventional_model", &o.fit_conventional_model),
+       IntOption("num_threads", &o.num_threads)},
+      "calibrate_underwater");
+  ThrowIfError(o.Check());
+  return o;
+}
+
+// The result of a stereo calibration with its rig.
+struct StereoCalibrationResult {
+  calib::StereoCalibration calibration;
+  StereoRig rig;
+  std::vector<std::string> notes;
+};
+
+StereoCalibrationResult RunStereo(
+    const CalibrationTarget& target, const std::vector<StereoView>& views,
+    const ImageSize& cam0, const ImageSize& cam1,
+    const calib::StereoCalibrationOptions& options) {
+  StatusOr<calib::StereoCalibration> calibration = Status::Error("not run");
+  {
+    py::gil_scoped_release release;
+    calibration = calib::CalibrateStereo(target, views, cam0, cam1, options);
+  }
+  calib::StereoCalibration result = ValueOrThrow(std::move(calibration));
+  StereoRig rig = ValueOrThrow(StereoRig::Create(
+      result.cam0.camera, result.cam1.camera, result.cam1_from_cam0));
+  std::vector<std::string> notes;
+  for (const StereoView& view : views) {
+    if (!view.note.empty()) notes.push_back(view.left_name + ": " + view.note);
+  }
+  return {std::move(result), std::move(rig), std::move(notes)};
+}
+
+struct UnderwaterResult {
+  calib::UnderwaterCalibration calibration;
+  std::vector<std::string> notes;
+};
+
+UnderwaterResult RunUnderwater(
+    const CalibrationTarget& target, const std::vector<StereoView>& views,
+    const ImageSize& cam0, const ImageSize& cam1, const StereoRig& air_rig,
+    const calib::UnderwaterCalibrationOptions& options) {
+  StatusOr<calib::UnderwaterCalibration> calibration = Status::Error("not run");
+  {
+    py::gil_scoped_release release;
+    calibration =
+        calib::CalibrateUnderwater(target, views, cam0, cam1, air_rig, options);
+  }
+  UnderwaterResult result{ValueOrThrow(std::move(calibration)), {}};
+  result.notes = result.calibration.notes;
+  for (const StereoView& view : views) {
+    if (!view.note.empty()) {
+      result.notes.push_back(view.left_name + ": " + view.note);
+    }
+  }
+  return result;
+}
+
+DoubleArray Sigmas(const calib::CameraCalibration& c) {
+  DoubleArray a(std::vector<py::ssize_t>{c.camera.num_params()});
+  for (int i = 0; i < c.camera.num_params(); ++i)
+    a.mutable_data()[i] = c.sigma[i];
+  return a;
+}
+
+constexpr const char* kStereoOptionsDoc = R"doc(
+Keyword options (StereoCalibrationOptions): huber_px=1.0 (pixels),
+outlier_sigmas=5.0, min_outlier_threshold_px=2.0, max_outlier_rounds=3,
+max_num_iterations=200, use_single_camera_views=True,
+min_corners_per_view=6, compute_covariance=True, num_threads=2.
+)doc";
+
+constexpr const char* kUnderwaterOptionsDoc = R"doc(
+Keyword options (UnderwaterCalibrationOptions): initial_n=1.34,
+estimate_air_gap=False, estimate_port_tilt=False, huber_px=1.0,
+outlier_sigmas=5.0, min_outlier_threshold_px=2.0, max_outlier_rounds=3,
+max_num_iterations=200, use_single_camera_views=True,
+min_corners_per_view=6, folds=10 (leave-out replicates; 0 or 1: none),
+fit_conventional_model=True, num_threads=2.
+)doc";
+
+}  // namespace
+
+void BindCalibration(py::module_& module) {
+  py::class_<CalibrationTarget>(module, "CalibrationTarget", R"doc(
+A planar calibration target (Kalibr's target YAML). Build one with
+CalibrationTarget.checkerboard(cols, rows, square) (INNER corners, square
+edge in meters), .aprilgrid(cols, rows, tag_size, tag_spacing) (tags, edge
+in meters, gap as a fraction of the tag), .charuco(squares_x, squares_y,
+square, marker, dictionary='DICT_6X6_250'), or read_calibration_target(path).
+points: the (N, 3) target points in the target frame (z = 0), meters, in
+point-id order.
+)doc")
+      .def_static(
+          "checkerboard",
+          [](int cols, int rows, double square) {
+            return ValueOrThrow(
+                calib::MakeCheckerboardTarget(cols, rows, square));
+          },
+          py::arg("cols"), py::arg("rows"), py::arg("square"))
+      .def_static(
+          "aprilgrid",
+          [](int cols, int rows, double tag_size, double tag_spacing) {
+            return ValueOrThrow(
+                calib::MakeAprilGridTarget(cols, rows, tag_size, tag_spacing));
+          },
+          py::arg("cols"), py::arg("rows"), py::arg("tag_size"),
+          py::arg("tag_spacing"))
+      .def_static(
+          "charuco",
+          [](int squares_x, int squares_y, double square, double marker,
+             const std::string& dictionary) {
+            return ValueOrThrow(calib::MakeCharucoTarget(
+                squares_x, squares_y, square, marker, dictionary));
+          },
+          py::arg("squares_x"), py::arg("squares_y"), py::arg("square"),
+          py::arg("marker"), py::arg("dictionary") = "DICT_6X6_250")
+      .def_property_readonly("points",
+                             [](const CalibrationTarget& t) {
+                               const std::vector<Eigen::Vector3d> points =
+                                   calib::TargetPoints(t);
+                               DoubleArray a = NewArray(points.size(), 3);
+                               for (size_t i = 0; i < points.size(); ++i) {
+                                 for (int k = 0; k < 3; ++k) {
+                                   a.mutable_data()[3 * i + k] = points[i][k];
+                                 }
+                               }
+                               return a;
+                             })
+      .def_readonly("cols", &CalibrationTarget::cols)
+      .def_readonly("rows", &CalibrationTarget::rows)
+      .def("__repr__", [](const CalibrationTarget& t) {
+        return "CalibrationTarget(" + calib::DescribeTarget(t) + ")";
+      });
+
+  module.def(
+      "read_calibration_target",
+      [](const py::object& path) {
+        const std::string file = PathFromPython(path);
+        return ReadOrThrow(file, calib::ReadCalibrationTarget(file));
+      },
+      py::arg("path"), "Reads a Kalibr target YAML (OSError / ValueError).");
+
+  module.def(
+      "render_target",
+      [](const Camera& camera, const CalibrationTarget& target,
+         const py::object& cam_from_target, int supersampling,
+         double blur_sigma_px, double noise_sigma, const py::object& seed,
+         double pixels_per_metre) {
+        const Rigid3d pose = ValueOrThrow(Rigid3d::FromMatrix(
+            Matrix4FromPython(cam_from_target, "cam_from_target")));
+        calib::TargetRenderOptions options;
+        options.supersampling = supersampling;
+        options.blur_sigma_px = blur_sigma_px;
+        options.noise_sigma = noise_sigma;
+        options.seed = SeedFromPython(seed, "seed");
+        ThrowIfError(options.Check());
+        // DrawTargetImage CHECKs the texture's size: refuse a density that
+        // would exceed it (the board's extent plus its quiet zone).
+        const std::vector<Eigen::Vector3d> points = calib::TargetPoints(target);
+        Eigen::Vector2d low = points[0].head<2>();
+        Eigen::Vector2d high = low;
+        for (const Eigen::Vector3d& p : points) {
+          low = low.cwiseMin(p.head<2>());
+          high = high.cwiseMax(p.head<2>());
+        }
+        const Eigen::Vector2d extent = 2.0 * (high - low).cwiseMax(1e-3);
+        if (!(pixels_per_metre > 0.0) || !std::isfinite(pixels_per_metre) ||
+            extent.x() * extent.y() * pixels_per_metre * pixels_per_metre >
+                1e8) {
+          ThrowValueError(
+              "pixels_per_metre must be > 0 and keep the texture "
+              "below 1e8 pixels");
+        }
+        const calib::TargetRenderer renderer =
+            ValueOrThrow(calib::TargetRenderer::Create(
+                camera, calib::DrawTargetImage(target, pixels_per_metre)));
+        cv::Mat image;
+        {
+          py::gil_scoped_release release;
+          image = renderer.Render(pose, options);
+        }
+        return ImageToNumpy(image);
+      },
+      py::arg("camera"), py::arg("target"), py::arg("cam_from_target"),
+      py::kw_only(), py::arg("supersampling") = 4,
+      py::arg("blur_sigma_px") = 0.0, py::arg("noise_sigma") = 0.0,
+      py::arg("seed") = 0, py::arg("pixels_per_metre") = 4000.0,
+      R"doc(
+A synthetic 8-bit image (uint8 (H, W)) of the target seen in air by an
+rcm.Camera at cam_from_target (4x4, meters; target points map into the
+camera frame). supersampling: sub-samples per pixel axis (1..16);
+blur_sigma_px: Gaussian blur, pixels; noise_sigma: gray levels.
+)doc");
+
+  py::class_<StereoCalibrationResult>(module, "StereoCalibrationResult", R"doc(
+The result of calibrate_stereo: rig (rcm.StereoRig, cam1_from_cam0 in
+meters), rms_px (over all corners of used views, as cv2.stereoCalibrate's),
+inlier_rms_px, pixel_sigma (estimated corner noise, pixels), initial_rms_px
+(OpenCV's initialization), baseline and baseline_sigma (meters), cam0_sigma
+and cam1_sigma (standard deviations of [fx, fy, cx, cy, d...]),
+extrinsics_covariance (6x6, [w; t] in rad and m), num_views_used,
+num_stereo_views, num_inliers, num_outliers, num_parameters,
+cam0_from_target (per input view: 4x4 or None), notes (why views were
+dropped).
+)doc")
+      .def_property_readonly(
+          "rig", [](const StereoCalibrationResult& r) { return r.rig; })
+      .def_property_readonly(
+          "rms_px",
+          [](const StereoCalibrationResult& r) { return r.calibration.rms_px; })
+      .def_property_readonly("inlier_rms_px",
+                             [](const StereoCalibrationResult& r) {
+                               return r.calibration.inlier_rms_px;
+                             })
+      .def_property_readonly("pixel_sigma",
+                             [](const StereoCalibrationResult& r) {
+                               return r.calibration.pixel_sigma;
+                             })
+      .def_property_readonly("initial_rms_px",
+                             [](const StereoCalibrationResult& r) {
+                               return r.calibration.initial_rms_px;
+                             })
+      .def_property_readonly("baseline",
+                             [](const StereoCalibrationResult& r) {
+                               return r.calibration.baseline;
+                             })
+      .def_property_readonly("baseline_sigma",
+                             [](const StereoCalibrationResult& r) {
+                               return r.calibration.baseline_sigma;
+                             })
+      .def_property_readonly("cam0_sigma",
+                             [](const StereoCalibrationResult& r) {
+                               return Sigmas(r.calibration.cam0);
+                             })
+      .def_property_readonly("cam1_sigma",
+                             [](const StereoCalibrationResult& r) {
+                               return Sigmas(r.calibration.cam1);
+                             })
+      .def_property_readonly(
+          "extrinsics_covariance",
+          [](const StereoCalibrationResult& r) {
+            return ToNumpy(r.calibration.extrinsics_covariance);
+          })
+      .def_property_readonly("num_views_used",
+                             [](const StereoCalibrationResult& r) {
+                               return r.calibration.num_views_used;
+                             })
+      .def_property_readonly("num_stereo_views",
+                             [](const StereoCalibrationResult& r) {
+                               return r.calibration.num_stereo_views;
+                             })
+      .def_property_readonly("num_inliers",
+                             [](const StereoCalibrationResult& r) {
+                               return r.calibration.num_inliers;
+                             })
+      .def_property_readonly("num_outliers",
+                             [](const StereoCalibrationResult& r) {
+                               return r.calibration.num_outliers;
+                             })
+      .def_property_readonly("num_parameters",
+                             [](const StereoCalibrationResult& r) {
+                               return r.calibration.num_parameters;
+                             })
+      .def_property_readonly(
+          "cam0_from_target",
+          [](const StereoCalibrationResult& r) {
+            py::list poses;
+            for (const std::optional<Rigid3d>& pose :
+                 r.calibration.cam0_from_target) {
+              poses.append(pose ? py::object(ToNumpy(pose->ToMatrix()))
+                                : py::object(py::none()));
+            }
+            return poses;
+          })
+      .def_readonly("notes", &StereoCalibrationResult::notes)
+      .def("__repr__", [](const StereoCalibrationResult& r) {
+        return "StereoCalibrationResult(rms_px=" +
+               std::to_string(r.calibration.rms_px) +
+               ", views_used=" + std::to_string(r.calibration.num_views_used) +
+               ", baseline=" + std::to_string(r.calibration.baseline) + " m)";
+      });
+
+  static const std::string stereo_doc = std::string(R"doc(
+Air stereo calibration by bundle adjustment over views of a planar target
+(C++ rcm::calib::CalibrateStereo).
+
+calibrate_stereo(target, left_images, right_images, model='radtan', **options)
+    images: equal-length lists of NumPy uint8 arrays (gray, BGR) or file
+    paths; the target is detected in each pair (GIL released).
+Returns a StereoCalibrationResult. ValueError with the library's message
+when no view shows the target in both cameras, a camera has fewer than 3
+usable views, and so on.
+)doc") + kStereoOptionsDoc;
+  module.def(
+      "calibrate_stereo",
+      [](const CalibrationTarget& target, const py::sequence& left_images,
+         const py::sequence& right_images, const std::string& model,
+         const py::kwargs& kwargs) {
+        const calib::StereoCalibrationOptions options =
+            StereoOptionsFrom(model, kwargs);
+        const Detections detections = Detect(target, left_images, right_images);
+        return RunStereo(target, detections.views, detections.sizes[0],
+                         detections.sizes[1], options);
+      },
+      py::arg("target"), py::arg("left_images"), py::arg("right_images"),
+      py::arg("model") = "radtan", stereo_doc.c_str());
+
+  static const std::string stereo_corners_doc = std::string(R"doc(
+calibrate_stereo from corner observations instead of images.
+
+views: a list of (left, right) per view, each None or (point_ids (M,) ints,
+pixels (M, 2) raw pixels), point ids indexing target.points; cam0_size,
+cam1_size: (width, height) in pixels.
+)doc") + kStereoOptionsDoc;
+  module.def(
+      "calibrate_stereo_from_corners",
+      [](const CalibrationTarget& target, const py::sequence& views,
+         const std::pair<int, int>& cam0_size,
+         const std::pair<int, int>& cam1_size, const std::string& model,
+         const py::kwargs& kwargs) {
+        const calib::StereoCalibrationOptions options =
+            StereoOptionsFrom(model, kwargs);
+        return RunStereo(target, ViewsFromCorners(target, views),
+                         SizeFrom(cam0_size), SizeFrom(cam1_size), options);
+      },
+      py::arg("target"), py::arg("views"), py::arg("cam0_size"),
+      py::arg("cam1_size"), py::arg("model") = "radtan",
+      stereo_corners_doc.c_str());
+
+  py::class_<UnderwaterResult>(module, "UnderwaterCalibrationResult", R"doc(
+The result of calibrate_underwater: n, sigma_n (from the covariance),
+sigma_n_leave_out (or None), rig (the air lenses with the refined
+cam1_from_cam0 and ports: what the other tools take), extrinsics_estimated,
+extrinsic_change (dict: rotation_deg, angle_deg, translation_mm and their
+sigmas), ports (two dicts: port, air_gap_estimated, air_gap_sigma (m),
+tilt_estimated, tilt_deg), rms_px, inlier_rms_px, pixel_sigma,
+initial_rms_px, num_views_used, num_stereo_views, num_inliers,
+num_outliers, num_parameters, notes.
+)doc")
+      .def_property_readonly(
+          "n", [](const UnderwaterResult& r) { return r.calibration.n; })
+      .def_property_readonly(
+          "sigma_n",
+          [](const UnderwaterResult& r) { return r.calibration.sigma_n; })
+      .def_property_readonly(
+          "sigma_n_leave_out",
+          [](const UnderwaterResult& r) -> py::object {
+            if (!r.calibration.sigma_n_leave_out) return py::none();
+            return py::float_(*r.calibration.sigma_n_leave_out);
+          })
+      .def_property_readonly(
+          "rig", [](const UnderwaterResult& r) { return r.calibration.rig; })
+      .def_property_readonly("extrinsics_estimated",
+                             [](const UnderwaterResult& r) {
+                               return r.calibration.extrinsics_estimated;
+                             })
+      .def_property_readonly(
+          "extrinsic_change",
+          [](const UnderwaterResult& r) {
+            const calib::ExtrinsicChange& c = r.calibration.extrinsic_change;
+            py::dict d;
+            d["rotation_deg"] = ToNumpy(c.rotation_deg);
+            d["rotation_sigma_deg"] = ToNumpy(c.rotation_sigma_deg);
+            d["angle_deg"] = c.angle_deg;
+            d["angle_sigma_deg"] = c.angle_sigma_deg;
+            d["translation_mm"] = ToNumpy(c.translation_mm);
+            d["translation_sigma_mm"] = ToNumpy(c.translation_sigma_mm);
+            return d;
+          })
+      .def_property_readonly(
+          "ports",
+          [](const UnderwaterResult& r) {
+            py::list ports;
+            for (const calib::PortEstimate& p : r.calibration.ports) {
+              py::dict d;
+              d["port"] = p.port;
+              d["air_gap_estimated"] = p.air_gap_estimated;
+              d["air_gap_sigma"] = p.air_gap_sigma;
+              d["tilt_estimated"] = p.tilt_estimated;
+              d["tilt_deg"] = p.tilt_deg;
+              ports.append(d);
+            }
+            return ports;
+          })
+      .def_property_readonly(
+          "rms_px",
+          [](const UnderwaterResult& r) { return r.calibration.rms_px; })
+      .def_property_readonly(
+          "inlier_rms_px",
+          [](const UnderwaterResult& r) { return r.calibration.inlier_rms_px; })
+      .def_property_readonly(
+          "pixel_sigma",
+          [](const UnderwaterResult& r) { return r.calibration.pixel_sigma; })
+      .def_property_readonly("initial_rms_px",
+                             [](const UnderwaterResult& r) {
+                               return r.calibration.initial_rms_px;
+                             })
+      .def_property_readonly("num_views_used",
+                             [](const UnderwaterResult& r) {
+                               return r.calibration.num_views_used;
+                             })
+      .def_property_readonly("num_stereo_views",
+                             [](const UnderwaterResult& r) {
+                               return r.calibration.num_stereo_views;
+                             })
+      .def_property_readonly(
+          "num_inliers",
+          [](const UnderwaterResult& r) { return r.calibration.num_inliers; })
+      .def_property_readonly(
+          "num_outliers",
+          [](const UnderwaterResult& r) { return r.calibration.num_outliers; })
+      .def_property_readonly("num_parameters",
+                             [](const UnderwaterResult& r) {
+                               return r.calibration.num_parameters;
+                             })
+      .def_readonly("notes", &UnderwaterResult::notes)
+      .def("__repr__", [](const UnderwaterResult& r) {
+        return "UnderwaterCalibrationResult(n=" +
+               std::to_string(r.calibration.n) +
+               ", sigma_n=" + std::to_string(r.calibration.sigma_n) +
+               ", rms_px=" + std::to_string(r.calibration.rms_px) + ")";
+      });
+
+  static const std::string underwater_doc = std::string(R"doc(
+The underwater target refinement (C++ rcm::calib::CalibrateUnderwater; rcm
+calibrate --underwater): n, cam1_from_cam0 and the board poses (optionally
+the air gaps and port tilts) from views of the target in water, with the
+air rig's lenses held.
+
+calibrate_underwater(target, left_images, right_images, air_rig, **options)
+    images: lists of NumPy uint8 arrays or paths, each of its air camera's
+    size. Returns an UnderwaterCalibrationResult.
+)doc") + kUnderwaterOptionsDoc;
+  module.def(
+      "calibrate_underwater",
+      [](const CalibrationTarget& target, const py::sequence& left_images,
+         const py::sequence& right_images, const StereoRig& air_rig,
+         const py::kwargs& kwargs) {
+        const calib::UnderwaterCalibrationOptions options =
+            UnderwaterOptionsFrom(kwargs);
+        const Detections detections = Detect(target, left_images, right_images);
+        return RunUnderwater(target, detections.views, detections.sizes[0],
+                             detections.sizes[1], air_rig, options);
+      },
+      py::arg("target"), py::arg("left_images"), py::arg("right_images"),
+      py::arg("air_rig"), underwater_doc.c_str());
+
+  static const std::string underwater_corners_doc = std::string(R"doc(
+calibrate_underwater from corner observations (views as in
+calibrate_stereo_from_corners; the image sizes are the air rig's).
+)doc") + kUnderwaterOptionsDoc;
+  module.def(
+      "calibrate_underwater_from_corners",
+      [](const CalibrationTarget& target, const py::sequence& views,
+         const StereoRig& air_rig, const py::kwargs& kwargs) {
+        const calib::UnderwaterCalibrationOptions options =
+            UnderwaterOptionsFrom(kwargs);
+        return RunUnderwater(
+            target, ViewsFromCorners(target, views),
+            {air_rig.left().width(), air_rig.left().height()},
+            {air_rig.right().width(), air_rig.right().height()}, air_rig,
+            options);
+      },
+      py::arg("target"), py::arg("views"), py::arg("air_rig"),
+      underwater_corners_doc.c_str());
+}
+
+}  // namespace rcm::python
