@@ -5,5 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/setup.sh
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "$@"
+# Debian's interpreter, which has python3-numpy (a pyenv or venv python3
+# earlier on PATH may not): the Python package is built for it.
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPython3_EXECUTABLE=/usr/bin/python3 "$@"
 cmake --build build -j2

@@ -84,6 +84,11 @@ if [[ -n $python_dir ]]; then
   echo "== the Python package from the prefix"
   export PYTHONPATH=$(dirname "$python_dir")
   export RCM_EXECUTABLE=$prefix/bin/rcm
+  # The C++ refinement printed to 17 digits, for the exact comparison.
+  if [[ -x $build/bin/rcm_refine_timing ]]; then
+    RCM_REFINE_TIMING=$(cd "$build/bin" && pwd)/rcm_refine_timing
+    export RCM_REFINE_TIMING
+  fi
   (cd "$work" && "$python" -c 'import rcm; print("rcm", rcm.__version__, "from", rcm.__file__)')
   "$python" -m pytest -q -p no:cacheprovider python/tests
 else

@@ -27,6 +27,7 @@ Quick start::
 from ._version import __version__
 from . import _rcm
 from ._rcm import (
+    FRONT_END_SYSTEMATIC_PX,
     CalibrationTarget,
     Camera,
     ClosedFormResult,

@@ -120,6 +120,10 @@ known), reacquire_fraction=0.5, num_threads=2.
 }  // namespace
 
 void BindFrontEnd(py::module_& module) {
+  // C++ kFrontEndSystematicPx: the systematic error floor of this front
+  // end's matches (pixels), for refine_refractive_index(systematic_px=...)
+  // on its matches, as `rcm estimate` does on images.
+  module.attr("FRONT_END_SYSTEMATIC_PX") = kFrontEndSystematicPx;
   py::class_<StereoMatches>(module, "StereoMatches", R"doc(
 The matches of one stereo pair: matches (rcm.Correspondences, raw pixels),
 pixels ((N, 4) [xl, yl, xr, yr]), left_keypoints, right_keypoints,
