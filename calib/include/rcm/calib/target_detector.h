@@ -3,8 +3,12 @@
 //
 // - checkerboard: cv::findChessboardCornersSB with patternSize (cols,
 //   rows), flags EXHAUSTIVE | ACCURACY, then ACCURACY alone, then
-//   NORMALIZE_IMAGE | EXHAUSTIVE | ACCURACY until one finds it: detector
-//   "chessboard-sb". Should it fail and chessboard_fallback is set, the
+//   NORMALIZE_IMAGE | EXHAUSTIVE | ACCURACY until one finds it, each
+//   corner then refined by cv::cornerSubPix on its own X-junction (half
+//   window half its shortest edge to a neighbouring corner, clamped to
+//   [2, 10] px, on the image smoothed by a 1 px Gaussian; SB alone puts
+//   the corners of the pattern's border up to ~0.1 px outward, towards the
+//   white margin): detector "chessboard-sb". Should it fail and chessboard_fallback is set, the
 //   classic cv::findChessboardCorners (adaptive threshold, normalized
 //   image) refined by cv::cornerSubPix: "chessboard-classic". The corners
 //   are row-major over (cols, rows), but which physical corner is first is
