@@ -152,6 +152,20 @@ ImageSize SizeFrom(const std::pair<int, int>& size) {
   return {size.first, size.second};
 }
 
+// The keywords the air and the underwater calibration share: the board
+// bundle adjustment's robust loss, outlier rounds, solver and threads.
+template <typename Options>
+std::vector<OptionField> BoardAdjustmentFields(Options* o) {
+  return {DoubleOption("huber_px", &o->huber_px),
+          DoubleOption("outlier_sigmas", &o->outlier_sigmas),
+          DoubleOption("min_outlier_threshold_px", &o->min_outlier_threshold_px),
+          IntOption("max_outlier_rounds", &o->max_outlier_rounds),
+          IntOption("max_num_iterations", &o->max_num_iterations),
+          BoolOption("use_single_camera_views", &o->use_single_camera_views),
+          IntOption("min_corners_per_view", &o->min_corners_per_view),
+          IntOption("num_threads", &o->num_threads)};
+}
+
 calib::StereoCalibrationOptions StereoOptionsFrom(const std::string& model,
                                                   const py::kwargs& kwargs) {
   calib::StereoCalibrationOptions o;
@@ -161,18 +175,9 @@ calib::StereoCalibrationOptions StereoOptionsFrom(const std::string& model,
                     "'");
   }
   o.model = *lens;
-  ApplyOptions(
-      kwargs,
-      {DoubleOption("huber_px", &o.huber_px),
-       DoubleOption("outlier_sigmas", &o.outlier_sigmas),
-       DoubleOption("min_outlier_threshold_px", &o.min_outlier_threshold_px),
-       IntOption("max_outlier_rounds", &o.max_outlier_rounds),
-       IntOption("max_num_iterations", &o.max_num_iterations),
-       BoolOption("use_single_camera_views", &o.use_single_camera_views),
-       IntOption("min_corners_per_view", &o.min_corners_per_view),
-       BoolOption("compute_covariance", &o.compute_covariance),
-       IntOption("num_threads", &o.num_threads)},
-      "calibrate_stereo");
+  std::vector<OptionField> fields = BoardAdjustmentFields(&o);
+  fields.push_back(BoolOption("compute_covariance", &o.compute_covariance));
+  ApplyOptions(kwargs, fields, "calibrate_stereo");
   ThrowIfError(o.Check());
   return o;
 }
@@ -180,22 +185,14 @@ calib::StereoCalibrationOptions StereoOptionsFrom(const std::string& model,
 calib::UnderwaterCalibrationOptions UnderwaterOptionsFrom(
     const py::kwargs& kwargs) {
   calib::UnderwaterCalibrationOptions o;
-  ApplyOptions(
-      kwargs,
-      {DoubleOption("initial_n", &o.initial_n),
-       BoolOption("estimate_air_gap", &o.estimate_air_gap),
-       BoolOption("estimate_port_tilt", &o.estimate_port_tilt),
-       DoubleOption("huber_px", &o.huber_px),
-       DoubleOption("outlier_sigmas", &o.outlier_sigmas),
-       DoubleOption("min_outlier_threshold_px", &o.min_outlier_threshold_px),
-       IntOption("max_outlier_rounds", &o.max_outlier_rounds),
-       IntOption("max_num_iterations", &o.max_num_iterations),
-       BoolOption("use_single_camera_views", &o.use_single_camera_views),
-       IntOption("min_corners_per_view", &o.min_corners_per_view),
-       IntOption("folds", &o.folds),
-       BoolOption("fit_conventional_model", &o.fit_conventional_model),
-       IntOption("num_threads", &o.num_threads)},
-      "calibrate_underwater");
+  std::vector<OptionField> fields = BoardAdjustmentFields(&o);
+  fields.push_back(DoubleOption("initial_n", &o.initial_n));
+  fields.push_back(BoolOption("estimate_air_gap", &o.estimate_air_gap));
+  fields.push_back(BoolOption("estimate_port_tilt", &o.estimate_port_tilt));
+  fields.push_back(IntOption("folds", &o.folds));
+  fields.push_back(
+      BoolOption("fit_conventional_model", &o.fit_conventional_model));
+  ApplyOptions(kwargs, fields, "calibrate_underwater");
   ThrowIfError(o.Check());
   return o;
 }
