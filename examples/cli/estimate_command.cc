@@ -708,12 +708,9 @@ nlohmann::json CalibrationJson(const Report& report, const StereoRig& rig) {
   const Eigen::Vector3d per_mm = 1e-3 * p.dn_dtranslation;
   const Eigen::Matrix3d rotation =
       rig.calibration_uncertainty()->RotationCovariance();
-  const char* mode = p.mode == RotationMode::kPrior  ? "self-calibrated"
-                     : p.mode == RotationMode::kFree ? "free"
-                                                     : "held";
   return {
       {"source", p.source},
-      {"rotation", mode},
+      {"rotation", RotationModeName(p.mode)},
       {"prior_sigma_deg",
        {std::sqrt(rotation(0, 0)) * kDegreesPerRadian,
         std::sqrt(rotation(1, 1)) * kDegreesPerRadian,

@@ -85,9 +85,7 @@ py::object ConsistencyDict(const std::optional<FrameConsistency>& c) {
 py::object CalibrationDict(const std::optional<CalibrationPropagation>& c) {
   if (!c) return py::none();
   py::dict d;
-  d["mode"] = c->mode == RotationMode::kHeld
-                  ? "held"
-                  : (c->mode == RotationMode::kPrior ? "prior" : "free");
+  d["mode"] = RotationModeName(c->mode);
   d["source"] = c->source;
   d["sigma_n"] = c->sigma_n;
   d["sigma_n_noise"] = c->sigma_n_noise;

@@ -15,6 +15,19 @@
 #include "rcm/geometry/epipolar.h"
 
 namespace rcm {
+
+const char* RotationModeName(RotationMode mode) {
+  switch (mode) {
+    case RotationMode::kHeld:
+      return "held";
+    case RotationMode::kPrior:
+      return "self-calibrated";
+    case RotationMode::kFree:
+      return "free";
+  }
+  return "held";
+}
+
 namespace {
 
 // Central-difference steps (see the header).

@@ -218,6 +218,10 @@ enum class RotationMode {
   kFree,   // estimated without a prior (--refine-rotation)
 };
 
+// "held", "self-calibrated" or "free": the mode's name in reports (rcm
+// estimate's JSON, the Python result's calibration dict).
+const char* RotationModeName(RotationMode mode);
+
 // The frames' agreement (the file comment).
 struct FrameConsistency {
   int frames = 0;           // with information on n
