@@ -18,6 +18,7 @@
 #include "air_flag.h"
 #include "air_gap_flag.h"
 #include "calibrate_underwater.h"
+#include "calibration_input.h"
 #include "calibration_run.h"
 #include "command.h"
 #include "image_input_flags.h"
@@ -111,7 +112,8 @@ extern const Subcommand kCalibrateCommand = {
     "calibrate",
     "air stereo calibration from target images (folders or a ROS1 bag)",
     kUsage,
-    {__FILE__, kImageInputFlagsSource, kTargetFlagsSource,
+    {__FILE__, kImageInputFlagsSource, kCalibrationInputFlagsSource,
+     kTargetFlagsSource,
      kLensModelFlagSource, kUnderwaterFlagsSource, kAirGapFlagSource, kAirFlagSource},
     RunCalibrate};
 
@@ -179,32 +181,21 @@ int RunCalibrate() {
     return kExitUsage;
   }
 
-  StatusOr<std::unique_ptr<StereoImageSource>> source =
-      OpenImageInputFromFlags();
-  if (!source.ok()) {
-    PrintError(command, source.status().message());
-    return kExitFailure;
-  }
-  if ((*source)->NumPairs() == 0) {
-    PrintError(command, (*source)->Describe() + ": no image pairs");
-    return kExitFailure;
-  }
-  if (const Status status = CheckCalibrationOutputPaths(paths);
-      !status.ok()) {
-    PrintError(command, status.message());
-    return kExitFailure;
-  }
   // What is being calibrated, with the report on stdout; stderr keeps to
   // warnings and the error.
-  if (!FLAGS_json) {
-    std::cout << "rcm calibrate: " << (*source)->Describe() << "; target "
-              << calib::DescribeTarget(*target) << std::endl;
-  }
-  StatusOr<Detections> detections = DetectTargets(source->get(), *target);
-  if (!detections.ok()) {
-    PrintError(command, detections.status().message());
+  StatusOr<CalibrationInput> input = ReadCalibrationInput(
+      *target, /*allow_left_only=*/false, paths,
+      [&target](const std::string& description) {
+        if (!FLAGS_json) {
+          std::cout << "rcm calibrate: " << description << "; target "
+                    << calib::DescribeTarget(*target) << std::endl;
+        }
+      });
+  if (!input.ok()) {
+    PrintError(command, input.status().message());
     return kExitFailure;
   }
+  const Detections* detections = &input->detections;
   const std::vector<StereoView>& views = detections->views;
   if (const Status status = CheckDetections(*detections, false); !status.ok()) {
     PrintError(command, status.message());
@@ -286,7 +277,7 @@ int RunCalibrate() {
   json["covariance"] = CovarianceSidecarPath(paths.camchain);
   json["report"] = paths.report;
   json["target"] = calib::DescribeTarget(*target);
-  json["source"] = (*source)->Describe();
+  json["source"] = input->description;
   json["pairs"] = views.size() + detections->unreadable;
   json["unreadable_pairs"] = detections->unreadable;
   json["stereo_views"] = stereo;

@@ -16,6 +16,7 @@
 
 #include "air_flag.h"
 #include "air_gap_flag.h"
+#include "calibration_input.h"
 #include "calibration_run.h"
 #include "image_input_flags.h"
 #include "progress.h"
@@ -201,30 +202,20 @@ int RunCalibrateUnderwater(const Subcommand& command,
       return kExitFailure;
     }
   }
-  StatusOr<std::unique_ptr<StereoImageSource>> source =
-      OpenImageInputFromFlags(/*allow_left_only=*/true);
-  if (!source.ok()) {
-    PrintError(command, source.status().message());
+  StatusOr<CalibrationInput> input = ReadCalibrationInput(
+      target, /*allow_left_only=*/true, paths,
+      [&target](const std::string& description) {
+        if (!FLAGS_json) {
+          std::cout << "rcm calibrate --underwater: " << description
+                    << "; target " << calib::DescribeTarget(target)
+                    << "; air calibration " << FLAGS_air << std::endl;
+        }
+      });
+  if (!input.ok()) {
+    PrintError(command, input.status().message());
     return kExitFailure;
   }
-  if ((*source)->NumPairs() == 0) {
-    PrintError(command, (*source)->Describe() + ": no images");
-    return kExitFailure;
-  }
-  if (const Status status = CheckCalibrationOutputPaths(paths); !status.ok()) {
-    PrintError(command, status.message());
-    return kExitFailure;
-  }
-  if (!FLAGS_json) {
-    std::cout << "rcm calibrate --underwater: " << (*source)->Describe()
-              << "; target " << calib::DescribeTarget(target)
-              << "; air calibration " << FLAGS_air << std::endl;
-  }
-  StatusOr<Detections> detections = DetectTargets(source->get(), target);
-  if (!detections.ok()) {
-    PrintError(command, detections.status().message());
-    return kExitFailure;
-  }
+  const Detections* detections = &input->detections;
   const bool one_camera = !detections->sizes[1].has_value() &&
                           detections->right_only == 0 &&
                           FLAGS_right.empty() && FLAGS_pairs.empty() &&
@@ -302,7 +293,7 @@ int RunCalibrateUnderwater(const Subcommand& command,
   json["report"] = paths.report;
   json["air"] = FLAGS_air;
   json["target"] = calib::DescribeTarget(target);
-  json["source"] = (*source)->Describe();
+  json["source"] = input->description;
   json["cameras"] = one_camera ? 1 : 2;
   json["n"] = result->n;
   json["sigma_n"] = result->sigma_n;

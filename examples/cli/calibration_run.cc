@@ -5,6 +5,8 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <mutex>
+#include <thread>
 #include <utility>
 
 #include "progress.h"
@@ -80,25 +82,86 @@ std::string WithSigma(double value, double sigma, int digits,
 
 StatusOr<Detections> DetectTargets(StereoImageSource* source,
                                    const calib::CalibrationTarget& target) {
-  Detections detections;
   const size_t pairs = source->NumPairs();
+  // Two workers, each reading (one at a time: a source need not be thread
+  // safe) and then searching a whole pair on its own thread, keep both
+  // cores busy where one searcher per image of a pair waited for the
+  // slower image and for the decoding of the next pair.
+  struct PairResult {
+    StatusOr<StereoImagePair> pair = Status::Error("not read");
+    calib::StereoView view;
+    calib::ImageSize sizes[2];
+  };
+  std::vector<PairResult> results(pairs);
+  calib::TargetDetectorOptions detector_options;
+  detector_options.num_threads = 1;
+  std::mutex mutex;
+  size_t next = 0;
+  size_t done = 0;
+  int found = 0;
   Progress progress("rcm calibrate: detecting, pair", pairs);
-  for (size_t i = 0; i < pairs; ++i) {
-    StatusOr<StereoImagePair> pair = source->ReadPair(i);
-    if (!pair.ok()) {
-      // One unreadable image loses its pair, never the pairing of others.
-      detections.warnings.push_back(pair.status().message() + "; pair skipped");
-      if (detections.unreadable++ == 0) {
-        detections.first_unreadable = pair.status().message();
+  const auto work = [&] {
+    for (;;) {
+      size_t i = 0;
+      PairResult* result = nullptr;
+      {
+        const std::lock_guard<std::mutex> lock(mutex);
+        if (next == pairs) return;
+        i = next++;
+        result = &results[i];
+        result->pair = source->ReadPair(i);
       }
-      progress.Update(i + 1);
+      if (result->pair.ok()) {
+        const StereoImagePair& pair = *result->pair;
+        if (pair.right.empty()) {
+          result->view.left =
+              calib::DetectTarget(pair.left, target, detector_options);
+          if (!result->view.left) result->view.note = "no target found";
+        } else {
+          result->view = calib::DetectTargetPair(pair.left, pair.right, target,
+                                                 detector_options);
+        }
+      }
+      const std::lock_guard<std::mutex> lock(mutex);
+      const bool one_camera = result->pair.ok() && result->pair->right.empty();
+      found += one_camera ? result->view.left.has_value()
+                          : result->view.stereo();
+      progress.Update(++done, std::to_string(found) +
+                                  (one_camera ? " with the target"
+                                              : " with the target in both"));
+      // Only the sizes are needed from here on.
+      if (result->pair.ok()) {
+        cv::Mat* images[2] = {&result->pair->left, &result->pair->right};
+        for (int c = 0; c < 2; ++c) {
+          result->sizes[c] = {images[c]->cols, images[c]->rows};
+          images[c]->release();
+        }
+      }
+    }
+  };
+  {
+    std::thread helper(work);
+    work();
+    helper.join();
+  }
+
+  Detections detections;
+  for (size_t i = 0; i < pairs; ++i) {
+    PairResult& result = results[i];
+    if (!result.pair.ok()) {
+      // One unreadable image loses its pair, never the pairing of others.
+      detections.warnings.push_back(result.pair.status().message() +
+                                    "; pair skipped");
+      if (detections.unreadable++ == 0) {
+        detections.first_unreadable = result.pair.status().message();
+      }
       continue;
     }
-    const bool one_camera = pair->right.empty();
-    const cv::Mat* images[2] = {&pair->left, &pair->right};
-    const std::string* names[2] = {&pair->left_name, &pair->right_name};
+    const StereoImagePair& pair = *result.pair;
+    const bool one_camera = result.sizes[1].width == 0;
+    const std::string* names[2] = {&pair.left_name, &pair.right_name};
     for (int c = 0; c < (one_camera ? 1 : 2); ++c) {
-      const calib::ImageSize size{images[c]->cols, images[c]->rows};
+      const calib::ImageSize size = result.sizes[c];
       if (!detections.sizes[c]) {
         detections.sizes[c] = size;
       } else if (detections.sizes[c]->width != size.width ||
@@ -112,29 +175,18 @@ StatusOr<Detections> DetectTargets(StereoImageSource* source,
                              "; one camera's images must all have one size");
       }
     }
-    calib::StereoView view;
-    if (one_camera) {
-      view.left = calib::DetectTarget(pair->left, target);
-      if (!view.left) view.note = "no target found";
-    } else {
-      view = calib::DetectTargetPair(pair->left, pair->right, target);
-    }
-    view.left_name = pair->left_name;
-    view.right_name = pair->right_name;
-    view.timestamp = pair->timestamp.value_or(0.0);
+    calib::StereoView& view = result.view;
+    view.left_name = pair.left_name;
+    view.right_name = pair.right_name;
+    view.timestamp = pair.timestamp.value_or(0.0);
     if (!view.note.empty() && !one_camera) {
-      detections.warnings.push_back(pair->left_name + " and " +
-                                    pair->right_name + ": " + view.note);
+      detections.warnings.push_back(pair.left_name + " and " +
+                                    pair.right_name + ": " + view.note);
     }
     detections.stereo += view.stereo() ? 1 : 0;
     detections.left_only += view.left && !view.right ? 1 : 0;
     detections.right_only += view.right && !view.left ? 1 : 0;
     detections.views.push_back(std::move(view));
-    progress.Update(i + 1, one_camera
-                               ? std::to_string(detections.left_only) +
-                                     " with the target"
-                               : std::to_string(detections.stereo) +
-                                     " with the target in both");
   }
   return detections;
 }
