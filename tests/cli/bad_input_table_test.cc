@@ -182,6 +182,18 @@ Setup File(const std::string& name, const std::string& bytes) {
   };
 }
 
+// A text file whose "$D" become the row's folder.
+Setup FileInDir(const std::string& name, const std::string& text) {
+  return [name, text](const std::string& dir) {
+    std::string bytes = text;
+    for (size_t at = bytes.find("$D"); at != std::string::npos;
+         at = bytes.find("$D", at + dir.size())) {
+      bytes.replace(at, 2, dir);
+    }
+    WriteBytes(dir + "/" + name, bytes);
+  };
+}
+
 Setup Folder(const std::string& name) {
   return [name](const std::string& dir) {
     fs::create_directories(dir + "/" + name);
@@ -1138,6 +1150,65 @@ void AddCalibrateRows(std::vector<BadInputCase>* rows) {
          defect.expected,
          outputs});
   }
+  // --corners FILE.vnl (mrcal's corners format) and --corners-out.
+  const std::vector<std::string> corner_args = {
+      "--corners", "$D/c.vnl", "--left", "$D/left", "--right", "$D/right",
+      "--out",     "$D/out/rig.yaml"};
+  std::string full_board;  // 35 rows of the 7x5 board for one left image
+  for (int i = 0; i < 35; ++i) full_board += "$D/left/000000.png 10 20 0\n";
+  std::string nine_by_six;  // 54 rows: a 9x6 board's
+  for (int i = 0; i < 54; ++i) nine_by_six += "a.png 10 20 0\n";
+  const struct {
+    std::string name;
+    Setup setup;
+    std::string expected;
+  } corners_defects[] = {
+      {"Missing", pair, "$D/c.vnl: cannot open: No such file or directory"},
+      {"Empty", Steps({pair, File("c.vnl", "# filename x y level\n")}),
+       "$D/c.vnl: no corners (no data rows)"},
+      {"RowWithoutY", Steps({pair, File("c.vnl", "a.png 10\n")}),
+       "$D/c.vnl:1: a row is 'filename x y [level]', got 2 fields"},
+      {"RowWithAnExtraColumn",
+       Steps({pair, File("c.vnl", "a.png 10 20 0 1\n")}),
+       "$D/c.vnl:1: a row is 'filename x y [level]', got 5 fields"},
+      {"OfAnotherBoard",
+       Steps({pair, File("c.vnl", "# filename x y level\n" + nine_by_six)}),
+       "$D/c.vnl:2: a.png has 54 rows, but the target has 35 points: corners "
+       "of another board"},
+      {"Nan", Steps({pair, File("c.vnl", "a.png nan 20 0\n")}),
+       "$D/c.vnl:1: x and y must be finite numbers or '-'"},
+      {"Bytes0To255", Steps({pair, File("c.vnl", AllBytes())}), "$D/c.vnl:"},
+      {"ImagesOfNeitherCamera",
+       Steps({pair, File("c.vnl", "elsewhere/a.png - - -\n")}),
+       "$D/c.vnl: none of its 1 image matches --left $D/left or --right "
+       "$D/right"},
+      {"ImagesNotAtHand",
+       FileInDir("c.vnl",
+                 "$D/left/000000.png - - -\n$D/right/000000.png - - -\n"),
+       "give --image-size W,H"},
+  };
+  for (const auto& defect : corners_defects) {
+    rows->push_back({"CalibrateCorners" + defect.name, defect.setup,
+                     CalibrateArgs(corner_args), defect.expected, outputs});
+  }
+  rows->push_back({"CalibrateCornersWithABadImageSize",
+                   FileInDir("c.vnl", full_board),
+                   CalibrateArgs(Concat(corner_args, {"--image-size", "640"})),
+                   "--image-size 640: expected W,H in pixels", outputs});
+  rows->push_back({"CalibrateCornersAndABag", pair,
+                   CalibrateArgs({"--corners", "$D/c.vnl", "--bag", "$D/b.bag",
+                                  "--out", "$D/out/rig.yaml"}),
+                   "--corners takes --left and --right", outputs});
+  rows->push_back({"CalibrateCornersOutInAMissingFolder", pair,
+                   CalibrateArgs(Concat(folders, {"--corners-out",
+                                                  "$D/nowhere/c.vnl"})),
+                   "--corners-out $D/nowhere/c.vnl: folder $D/nowhere does "
+                   "not exist",
+                   Concat(outputs, {"$D/nowhere/c.vnl"})});
+  rows->push_back({"CalibrateImageSizeWithoutCorners", pair,
+                   CalibrateArgs(Concat(folders, {"--image-size", "640,480"})),
+                   "--image-size goes with --corners", outputs});
+
   // Outputs that cannot be written.
   const Setup pair_and_file = Steps({pair, File("file", "a file\n")});
   rows->push_back({"CalibrateOutBelowAFile",

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
@@ -219,6 +221,87 @@ TEST(CalibrateCli, JsonOnStdoutAndAnOutputFolder) {
   EXPECT_EQ(json["cam0"]["sigma"].size(), 8u);
   ExpectCloseToTruth(dir + "/calibration/camchain.yaml");
   EXPECT_TRUE(fs::exists(dir + "/calibration/report/coverage_cam0.png"));
+}
+
+// --corners-out writes what the run calibrated from; --corners with the
+// same --left/--right reads it back instead of detecting: the same
+// calibration to the last bit (the file keeps shortest round-trip
+// decimals).
+TEST(CalibrateCli, CornersOutThenCornersGivesTheSameCamchain) {
+  const std::string dir = WriteFolders(Pairs(), "pairs");
+  const std::string corners = dir + "/corners.vnl";
+  const RunResult detected = Rcm(Args(
+      dir, dir + "/detected.yaml", {"--folds", "0", "--corners-out", corners}));
+  ASSERT_EQ(detected.exit_code, 0) << detected.err;
+  const std::string text = test::ReadWholeFile(corners);
+  // 35 rows per image that shows the 7x5 board, one per image without it.
+  const RenderedPairs& pairs = Pairs();
+  EXPECT_EQ(text.rfind("# filename x y level\n", 0), 0u);
+  EXPECT_NE(text.find(dir + "/left/000.png "), std::string::npos);
+  EXPECT_NE(text.find(dir + "/right/000.png "), std::string::npos);
+  EXPECT_GE(std::count(text.begin(), text.end(), '\n'),
+            1 + 35 * 2 * pairs.Stereo());
+
+  const RunResult read = Rcm(Args(
+      dir, dir + "/read.yaml", {"--folds", "0", "--corners", corners}));
+  ASSERT_EQ(read.exit_code, 0) << read.err;
+  EXPECT_NE(read.out.find("corners file " + corners), std::string::npos)
+      << read.out;
+  EXPECT_EQ(test::ReadWholeFile(dir + "/read.yaml"),
+            test::ReadWholeFile(dir + "/detected.yaml"));
+}
+
+// mrcal's way of naming the cameras: one folder, a glob per camera, the
+// frame number where '*' is; the images need not be at hand.
+TEST(CalibrateCli, CornersOfMrcalStyleNamesPairByTheirNumber) {
+  const std::string dir = WriteFolders(Pairs(), "pairs");
+  const std::string corners = dir + "/corners.vnl";
+  ASSERT_EQ(Rcm(Args(dir, dir + "/detected.yaml",
+                     {"--folds", "0", "--corners-out", corners}))
+                .exit_code,
+            0);
+  // left/007.png -> frames/left007.png, right/007.png -> frames/right007.png,
+  // and the right camera's rows first: order does not matter, names do.
+  std::string left_rows;
+  std::string right_rows;
+  {
+    std::istringstream lines(test::ReadWholeFile(corners));
+    for (std::string line; std::getline(lines, line);) {
+      if (line.empty() || line[0] == '#') continue;
+      for (const char* camera : {"left", "right"}) {
+        const std::string from = dir + "/" + camera + "/";
+        if (line.compare(0, from.size(), from) == 0) {
+          (camera[0] == 'l' ? left_rows : right_rows) +=
+              "frames/" + std::string(camera) + line.substr(from.size()) + "\n";
+        }
+      }
+    }
+  }
+  const std::string renamed = dir + "/mrcal.vnl";
+  std::ofstream(renamed) << "# filename x y level\n" << right_rows << left_rows;
+  const cv::Size size = Pairs().left.front().size();
+  const RunResult read = Rcm(
+      {"calibrate", "--corners", renamed, "--left", "frames/left*.png",
+       "--right", "frames/right*.png", "--image-size",
+       std::to_string(size.width) + "," + std::to_string(size.height),
+       "--out", dir + "/read.yaml", "--folds", "0", "--board", "chessboard",
+       "--cols", "7", "--rows", "5", "--square", BoardFlags()[7]});
+  ASSERT_EQ(read.exit_code, 0) << read.err;
+  const Camchain a = ReadCamchain(dir + "/read.yaml").value();
+  const Camchain b = ReadCamchain(dir + "/detected.yaml").value();
+  // The same corners and views: the same solution, to rounding (1e-13
+  // relative was seen; the solves differ only in the images' names).
+  constexpr double kRelativeTolerance = 1e-9;
+  for (int c = 0; c < 2; ++c) {
+    const Camera& x = a.cameras[c].camera;
+    const Camera& y = b.cameras[c].camera;
+    ASSERT_EQ(x.num_params(), y.num_params());
+    for (int i = 0; i < x.num_params(); ++i) {
+      EXPECT_NEAR(x.params()[i], y.params()[i],
+                  kRelativeTolerance * std::max(1.0, std::abs(y.params()[i])))
+          << "cam" << c << " parameter " << i;
+    }
+  }
 }
 
 TEST(CalibrateCli, BoardInOneImageOnlyIsNamedAndUsedForThatCamera) {
