@@ -28,6 +28,7 @@ packages=(
   pybind11-dev python3-dev python3-numpy  # the Python package (python/)
   python3-pytest       # its tests
   python3-opencv       # cv2.remap with rcm's maps, in the Python tests and docs
+  mrcal                # mrcal-calibrate-cameras: the peer the air calibration is tested against
 )
 
 missing=()
