@@ -51,8 +51,9 @@ struct CrossValidation {
 };
 
 // Runs the folds with the options of the full calibration `full`
-// (CalibrateStereo of the same inputs). `progress`, when set, is called
-// after each fold with (done, total). Fails when fewer than 2 folds
+// (CalibrateStereo of the same inputs), calibration_options.num_threads
+// folds at a time, each solved on one thread. `progress`, when set, is
+// called after each fold with (done, total), from one thread at a time. Fails when fewer than 2 folds
 // succeed (e.g. 3 views split 3 ways leave too few per camera).
 StatusOr<CrossValidation> CrossValidateStereo(
     const CalibrationTarget& target, const std::vector<StereoView>& views,
