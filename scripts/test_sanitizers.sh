@@ -55,6 +55,9 @@ skipped=(
   # [UnderwaterCli.OneCameraGivesN, .TooFewViews, .NPinnedAtTheUpperBound,
   # UnderwaterCalibration.*, EstimateCli.*]: the two dives' accuracy end to end
   'UnderwaterCli\.(Dataset|Narrow)RigThatDriftedHalfADegree$'
+  # [OpenCvSampleStereo.*, CalibrateCli.Corners*]: rcm against mrcal on the
+  # sample pairs, a comparison of two solvers' numbers
+  'MrcalPeer\.'
   # [EstimateImagesCli.FoldersGiveNAndThePictures, ...]: each estimator on images
   'EstimateImagesCli\.EveryEstimatorRunsOnImages$'
 )
