@@ -237,10 +237,18 @@ TEST(UnderwaterCli, OneCameraGivesN) {
                      (test::kSanitizerBuild ? " --frames 5 --supersampling 1"
                                             : " --frames 12"));
   const std::string water = Folder("water");
+  const std::string corners = water + "-corners.vnl";
   const RunResult result = Rcm(
       Words("calibrate --underwater --air " + dive + "/camchain.yaml --left " +
-            dive + "/left --out " + water + " --json --folds 0 " + Board(0.03)));
+            dive + "/left --out " + water + " --json --folds 0 " +
+            Board(0.03) + " --corners-out " + corners));
   const nlohmann::json json = Json(result);
+  // The same run from the corners it wrote: the same n, bit for bit.
+  const RunResult again = Rcm(
+      Words("calibrate --underwater --air " + dive + "/camchain.yaml --left " +
+            dive + "/left --out " + Folder("again") + " --json --folds 0 " +
+            Board(0.03) + " --corners " + corners));
+  EXPECT_EQ(Json(again)["n"].get<double>(), json["n"].get<double>());
   EXPECT_EQ(json["cameras"].get<int>(), 1);
   EXPECT_FALSE(json["extrinsics_estimated"].get<bool>());
   EXPECT_TRUE(json["extrinsic_change_deg"].is_null());
