@@ -47,7 +47,7 @@ Dive MakeDive(bool thick) {
                                              0.25, /*seed=*/1)};
 }
 
-// Residual and Jacobian of one cam1 corner (16 parameters).
+// Residual and Jacobian of one cam1 corner (18 parameters).
 void BM_UnderwaterResidualAndJacobian(benchmark::State& state) {
   const bool thick = state.range(0) != 0;
   const Dive dive = MakeDive(thick);
@@ -60,16 +60,17 @@ void BM_UnderwaterResidualAndJacobian(benchmark::State& state) {
   const std::unique_ptr<ceres::CostFunction> cost(
       Cam1UnderwaterReprojectionError<EquidistantLens>::Create(
           constants, TargetPoints(Checkerboard())[observation.point_ids[0]],
-          observation.pixels[0]));
+          Eigen::Vector2d(0.5, 0.5), observation.pixels[0]));
   double n = kN;
   double pose[6] = {0.1, -0.2, 0.05, 0.02, -0.01, 0.7};
   double extrinsics[6] = {0.0, 0.01, 0.0, -0.11, 0.0, 0.0};
   double gap = thick ? 0.008 : 0.0;
   double tilt[2] = {0.0, 0.0};
-  const double* parameters[5] = {&n, pose, extrinsics, &gap, tilt};
+  double warp[2] = {4e-4, 3e-4};
+  const double* parameters[6] = {&n, pose, extrinsics, &gap, tilt, warp};
   double residuals[2];
-  double j_n[2], j_pose[12], j_extrinsics[12], j_gap[2], j_tilt[4];
-  double* jacobians[5] = {j_n, j_pose, j_extrinsics, j_gap, j_tilt};
+  double j_n[2], j_pose[12], j_extrinsics[12], j_gap[2], j_tilt[4], j_warp[4];
+  double* jacobians[6] = {j_n, j_pose, j_extrinsics, j_gap, j_tilt, j_warp};
   for (auto _ : state) {
     benchmark::DoNotOptimize(cost->Evaluate(parameters, residuals, jacobians));
   }

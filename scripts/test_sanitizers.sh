@@ -39,6 +39,12 @@ skipped=(
   # [StereoCalibration.*, UnderwaterCalibration.*, CrossValidation.*]: Monte Carlo
   '(StereoCalibration|UnderwaterCalibration)\.MonteCarloSigmaIsHonest$'
   'OpenCvSampleStereo\.LeaveOneOutIsStable$'
+  # [BoardWarp.Exact*, MeanFramesProjection.JacobianMatchesCentralDifferences]:
+  # Monte Carlo of the warp's sigma and of the mean-frames projection spread
+  'BoardWarp\.MonteCarloWarpSigmaIsHonest$'
+  'MeanFramesProjection\.MonteCarloSpreadIsThePredictedOne$'
+  # [BoardWarp.Exact*, BoardRendering.*]: the bow and focal lengths on renders
+  'BoardWarpOnRenders\.BowRecoveredAndFocalLengthsUnbiased$'
   # [BoardRendering.PixelsAreTheExactPixelIntegral, CalibrateCli.*, UnderwaterCli.*]:
   # the accuracy of a calibration, and of the detected corners, on renders
   'CalibrationOnRenders\.ChessboardEquidistantDatasetRig$'

@@ -1,5 +1,7 @@
 #include "rcm/calib/calibration_report.h"
 
+#include "rcm/calib/projection_uncertainty.h"
+
 #include <ceres/jet.h>
 #include <glog/logging.h>
 
@@ -103,18 +105,38 @@ struct SampleGrid {
   double V(int j) const { return -0.5 + (j + 0.5) * height / rows; }
 };
 
-// ProjectionUncertainty at the sample grid's centers (CV_64F, rows x cols).
-cv::Mat UncertaintySamples(const CameraCalibration& calibration,
-                           const ImageSize& size) {
+// `sigma(pixel)` at the sample grid's centers (CV_64F, rows x cols).
+template <typename Sigma>
+cv::Mat SampleOverImage(const ImageSize& size, const Sigma& sigma) {
   const SampleGrid grid(size);
   cv::Mat samples(grid.rows, grid.cols, CV_64F);
   for (int j = 0; j < grid.rows; ++j) {
     for (int i = 0; i < grid.cols; ++i) {
-      samples.at<double>(j, i) = ProjectionUncertainty(
-          calibration, Eigen::Vector2d(grid.U(i), grid.V(j)));
+      samples.at<double>(j, i) = sigma(Eigen::Vector2d(grid.U(i), grid.V(j)));
     }
   }
   return samples;
+}
+
+// ProjectionUncertainty at the sample grid's centers.
+cv::Mat UncertaintySamples(const CameraCalibration& calibration,
+                           const ImageSize& size) {
+  return SampleOverImage(size, [&](const Eigen::Vector2d& pixel) {
+    return ProjectionUncertainty(calibration, pixel);
+  });
+}
+
+// MeanFramesProjectionUncertainty at the sample grid's centers (NaN
+// everywhere without the full covariance).
+cv::Mat MeanFramesSamples(const StereoCalibration& calibration, int camera,
+                          double distance) {
+  const Camera& c = camera == 0 ? calibration.cam0.camera
+                                : calibration.cam1.camera;
+  return SampleOverImage({c.width(), c.height()},
+                         [&](const Eigen::Vector2d& pixel) {
+                           return MeanFramesProjectionUncertainty(
+                               calibration, camera, pixel, distance);
+                         });
 }
 
 std::vector<double> Values(const cv::Mat& samples) {
@@ -339,6 +361,10 @@ double ProjectionUncertainty(const CameraCalibration& calibration,
 // Summary.
 
 Status CalibrationReportOptions::Check() const {
+  if (!(uncertainty_distance_m > 0.0)) {
+    return Status::Error("uncertainty_distance_m must be positive, got " +
+                         FormatDouble(uncertainty_distance_m));
+  }
   if (coverage_cols < 1 || coverage_rows < 1) {
     return Status::Error("coverage grid needs at least 1x1 cells, got " +
                          std::to_string(coverage_cols) + "x" +
@@ -415,9 +441,14 @@ CalibrationReport SummarizeCalibration(
         static_cast<double>(counts.size());
     const std::vector<double> samples =
         Values(UncertaintySamples(*cameras[c], sizes[c]));
-    stats.uncertainty_median_px = Quantile(samples, 0.5);
-    stats.uncertainty_p95_px = Quantile(samples, 0.95);
-    stats.uncertainty_max_px = Quantile(samples, 1.0);
+    stats.intrinsics_only_uncertainty_median_px = Quantile(samples, 0.5);
+    stats.intrinsics_only_uncertainty_p95_px = Quantile(samples, 0.95);
+    stats.intrinsics_only_uncertainty_max_px = Quantile(samples, 1.0);
+    const std::vector<double> mean_frames = Values(
+        MeanFramesSamples(calibration, c, options.uncertainty_distance_m));
+    stats.projection_uncertainty_median_px = Quantile(mean_frames, 0.5);
+    stats.projection_uncertainty_p95_px = Quantile(mean_frames, 0.95);
+    stats.projection_uncertainty_max_px = Quantile(mean_frames, 1.0);
     stats.view_rms_limit_px = options.max_view_rms_factor * stats.rms_px;
   }
 
@@ -471,12 +502,13 @@ CalibrationReport SummarizeCalibration(
   }
   for (int c = 0; c < 2; ++c) {
     const CalibrationReport::CameraStats& stats = report.cameras[c];
-    if (stats.uncertainty_p95_px > options.max_uncertainty_px) {
+    if (stats.intrinsics_only_uncertainty_p95_px >
+        options.max_uncertainty_px) {
       warnings.push_back(
-          CameraName(c) + ": projection uncertainty " +
-          Fixed(stats.uncertainty_p95_px, 2) +
+          CameraName(c) + ": intrinsics-only projection uncertainty " +
+          Fixed(stats.intrinsics_only_uncertainty_p95_px, 2) +
           " px over 95 % of the image (max " +
-          Fixed(stats.uncertainty_max_px, 2) + " px), above " +
+          Fixed(stats.intrinsics_only_uncertainty_max_px, 2) + " px), above " +
           FormatDouble(options.max_uncertainty_px) +
           " px; the intrinsics are poorly constrained: add views that fill " +
           "the image, closer and tilted");
@@ -794,13 +826,17 @@ cv::Mat DrawCoverage(const StereoCalibration& calibration,
   return figure.Finish();
 }
 
-cv::Mat DrawProjectionUncertainty(const CameraCalibration& calibration,
-                                  double max_px,
-                                  const std::string& camera_name) {
+namespace {
+
+// The heat map of DrawProjectionUncertainty for any samples over the
+// image: `what` follows the camera's name in the title ("<what>: median
+// ..."), `legend` is the legend's first words.
+cv::Mat DrawUncertaintyMap(const cv::Mat& samples, const ImageSize& size,
+                           double max_px, const std::string& camera_name,
+                           const std::string& what,
+                           const std::string& legend) {
   CHECK(Finite(max_px) && max_px >= 0.0) << max_px;
-  const ImageSize size{calibration.camera.width(), calibration.camera.height()};
   CheckSize(size);
-  const cv::Mat samples = UncertaintySamples(calibration, size);
   const std::vector<double> values = Values(samples);
   const double largest = Quantile(values, 1.0);
   const UncertaintyScale scale(values, max_px);
@@ -954,16 +990,13 @@ cv::Mat DrawProjectionUncertainty(const CameraCalibration& calibration,
 
   const double median = Quantile(values, 0.5);
   const double p95 = Quantile(values, 0.95);
-  figure.Text((camera_name.empty() ? "" : camera_name + " ") +
-                  "projection uncertainty (1 sigma, from the intrinsics "
-                  "covariance): median " +
-                  Fixed(median, 3) + ", 95 % " + Fixed(p95, 3) + ", max " +
-                  Fixed(largest, 3) + " px",
+  figure.Text((camera_name.empty() ? "" : camera_name + " ") + what +
+                  ": median " + Fixed(median, 3) + ", 95 % " + Fixed(p95, 3) +
+                  ", max " + Fixed(largest, 3) + " px",
               cv::Point2d(layout.margin, layout.title_baseline), kTitleFont,
               kInk, layout.TextWidth());
   figure.Text(
-      "per pixel: sqrt of the largest eigenvalue of J C J^T, J = d "
-      "pixel / d intrinsics at the pixel's ray; log scale" +
+      legend + "; log scale" +
           std::string(
               values.size() > 0 &&
                       std::any_of(values.begin(), values.end(),
@@ -973,6 +1006,41 @@ cv::Mat DrawProjectionUncertainty(const CameraCalibration& calibration,
       cv::Point2d(layout.margin, layout.legend_baseline), kTextFont, kInk,
       layout.TextWidth());
   return figure.Finish();
+}
+
+}  // namespace
+
+std::string DistanceName(double distance_m) {
+  return std::isinf(distance_m) ? "infinity" : FormatDouble(distance_m) + " m";
+}
+
+cv::Mat DrawProjectionUncertainty(const CameraCalibration& calibration,
+                                  double max_px,
+                                  const std::string& camera_name) {
+  const ImageSize size{calibration.camera.width(), calibration.camera.height()};
+  CheckSize(size);
+  return DrawUncertaintyMap(
+      UncertaintySamples(calibration, size), size, max_px, camera_name,
+      "intrinsics-only projection uncertainty (1 sigma, the ray held fixed "
+      "in the camera)",
+      "per pixel: sqrt of the largest eigenvalue of J C J^T, J = d pixel / d "
+      "intrinsics at the pixel's ray, C the intrinsics' covariance");
+}
+
+cv::Mat DrawMeanFramesUncertainty(const StereoCalibration& calibration,
+                                  int camera, double distance_m, double max_px,
+                                  const std::string& camera_name) {
+  CHECK(camera == 0 || camera == 1) << camera;
+  const Camera& c =
+      camera == 0 ? calibration.cam0.camera : calibration.cam1.camera;
+  return DrawUncertaintyMap(
+      MeanFramesSamples(calibration, camera, distance_m),
+      {c.width(), c.height()}, max_px, camera_name,
+      "projection uncertainty at " + DistanceName(distance_m) +
+          " (1 sigma, mrcal's mean-frames)",
+      "per pixel: sqrt of the largest eigenvalue of J Var(b) J^T, q(b) = the "
+      "point at that distance held fixed to the mean of the board poses, b "
+      "every unknown");
 }
 
 cv::Mat DrawPerViewRms(const CalibrationReport& report) {
@@ -1142,9 +1210,16 @@ Status WriteCalibrationReport(const std::string& directory,
       return DrawCoverage(calibration, views, c, sizes[c],
                           options.coverage_cols, options.coverage_rows);
     }));
-    RCM_RETURN_IF_ERROR(write_png("uncertainty" + suffix, [&] {
+    RCM_RETURN_IF_ERROR(write_png("intrinsics_only_uncertainty" + suffix, [&] {
       return DrawProjectionUncertainty(*cameras[c], 0.0, CameraName(c));
     }));
+    if (calibration.full_covariance.size() > 0) {
+      RCM_RETURN_IF_ERROR(write_png("projection_uncertainty" + suffix, [&] {
+        return DrawMeanFramesUncertainty(calibration, c,
+                                         options.uncertainty_distance_m, 0.0,
+                                         CameraName(c));
+      }));
+    }
   }
   RCM_RETURN_IF_ERROR(
       write_png("per_view_rms.png", [&] { return DrawPerViewRms(report); }));

@@ -4,6 +4,8 @@
 #include <ceres/rotation.h>
 #include <glog/logging.h>
 
+#include <Eigen/Cholesky>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -11,6 +13,7 @@
 
 #include "board_bundle_adjustment.h"
 #include "rcm/calib/board_reprojection_error.h"
+#include "rcm/calib/board_warp.h"
 #include "rcm/calib/calibration_initialization.h"
 #include "rcm/io/number_format.h"
 
@@ -27,67 +30,155 @@ struct Parameters {
   std::array<std::array<double, kMaxLensParams>, 2> lens{};
   Pose cam1_from_cam0{};
   std::vector<Pose> cam0_from_target;  // per view (unused views ignored)
+  std::array<double, 2> board_warp{};  // [warp_x, warp_y] (m), board_warp.h
+};
+
+// The target's corners and their warp basis.
+struct Board {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector2d> warp_basis;
 };
 
 template <typename LensModel>
-ceres::CostFunction* MakeCost(const Corner& corner,
-                              const Eigen::Vector3d& point) {
+ceres::CostFunction* MakeCost(const Corner& corner, const Board& board) {
+  const Eigen::Vector3d& point = board.points[corner.point_id];
+  const Eigen::Vector2d& basis = board.warp_basis[corner.point_id];
   if (corner.camera == 0) {
-    return Cam0BoardReprojectionError<LensModel>::Create(point, corner.pixel);
+    return Cam0WarpedBoardReprojectionError<LensModel>::Create(point, basis,
+                                                               corner.pixel);
   }
-  return Cam1BoardReprojectionError<LensModel>::Create(point, corner.pixel);
+  return Cam1WarpedBoardReprojectionError<LensModel>::Create(point, basis,
+                                                             corner.pixel);
 }
 
 ceres::CostFunction* CostFor(LensModelId model, const Corner& corner,
-                             const Eigen::Vector3d& point) {
-  RCM_LENS_MODEL_SWITCH(model, return MakeCost<LensModel>(corner, point);)
+                             const Board& board) {
+  RCM_LENS_MODEL_SWITCH(model, return MakeCost<LensModel>(corner, board);)
   LOG(FATAL) << "unknown lens model";
   return nullptr;
 }
 
-// Adds the residuals of the inliers to `problem`.
+// Adds the residuals of the inliers to `problem`; the warp is held at its
+// value (0) unless `estimate_warp`.
 void AddResiduals(LensModelId model, const std::vector<Corner>& corners,
-                  const std::vector<Eigen::Vector3d>& target_points,
-                  double huber_px, Parameters* parameters,
-                  ceres::Problem* problem) {
+                  const Board& board, bool estimate_warp, double huber_px,
+                  Parameters* parameters, ceres::Problem* problem) {
+  double* warp = parameters->board_warp.data();
   for (const Corner& corner : corners) {
     if (!corner.inlier) continue;
     ceres::LossFunction* loss =
         huber_px > 0.0 ? new ceres::HuberLoss(huber_px) : nullptr;
     double* lens = parameters->lens[corner.camera].data();
     double* pose = parameters->cam0_from_target[corner.view].data();
-    ceres::CostFunction* cost =
-        CostFor(model, corner, target_points[corner.point_id]);
+    ceres::CostFunction* cost = CostFor(model, corner, board);
     if (corner.camera == 0) {
-      problem->AddResidualBlock(cost, loss, lens, pose);
+      problem->AddResidualBlock(cost, loss, lens, pose, warp);
     } else {
       problem->AddResidualBlock(cost, loss, lens, pose,
-                                parameters->cam1_from_cam0.data());
+                                parameters->cam1_from_cam0.data(), warp);
     }
+  }
+  if (!estimate_warp && problem->HasParameterBlock(warp)) {
+    problem->SetParameterBlockConstant(warp);
   }
 }
 
 // The residual of one corner at the current parameters; NaN when the
 // corner is behind its camera.
 Eigen::Vector2d Residual(LensModelId model, const Corner& corner,
-                         const std::vector<Eigen::Vector3d>& target_points,
-                         const Parameters& parameters) {
-  const Eigen::Vector3d& point = target_points[corner.point_id];
+                         const Board& board, const Parameters& parameters) {
+  const Eigen::Vector3d& point = board.points[corner.point_id];
+  const Eigen::Vector2d& basis = board.warp_basis[corner.point_id];
   const double* lens = parameters.lens[corner.camera].data();
   const double* pose = parameters.cam0_from_target[corner.view].data();
+  const double* warp = parameters.board_warp.data();
   Eigen::Vector2d residual;
   bool ok = false;
   RCM_LENS_MODEL_SWITCH(
       model,
       if (corner.camera == 0) {
-        ok = Cam0BoardReprojectionError<LensModel>(point, corner.pixel)(
-            lens, pose, residual.data());
+        ok = Cam0WarpedBoardReprojectionError<LensModel>(point, basis,
+                                                         corner.pixel)(
+            lens, pose, warp, residual.data());
       } else {
-        ok = Cam1BoardReprojectionError<LensModel>(point, corner.pixel)(
-            lens, pose, parameters.cam1_from_cam0.data(), residual.data());
+        ok = Cam1WarpedBoardReprojectionError<LensModel>(point, basis,
+                                                         corner.pixel)(
+            lens, pose, parameters.cam1_from_cam0.data(), warp,
+            residual.data());
       } break;)
   if (!ok) residual.setConstant(std::numeric_limits<double>::quiet_NaN());
   return residual;
+}
+
+// sigma^2 (J^T J)^-1 of every unknown of `problem` (header), dense, with
+// the layout of FullCovariance; false when J^T J is not positive definite.
+// J^T J is scaled to unit diagonal before the Cholesky factorization
+// (D^-1/2 J^T J D^-1/2), which keeps its condition number that of the
+// geometry rather than of the parameters' units (px vs rad vs m).
+bool ComputeFullCovariance(const std::vector<bool>& view_used,
+                           int num_lens_params, bool estimate_warp,
+                           double variance, Parameters* parameters,
+                           ceres::Problem* problem, FullCovariance* out,
+                           Eigen::VectorXd* values) {
+  std::vector<double*> blocks;
+  std::vector<int> sizes;
+  FullCovariance layout;
+  layout.num_lens_params = num_lens_params;
+  int total = 0;
+  const auto add = [&](double* block, int size) {
+    blocks.push_back(block);
+    sizes.push_back(size);
+    total += size;
+    return total - size;
+  };
+  for (int c = 0; c < 2; ++c) {
+    layout.lens_offset[c] = add(parameters->lens[c].data(), num_lens_params);
+  }
+  layout.extrinsics_offset = add(parameters->cam1_from_cam0.data(), 6);
+  layout.pose_offset.assign(view_used.size(), -1);
+  for (size_t v = 0; v < view_used.size(); ++v) {
+    if (view_used[v] &&
+        problem->HasParameterBlock(parameters->cam0_from_target[v].data())) {
+      layout.pose_offset[v] = add(parameters->cam0_from_target[v].data(), 6);
+    }
+  }
+  if (estimate_warp) layout.warp_offset = add(parameters->board_warp.data(), 2);
+  for (double* block : blocks) {
+    if (!problem->HasParameterBlock(block)) return false;
+  }
+  ceres::Problem::EvaluateOptions evaluate;
+  evaluate.parameter_blocks = blocks;
+  evaluate.apply_loss_function = false;
+  evaluate.num_threads = 1;
+  ceres::CRSMatrix crs;
+  if (!problem->Evaluate(evaluate, nullptr, nullptr, nullptr, &crs)) {
+    return false;
+  }
+  Eigen::MatrixXd information = Eigen::MatrixXd::Zero(total, total);
+  for (int r = 0; r < crs.num_rows; ++r) {
+    for (int a = crs.rows[r]; a < crs.rows[r + 1]; ++a) {
+      for (int b = crs.rows[r]; b < crs.rows[r + 1]; ++b) {
+        information(crs.cols[a], crs.cols[b]) += crs.values[a] * crs.values[b];
+      }
+    }
+  }
+  const Eigen::VectorXd diagonal = information.diagonal();
+  if (!(diagonal.minCoeff() > 0.0)) return false;
+  const Eigen::VectorXd scale = diagonal.cwiseSqrt().cwiseInverse();
+  const Eigen::MatrixXd scaled =
+      scale.asDiagonal() * information * scale.asDiagonal();
+  const Eigen::LLT<Eigen::MatrixXd> llt(scaled);
+  if (llt.info() != Eigen::Success) return false;
+  const Eigen::MatrixXd inverse =
+      llt.solve(Eigen::MatrixXd::Identity(total, total));
+  layout.matrix = variance * scale.asDiagonal() * inverse * scale.asDiagonal();
+  if (!layout.matrix.allFinite()) return false;
+  values->resize(total);
+  for (size_t b = 0, offset = 0; b < blocks.size(); offset += sizes[b], ++b) {
+    for (int i = 0; i < sizes[b]; ++i) (*values)[offset + i] = blocks[b][i];
+  }
+  *out = std::move(layout);
+  return true;
 }
 
 }  // namespace
@@ -115,6 +206,7 @@ StatusOr<StereoCalibration> CalibrateStereo(
     }
   }
   const std::vector<Eigen::Vector3d> target_points = TargetPoints(target);
+  const Board board{target_points, BoardWarpBasis(target)};
   const int num_points = static_cast<int>(target_points.size());
   const int num_views = static_cast<int>(views.size());
 
@@ -210,29 +302,33 @@ StatusOr<StereoCalibration> CalibrateStereo(
   const int num_views_used =
       static_cast<int>(std::count(view_used.begin(), view_used.end(), true));
   const int num_lens_params = cameras[0]->num_params();
-  const int num_parameters = 2 * num_lens_params + 6 + 6 * num_views_used;
+  const int num_warp_params = options.estimate_board_warp ? 2 : 0;
+  const int num_parameters =
+      2 * num_lens_params + 6 + 6 * num_views_used + num_warp_params;
 
   double initial_sum = 0.0;
   for (const Corner& corner : corners) {
-    initial_sum += Residual(options.model, corner, target_points, parameters)
-                       .squaredNorm();
+    initial_sum +=
+        Residual(options.model, corner, board, parameters).squaredNorm();
   }
   result.initial_rms_px =
       corners.empty() ? 0.0 : std::sqrt(initial_sum / corners.size());
 
   // Robust solves with outlier rejection, then least squares on the inliers.
   const auto residual = [&](const Corner& corner) {
-    return Residual(options.model, corner, target_points, parameters);
+    return Residual(options.model, corner, board, parameters);
   };
+  const ceres::Solver::Options solver_options = internal::BoardSolverOptions(
+      options.max_num_iterations, options.num_threads);
   ceres::Problem problem;
   RCM_RETURN_IF_ERROR(internal::FitWithOutlierRejection(
       {options.huber_px, options.outlier_sigmas,
        options.min_outlier_threshold_px, options.max_outlier_rounds},
-      internal::BoardSolverOptions(options.max_num_iterations,
-                                   options.num_threads),
+      solver_options,
       [&](double huber_px, ceres::Problem* problem) {
-        AddResiduals(options.model, corners, target_points, huber_px,
-                     &parameters, problem);
+        AddResiduals(options.model, corners, board,
+                     options.estimate_board_warp, huber_px, &parameters,
+                     problem);
       },
       residual, &corners, &problem));
 
@@ -251,6 +347,9 @@ StatusOr<StereoCalibration> CalibrateStereo(
     (c == 0 ? result.cam0 : result.cam1) = CameraCalibration(*camera);
   }
   result.cam1_from_cam0 = RigidFromPose(parameters.cam1_from_cam0.data());
+  result.board_warp_estimated = options.estimate_board_warp;
+  result.board_warp =
+      Eigen::Vector2d(parameters.board_warp[0], parameters.board_warp[1]);
   result.baseline = result.cam1_from_cam0.translation.norm();
   if (!(result.baseline > 0.0) || !std::isfinite(result.baseline)) {
     return Status::Error("bundle adjustment diverged: the baseline is " +
@@ -279,14 +378,17 @@ StatusOr<StereoCalibration> CalibrateStereo(
   result.pixel_sigma = std::sqrt(inlier_sum / redundancy);
 
   if (options.compute_covariance) {
-    double* blocks[3] = {parameters.lens[0].data(), parameters.lens[1].data(),
-                         parameters.cam1_from_cam0.data()};
+    std::vector<internal::CovarianceBlockRef> blocks = {
+        {parameters.lens[0].data(), num_lens_params},
+        {parameters.lens[1].data(), num_lens_params},
+        {parameters.cam1_from_cam0.data(), 6}};
+    if (options.estimate_board_warp) {
+      blocks.push_back({parameters.board_warp.data(), 2});
+    }
     Eigen::MatrixXd covariance;
-    if (!internal::JointCovariance({{blocks[0], num_lens_params},
-                                    {blocks[1], num_lens_params},
-                                    {blocks[2], 6}},
-                                   /*cross_blocks=*/false, options.num_threads,
-                                   &problem, &covariance)) {
+    if (!internal::JointCovariance(blocks, /*cross_blocks=*/false,
+                                   options.num_threads, &problem,
+                                   &covariance)) {
       return Status::Error(
           "the calibration is degenerate: its covariance cannot be computed "
           "(the views do not constrain every parameter; add views with the "
@@ -308,13 +410,28 @@ StatusOr<StereoCalibration> CalibrateStereo(
     jacobian.topLeftCorner<3, 3>() = internal::LeftPerturbationFromAngleAxis(
         parameters.cam1_from_cam0.data());
     const Eigen::Matrix<double, 6, 6> extrinsics =
-        covariance.bottomRightCorner<6, 6>();
+        covariance.block<6, 6>(2 * num_lens_params, 2 * num_lens_params);
+    if (options.estimate_board_warp) {
+      result.board_warp_covariance =
+          variance * covariance.bottomRightCorner<2, 2>();
+      result.board_warp_sigma =
+          result.board_warp_covariance.diagonal().cwiseSqrt();
+    }
     result.extrinsics_covariance =
         variance * jacobian * extrinsics * jacobian.transpose();
     const Eigen::Vector3d direction =
         result.cam1_from_cam0.translation / result.baseline;
     result.baseline_sigma = std::sqrt(direction.dot(
         result.extrinsics_covariance.bottomRightCorner<3, 3>() * direction));
+    if (!ComputeFullCovariance(view_used, num_lens_params,
+                               options.estimate_board_warp, variance,
+                               &parameters, &problem, &result.full_covariance,
+                               &result.full_parameters)) {
+      return Status::Error(
+          "the calibration is degenerate: the covariance of its board poses "
+          "cannot be computed (add views with the target tilted and near the "
+          "image corners)");
+    }
   }
   return result;
 }

@@ -21,6 +21,38 @@ constexpr int kMaxSupersampling = 16;
 constexpr int64_t kMinRowsPerThread = 8;
 // Threads Create undistorts the pixel corners with.
 constexpr int kCreateThreads = 2;
+// Newton on the ray-surface intersection (header): converged when the
+// step in depth is below kWarpStep [m]; kMaxWarpIterations is far more than
+// the ~4 a bow of millimetres needs.
+constexpr double kWarpStep = 1e-12;
+constexpr int kMaxWarpIterations = 30;
+
+// The target point (x, y) where the camera ray d meets the bowed board,
+// from the plane's hit; nullopt when Newton does not converge or the hit is
+// behind the camera. target = R^T (s d - t).
+std::optional<Eigen::Vector2d> WarpedHit(const Eigen::Matrix3d& target_from_cam,
+                                         const Eigen::Vector3d& origin,
+                                         const Eigen::Vector3d& ray,
+                                         const BoardWarpSurface& surface) {
+  const Eigen::Vector3d direction = target_from_cam * ray;
+  if (!(std::abs(direction.z()) > 0.0)) return std::nullopt;
+  double s = -origin.z() / direction.z();
+  for (int i = 0; i < kMaxWarpIterations; ++i) {
+    const Eigen::Vector3d p = origin + s * direction;
+    const double f = p.z() - surface.Height(p.x(), p.y());
+    const double slope =
+        direction.z() - surface.Slope(p.x(), p.y()).dot(direction.head<2>());
+    if (!(std::abs(slope) > 0.0)) return std::nullopt;
+    const double step = f / slope;
+    s -= step;
+    if (!std::isfinite(s)) return std::nullopt;
+    if (std::abs(step) < kWarpStep) {
+      if (!(s > 0.0)) return std::nullopt;
+      return (origin + s * direction).head<2>();
+    }
+  }
+  return std::nullopt;
+}
 
 }  // namespace
 
@@ -111,14 +143,28 @@ cv::Mat TargetRenderer::Render(const Rigid3d& cam_from_target,
         texture_from_target * plane.inverse();
 
     // Homogeneous texture points of the pixel corners (NaN where invalid).
+    const bool warped = options.board_warp.warp.squaredNorm() > 0.0;
+    const Eigen::Matrix3d target_from_cam =
+        cam_from_target.rotation.transpose();
+    const Eigen::Vector3d origin =
+        -(target_from_cam * cam_from_target.translation);
     std::vector<Eigen::Vector3d> corners(corner_rays_.size());
-    ParallelFor(static_cast<int64_t>(height) + 1, options.num_threads,
-                kMinRowsPerThread, [&](int64_t begin, int64_t end) {
-                  for (int64_t k = begin * columns; k < end * columns; ++k) {
-                    corners[k] =
-                        texture_from_ray * corner_rays_[k].cast<double>();
-                  }
-                });
+    ParallelFor(
+        static_cast<int64_t>(height) + 1, options.num_threads,
+        kMinRowsPerThread, [&](int64_t begin, int64_t end) {
+          for (int64_t k = begin * columns; k < end * columns; ++k) {
+            const Eigen::Vector3d ray = corner_rays_[k].cast<double>();
+            corners[k] = texture_from_ray * ray;
+            if (!warped || !(corners[k].z() > 0.0)) continue;
+            const std::optional<Eigen::Vector2d> hit =
+                WarpedHit(target_from_cam, origin, ray, options.board_warp);
+            corners[k] = hit ? Eigen::Vector3d(
+                                   corners[k].z() *
+                                   (texture_from_target * hit->homogeneous()))
+                             : Eigen::Vector3d::Constant(
+                                   std::numeric_limits<double>::quiet_NaN());
+          }
+        });
 
     const cv::Mat& texture = target_image_.image;
     const int texture_cols = texture.cols;
@@ -201,9 +247,9 @@ cv::Mat TargetRenderer::Render(const Rigid3d& cam_from_target,
 
 std::vector<std::optional<Eigen::Vector2d>> ProjectTargetPoints(
     const Camera& camera, const Rigid3d& cam_from_target,
-    const CalibrationTarget& target) {
+    const CalibrationTarget& target, const Eigen::Vector2d& board_warp) {
   std::vector<std::optional<Eigen::Vector2d>> pixels;
-  for (const Eigen::Vector3d& point : TargetPoints(target)) {
+  for (const Eigen::Vector3d& point : WarpedTargetPoints(target, board_warp)) {
     const Eigen::Vector3d in_camera = cam_from_target * point;
     std::optional<Eigen::Vector2d> pixel;
     if (in_camera.z() > 0.0) {

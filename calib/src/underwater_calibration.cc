@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "board_bundle_adjustment.h"
+#include "rcm/calib/board_warp.h"
 #include "rcm/calib/calibration_initialization.h"
 #include "rcm/calib/underwater_reprojection_error.h"
 #include "rcm/camera/refractive_model.h"
@@ -45,6 +46,7 @@ const double kMaxTiltParameter =
 // What the problem holds fixed: the target, the lenses and the glass.
 struct Model {
   std::vector<Eigen::Vector3d> target_points;
+  std::vector<Eigen::Vector2d> warp_basis;  // per point (board_warp.h)
   std::array<LensModelId, 2> lens_models{};
   std::array<UnderwaterCameraConstants, 2> constants{};
 };
@@ -56,6 +58,7 @@ struct Parameters {
   std::array<double, 2> air_gap{};              // per camera
   std::array<std::array<double, 2>, 2> tilt{};  // per camera: (a, b)
   std::vector<Pose> cam0_from_target;           // per input view
+  std::array<double, 2> board_warp{};           // [warp_x, warp_y] (m)
 };
 
 // Which of them are estimated (the poses always are).
@@ -63,18 +66,20 @@ struct FreeParameters {
   bool extrinsics = false;
   std::array<bool, 2> air_gap{};
   std::array<bool, 2> tilt{};
+  bool board_warp = false;
 };
 
 template <typename LensModel>
 ceres::CostFunction* MakeCost(const Model& model, const Corner& corner) {
   const UnderwaterCameraConstants& constants = model.constants[corner.camera];
   const Eigen::Vector3d& point = model.target_points[corner.point_id];
+  const Eigen::Vector2d& basis = model.warp_basis[corner.point_id];
   if (corner.camera == 0) {
-    return Cam0UnderwaterReprojectionError<LensModel>::Create(constants, point,
-                                                              corner.pixel);
+    return Cam0UnderwaterReprojectionError<LensModel>::Create(
+        constants, point, basis, corner.pixel);
   }
-  return Cam1UnderwaterReprojectionError<LensModel>::Create(constants, point,
-                                                            corner.pixel);
+  return Cam1UnderwaterReprojectionError<LensModel>::Create(
+      constants, point, basis, corner.pixel);
 }
 
 ceres::CostFunction* CostFor(const Model& model, const Corner& corner) {
@@ -98,13 +103,19 @@ void AddResiduals(const Model& model, const std::vector<Corner>& corners,
     if (c == 0) {
       problem->AddResidualBlock(CostFor(model, corner), loss, &parameters->n,
                                 pose, &parameters->air_gap[0],
-                                parameters->tilt[0].data());
+                                parameters->tilt[0].data(),
+                                parameters->board_warp.data());
     } else {
       problem->AddResidualBlock(CostFor(model, corner), loss, &parameters->n,
                                 pose, parameters->cam1_from_cam0.data(),
                                 &parameters->air_gap[1],
-                                parameters->tilt[1].data());
+                                parameters->tilt[1].data(),
+                                parameters->board_warp.data());
     }
+  }
+  if (problem->HasParameterBlock(parameters->board_warp.data()) &&
+      !free.board_warp) {
+    problem->SetParameterBlockConstant(parameters->board_warp.data());
   }
   if (!problem->HasParameterBlock(&parameters->n)) return;
   problem->SetParameterLowerBound(&parameters->n, 0, kMinIndex);
@@ -144,17 +155,19 @@ bool EvaluateResidual(const Model& model, const Corner& corner,
                       const Parameters& parameters, double* residual) {
   const UnderwaterCameraConstants& constants = model.constants[corner.camera];
   const Eigen::Vector3d& point = model.target_points[corner.point_id];
+  const Eigen::Vector2d& basis = model.warp_basis[corner.point_id];
   const double* pose = parameters.cam0_from_target[corner.view].data();
   if (corner.camera == 0) {
-    return Cam0UnderwaterReprojectionError<LensModel>(
-        constants, point, corner.pixel)(&parameters.n, pose,
-                                        &parameters.air_gap[0],
-                                        parameters.tilt[0].data(), residual);
+    return Cam0UnderwaterReprojectionError<LensModel>(constants, point, basis,
+                                                      corner.pixel)(
+        &parameters.n, pose, &parameters.air_gap[0], parameters.tilt[0].data(),
+        parameters.board_warp.data(), residual);
   }
-  return Cam1UnderwaterReprojectionError<LensModel>(constants, point,
+  return Cam1UnderwaterReprojectionError<LensModel>(constants, point, basis,
                                                     corner.pixel)(
       &parameters.n, pose, parameters.cam1_from_cam0.data(),
-      &parameters.air_gap[1], parameters.tilt[1].data(), residual);
+      &parameters.air_gap[1], parameters.tilt[1].data(),
+      parameters.board_warp.data(), residual);
 }
 
 // The same; NaN when the port cannot image the corner.
@@ -226,6 +239,9 @@ CovarianceLayout LayoutOf(const FreeParameters& free,
       layout.Add("cam" + std::to_string(c) + " port_tilt",
                  parameters.tilt[c].data(), 2);
     }
+  }
+  if (free.board_warp) {
+    layout.Add("board_warp", parameters.board_warp.data(), 2);
   }
   return layout;
 }
@@ -379,6 +395,7 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
 
   Model model;
   model.target_points = TargetPoints(target);
+  model.warp_basis = BoardWarpBasis(target);
   const int num_points = static_cast<int>(model.target_points.size());
   StatusOr<internal::UsedObservations> selected = internal::SelectObservations(
       views, num_points, options.min_corners_per_view,
@@ -459,6 +476,7 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     free.air_gap[c] = options.estimate_air_gap && camera_used[c];
     free.tilt[c] = options.estimate_port_tilt && camera_used[c];
   }
+  free.board_warp = options.estimate_board_warp;
   const CovarianceLayout layout = LayoutOf(free, parameters);
   const int num_parameters = layout.size + 6 * num_views_used;
 
@@ -666,6 +684,17 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     }
   }
 
+  // The board's warp.
+  result.board_warp_estimated = free.board_warp;
+  result.board_warp =
+      Eigen::Vector2d(parameters.board_warp[0], parameters.board_warp[1]);
+  if (free.board_warp) {
+    result.board_warp_covariance =
+        result.covariance.Block("board_warp", "board_warp");
+    result.board_warp_sigma =
+        result.board_warp_covariance.diagonal().cwiseSqrt();
+  }
+
   // The extrinsics and their change from the air calibration.
   if (free.extrinsics) {
     const UnderwaterParameterBlock& block =
@@ -826,6 +855,7 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     conventional.use_single_camera_views = options.use_single_camera_views;
     conventional.min_corners_per_view = options.min_corners_per_view;
     conventional.compute_covariance = false;
+    conventional.estimate_board_warp = options.estimate_board_warp;
     conventional.num_threads = options.num_threads;
     const StatusOr<StereoCalibration> calibration = CalibrateStereo(
         target, views, {cameras[0]->width(), cameras[0]->height()},

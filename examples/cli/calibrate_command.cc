@@ -28,6 +28,7 @@
 #include "rcm/calib/calibration_report.h"
 #include "rcm/calib/calibration_target.h"
 #include "rcm/calib/cross_validation.h"
+#include "rcm/calib/projection_uncertainty.h"
 #include "rcm/calib/stereo_calibration.h"
 #include "rcm/calib/target_detector.h"
 #include "rcm/geometry/stereo_rig.h"
@@ -47,6 +48,14 @@ DEFINE_double(huber, 1.0, "Huber loss scale of the robust solves, pixels");
 DEFINE_double(outlier_sigmas, 5.0,
               "corners beyond this many robust sigmas are outliers (and "
               "beyond 2 px)");
+DEFINE_bool(flat_board, false,
+            "assume the board is flat: do not estimate its bow (two "
+            "parameters shared by all views, mrcal's calobject_warp; also "
+            "with --underwater)");
+DEFINE_string(uncertainty_distance, "inf",
+              "distance [m] of the projection uncertainty in the report "
+              "(mrcal's mean-frames method through the board poses); inf: "
+              "at infinity");
 DEFINE_int32(min_corners, 6,
              "fewest corners of a view in one image for it to be used");
 
@@ -70,9 +79,13 @@ constexpr char kUsage[] =
     "      --model equidistant --out camchain.yaml\n\n"
     "Detects the target in every pair, calibrates both cameras' lenses, the\n"
     "extrinsics cam1_from_cam0 (cam0 = left) and every target pose by a\n"
-    "Ceres bundle adjustment, and writes the Kalibr camchain (--out) and a\n"
+    "Ceres bundle adjustment (with the board's bow, two parameters shared\n"
+    "by all views, as mrcal's calobject_warp; --flat-board assumes a flat\n"
+    "board, as OpenCV does), and writes the Kalibr camchain (--out) and a\n"
     "report folder: residual and coverage pictures, the projection\n"
-    "uncertainty over each image, per-view RMS, calibration.json.\n"
+    "uncertainty over each image (mrcal's mean-frames method, through the\n"
+    "board poses, at --uncertainty-distance, default infinity; and the\n"
+    "intrinsics-only figure), per-view RMS, calibration.json.\n"
     "--out names the camchain file (.yaml) or a folder that gets\n"
     "camchain.yaml and report/; camchain-covariance.yaml beside the camchain\n"
     "tells rcm estimate how well it is known.\n\n"
@@ -144,6 +157,7 @@ int RunCalibrate() {
   options.huber_px = FLAGS_huber;
   options.outlier_sigmas = FLAGS_outlier_sigmas;
   options.min_corners_per_view = FLAGS_min_corners;
+  options.estimate_board_warp = !FLAGS_flat_board;
   if (const Status status = options.Check(); !status.ok()) {
     PrintError(command, status.message());
     return kExitUsage;
@@ -151,6 +165,23 @@ int RunCalibrate() {
   if (FLAGS_folds < 0 || FLAGS_folds == 1) {
     PrintError(command, "--folds must be 0 (off) or at least 2");
     return kExitUsage;
+  }
+  double uncertainty_distance = calib::kInfiniteDistance;
+  if (FLAGS_uncertainty_distance != "inf" &&
+      FLAGS_uncertainty_distance != "infinity") {
+    char* end = nullptr;
+    errno = 0;
+    uncertainty_distance =
+        std::strtod(FLAGS_uncertainty_distance.c_str(), &end);
+    if (end == FLAGS_uncertainty_distance.c_str() || *end != '\0' ||
+        errno != 0 || !(uncertainty_distance > 0.0) ||
+        !std::isfinite(uncertainty_distance)) {
+      PrintError(command,
+                 "--uncertainty-distance must be a positive distance in "
+                 "meters or inf, got '" +
+                     FLAGS_uncertainty_distance + "'");
+      return kExitUsage;
+    }
   }
   const StatusOr<CalibrationTarget> target = TargetFromFlags();
   if (!target.ok()) {
@@ -171,6 +202,7 @@ int RunCalibrate() {
     underwater.outlier_sigmas = FLAGS_outlier_sigmas;
     underwater.min_corners = FLAGS_min_corners;
     underwater.folds = FLAGS_folds;
+    underwater.estimate_board_warp = !FLAGS_flat_board;
     return RunCalibrateUnderwater(command, *target, paths, underwater);
   }
   if (!FLAGS_air.empty() || FLAGS_estimate_air_gap ||
@@ -235,8 +267,10 @@ int RunCalibrate() {
     }
   }
 
-  calib::CalibrationReport report =
-      calib::SummarizeCalibration(*calibration, views, sizes[0], sizes[1]);
+  calib::CalibrationReportOptions report_options;
+  report_options.uncertainty_distance_m = uncertainty_distance;
+  calib::CalibrationReport report = calib::SummarizeCalibration(
+      *calibration, views, sizes[0], sizes[1], report_options);
   if (cross_validation) {
     for (const calib::ParameterSpread& p : cross_validation->parameters) {
       // The covariance assumes independent corner noise; a leave-out
@@ -308,13 +342,25 @@ int RunCalibrate() {
                                                   sigma6[2]};
   json["cam1_from_cam0"]["sigma_translation_m"] = {sigma6[3], sigma6[4],
                                                    sigma6[5]};
+  json["board_flatness"] = BoardFlatnessJson(
+      calibration->board_warp_estimated, calibration->board_warp,
+      calibration->board_warp_covariance);
   for (int c = 0; c < 2; ++c) {
     const calib::CalibrationReport::CameraStats& s = report.cameras[c];
     json["coverage"]["cam" + std::to_string(c)] = s.coverage;
-    json["projection_uncertainty_px"]["cam" + std::to_string(c)] = {
-        {"median", JsonNumber(s.uncertainty_median_px)},
-        {"p95", JsonNumber(s.uncertainty_p95_px)},
-        {"max", JsonNumber(s.uncertainty_max_px)}};
+    // mrcal's mean-frames figure at the stated distance, and the
+    // intrinsics-only one (the ray held fixed in the camera).
+    json["projection_uncertainty"]["cam" + std::to_string(c)] = {
+        {"distance_m", std::isinf(uncertainty_distance)
+                           ? nlohmann::json("inf")
+                           : nlohmann::json(uncertainty_distance)},
+        {"median_px", JsonNumber(s.projection_uncertainty_median_px)},
+        {"p95_px", JsonNumber(s.projection_uncertainty_p95_px)},
+        {"max_px", JsonNumber(s.projection_uncertainty_max_px)}};
+    json["intrinsics_only_uncertainty_px"]["cam" + std::to_string(c)] = {
+        {"median", JsonNumber(s.intrinsics_only_uncertainty_median_px)},
+        {"p95", JsonNumber(s.intrinsics_only_uncertainty_p95_px)},
+        {"max", JsonNumber(s.intrinsics_only_uncertainty_max_px)}};
   }
   if (cross_validation) {
     nlohmann::json folds = nlohmann::json::object();
@@ -332,7 +378,8 @@ int RunCalibrate() {
   json["warnings"] = report.warnings;
 
   if (Status status = calib::WriteCalibrationReport(
-          paths.report, report, *calibration, views, sizes[0], sizes[1]);
+          paths.report, report, *calibration, views, sizes[0], sizes[1],
+          report_options);
       !status.ok()) {
     PrintError(command, status.message());
     return kExitFailure;
@@ -409,6 +456,19 @@ int RunCalibrate() {
                     : std::nullopt)
           .c_str(),
       calibration->cam1_from_cam0.RotationAngle() * 180.0 / M_PI);
+  for (int c = 0; c < 2; ++c) {
+    const calib::CalibrationReport::CameraStats& s = report.cameras[c];
+    std::printf(
+        "cam%d projection uncertainty at %s: median %.3f, 95 %% %.3f px "
+        "(intrinsics only: median %.3f px)\n",
+        c, calib::DistanceName(uncertainty_distance).c_str(),
+        s.projection_uncertainty_median_px, s.projection_uncertainty_p95_px,
+        s.intrinsics_only_uncertainty_median_px);
+  }
+  std::printf("%s\n", BoardFlatnessText(calibration->board_warp_estimated,
+                                         calibration->board_warp,
+                                         calibration->board_warp_covariance)
+                           .c_str());
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();

@@ -186,6 +186,7 @@ int RunCalibrateUnderwater(const Subcommand& command,
   options.outlier_sigmas = run.outlier_sigmas;
   options.min_corners_per_view = run.min_corners;
   options.folds = run.folds;
+  options.estimate_board_warp = run.estimate_board_warp;
   if (const Status status = options.Check(); !status.ok()) {
     PrintError(command, status.message());
     return kExitUsage;
@@ -340,6 +341,9 @@ int RunCalibrateUnderwater(const Subcommand& command,
                           ? nlohmann::json(result->conventional.pixel_sigma)
                           : nullptr},
       {"error", result->conventional.error}};
+  json["board_flatness"] =
+      BoardFlatnessJson(result->board_warp_estimated, result->board_warp,
+                        result->board_warp_covariance);
   json["warnings"] = warnings;
   if (Status status = WriteFileAtomically(
           (std::filesystem::path(paths.report) / "underwater.json").string(),
@@ -408,6 +412,10 @@ int RunCalibrateUnderwater(const Subcommand& command,
   } else {
     std::printf("extrinsics: the air calibration's (one camera)\n");
   }
+  std::printf("%s\n", BoardFlatnessText(result->board_warp_estimated,
+                                         result->board_warp,
+                                         result->board_warp_covariance)
+                           .c_str());
   for (int c = 0; c < (one_camera ? 1 : 2); ++c) {
     const calib::PortEstimate& port = result->ports[c];
     if (!port.air_gap_estimated && !port.tilt_estimated) continue;

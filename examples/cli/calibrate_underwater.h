@@ -24,6 +24,7 @@ struct UnderwaterRunOptions {
   double outlier_sigmas = 5.0;
   int min_corners = 6;
   int folds = 10;
+  bool estimate_board_warp = true;  // not --flat-board
 };
 
 // Runs rcm calibrate --underwater once the common flags are checked

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <mutex>
@@ -78,6 +79,31 @@ std::string WithSigma(double value, double sigma, int digits,
       FormatFixed(value, digits) + " +- " + FormatFixed(sigma, digits);
   if (leave_out) text += " (" + FormatFixed(*leave_out, digits) + ")";
   return text;
+}
+
+std::string BoardFlatnessText(bool estimated, const Eigen::Vector2d& warp,
+                              const Eigen::Matrix2d& covariance) {
+  if (!estimated) return "board flatness: assumed flat (--flat-board)";
+  const Eigen::Vector2d sigma = covariance.diagonal().cwiseSqrt();
+  return "board flatness: bowl " +
+         WithSigma(1e3 * warp.sum(), 1e3 * std::sqrt(covariance.sum()), 2,
+                   std::nullopt) +
+         " mm at the centre (x " +
+         WithSigma(1e3 * warp.x(), 1e3 * sigma.x(), 2, std::nullopt) +
+         ", y " + WithSigma(1e3 * warp.y(), 1e3 * sigma.y(), 2, std::nullopt) +
+         " mm)";
+}
+
+nlohmann::json BoardFlatnessJson(bool estimated, const Eigen::Vector2d& warp,
+                                 const Eigen::Matrix2d& covariance) {
+  nlohmann::json json = {{"estimated", estimated}};
+  if (!estimated) return json;
+  const Eigen::Vector2d sigma = covariance.diagonal().cwiseSqrt();
+  json["board_warp_mm"] = {1e3 * warp.x(), 1e3 * warp.y()};
+  json["board_warp_sigma_mm"] = {1e3 * sigma.x(), 1e3 * sigma.y()};
+  json["bowl_mm"] = 1e3 * warp.sum();
+  json["bowl_sigma_mm"] = 1e3 * std::sqrt(covariance.sum());
+  return json;
 }
 
 StatusOr<Detections> DetectTargets(StereoImageSource* source,

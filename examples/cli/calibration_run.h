@@ -4,6 +4,8 @@
 #ifndef RCM_EXAMPLES_CLI_CALIBRATION_RUN_H_
 #define RCM_EXAMPLES_CLI_CALIBRATION_RUN_H_
 
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -36,6 +38,19 @@ Status CheckCalibrationOutputPaths(const CalibrationOutputPaths& paths);
 // "fx 532.69 +- 0.37" with the leave-out sigma in parentheses when given.
 std::string WithSigma(double value, double sigma, int digits,
                       std::optional<double> leave_out);
+
+// The board's flatness as rcm calibrate prints it: "board flatness: bowl
+// 0.74 +- 0.05 mm at the centre (x 0.40 +- 0.03, y 0.34 +- 0.03 mm)", or
+// "board flatness: assumed flat (--flat-board)" when not estimated. warp
+// [m], covariance [m^2] (board_warp.h).
+std::string BoardFlatnessText(bool estimated, const Eigen::Vector2d& warp,
+                              const Eigen::Matrix2d& covariance);
+
+// Its JSON: {"estimated", "board_warp_mm": [x, y], "board_warp_sigma_mm":
+// [sx, sy], "bowl_mm", "bowl_sigma_mm"} (the bowl at the centre is
+// warp_x + warp_y); {"estimated": false} when not estimated.
+nlohmann::json BoardFlatnessJson(bool estimated, const Eigen::Vector2d& warp,
+                                 const Eigen::Matrix2d& covariance);
 
 // The detection pass over every pair (a progress bar on a terminal). Its
 // warnings wait until the pass is over, so that a run that fails says one

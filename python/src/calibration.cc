@@ -163,6 +163,7 @@ std::vector<OptionField> BoardAdjustmentFields(Options* o) {
           IntOption("max_num_iterations", &o->max_num_iterations),
           BoolOption("use_single_camera_views", &o->use_single_camera_views),
           IntOption("min_corners_per_view", &o->min_corners_per_view),
+          BoolOption("estimate_board_warp", &o->estimate_board_warp),
           IntOption("num_threads", &o->num_threads)};
 }
 
@@ -259,7 +260,9 @@ constexpr const char* kStereoOptionsDoc = R"doc(
 Keyword options (StereoCalibrationOptions): huber_px=1.0 (pixels),
 outlier_sigmas=5.0, min_outlier_threshold_px=2.0, max_outlier_rounds=3,
 max_num_iterations=200, use_single_camera_views=True,
-min_corners_per_view=6, compute_covariance=True, num_threads=2.
+min_corners_per_view=6, estimate_board_warp=True (the board's bow, two
+parameters shared by all views, mrcal's calobject_warp), compute_covariance=True,
+num_threads=2.
 )doc";
 
 constexpr const char* kUnderwaterOptionsDoc = R"doc(
@@ -267,7 +270,8 @@ Keyword options (UnderwaterCalibrationOptions): initial_n=1.34,
 estimate_air_gap=False, estimate_port_tilt=False, huber_px=1.0,
 outlier_sigmas=5.0, min_outlier_threshold_px=2.0, max_outlier_rounds=3,
 max_num_iterations=200, use_single_camera_views=True,
-min_corners_per_view=6, folds=10 (leave-out replicates; 0 or 1: none),
+min_corners_per_view=6, estimate_board_warp=True, folds=10 (leave-out
+replicates; 0 or 1: none),
 fit_conventional_model=True, num_threads=2.
 )doc";
 
@@ -393,8 +397,10 @@ inlier_rms_px, pixel_sigma (estimated corner noise, pixels), initial_rms_px
 and cam1_sigma (standard deviations of [fx, fy, cx, cy, d...]),
 extrinsics_covariance (6x6, [w; t] in rad and m), num_views_used,
 num_stereo_views, num_inliers, num_outliers, num_parameters,
-cam0_from_target (per input view: 4x4 or None), notes (why views were
-dropped).
+cam0_from_target (per input view: 4x4 or None), board_warp_estimated,
+board_warp ([warp_x, warp_y], meters: the board's bow, zero when not
+estimated; the bowl at the centre is their sum), board_warp_sigma (meters),
+board_warp_covariance (2x2), notes (why views were dropped).
 )doc")
       .def_property_readonly(
           "rig", [](const StereoCalibrationResult& r) { return r.rig; })
@@ -433,6 +439,23 @@ dropped).
           "extrinsics_covariance",
           [](const StereoCalibrationResult& r) {
             return ToNumpy(r.calibration.extrinsics_covariance);
+          })
+      .def_property_readonly("board_warp_estimated",
+                             [](const StereoCalibrationResult& r) {
+                               return r.calibration.board_warp_estimated;
+                             })
+      .def_property_readonly("board_warp",
+                             [](const StereoCalibrationResult& r) {
+                               return ToNumpy(r.calibration.board_warp);
+                             })
+      .def_property_readonly("board_warp_sigma",
+                             [](const StereoCalibrationResult& r) {
+                               return ToNumpy(r.calibration.board_warp_sigma);
+                             })
+      .def_property_readonly(
+          "board_warp_covariance",
+          [](const StereoCalibrationResult& r) {
+            return ToNumpy(r.calibration.board_warp_covariance);
           })
       .def_property_readonly("num_views_used",
                              [](const StereoCalibrationResult& r) {
@@ -528,7 +551,8 @@ extrinsic_change (dict: rotation_deg, angle_deg, translation_mm and their
 sigmas), ports (two dicts: port, air_gap_estimated, air_gap_sigma (m),
 tilt_estimated, tilt_deg), rms_px, inlier_rms_px, pixel_sigma,
 initial_rms_px, num_views_used, num_stereo_views, num_inliers,
-num_outliers, num_parameters, notes.
+num_outliers, num_parameters, board_warp_estimated, board_warp and
+board_warp_sigma (meters, as calibrate_stereo's), notes.
 )doc")
       .def_property_readonly(
           "n", [](const UnderwaterResult& r) { return r.calibration.n; })
@@ -546,6 +570,18 @@ num_outliers, num_parameters, notes.
       .def_property_readonly("extrinsics_estimated",
                              [](const UnderwaterResult& r) {
                                return r.calibration.extrinsics_estimated;
+                             })
+      .def_property_readonly("board_warp_estimated",
+                             [](const UnderwaterResult& r) {
+                               return r.calibration.board_warp_estimated;
+                             })
+      .def_property_readonly("board_warp",
+                             [](const UnderwaterResult& r) {
+                               return ToNumpy(r.calibration.board_warp);
+                             })
+      .def_property_readonly("board_warp_sigma",
+                             [](const UnderwaterResult& r) {
+                               return ToNumpy(r.calibration.board_warp_sigma);
                              })
       .def_property_readonly(
           "extrinsic_change",

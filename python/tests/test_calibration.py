@@ -101,6 +101,54 @@ def test_exact_stereo_calibration_from_corners(realistic_rig):
         np.testing.assert_allclose(estimate, pose, atol=EXACT)
 
 
+def bowed(target, warp):
+    """The target's points on the board bowed by warp = [x, y] meters
+    (mrcal's calobject_warp, rcm/calib/board_warp.h): z = x 4 xr (1 - xr)
+    + y 4 yr (1 - yr), (xr, yr) normalized over the points' extent."""
+    points = target.points.copy()
+    low = points[:, :2].min(axis=0)
+    r = (points[:, :2] - low) / (points[:, :2].max(axis=0) - low)
+    points[:, 2] = 4 * r * (1 - r) @ np.asarray(warp, float)
+    return points
+
+
+def test_board_warp_is_estimated_by_default(realistic_rig):
+    # Exact corners of a board bowed by 0.4 + 0.3 mm: the warp is the
+    # truth to 1e-9 m; with estimate_board_warp=False the flat board
+    # cannot fit them.
+    target = checkerboard()
+    warp = [4e-4, 3e-4]
+    poses = board_poses(realistic_rig.cam0, target, 18, seed=7)
+
+    class Bowed:
+        points = bowed(target, warp)
+
+    views = stereo_views(realistic_rig, Bowed, poses)
+    result = rcm.calibrate_stereo_from_corners(
+        target, views, realistic_rig.cam0.image_size,
+        realistic_rig.cam1.image_size, model="equidistant")
+    assert result.board_warp_estimated
+    np.testing.assert_allclose(result.board_warp, warp, rtol=0, atol=EXACT)
+    assert np.all(result.board_warp_sigma > 0)
+    assert result.board_warp_covariance.shape == (2, 2)
+    np.testing.assert_allclose(result.rig.cam0.intrinsics,
+                               realistic_rig.cam0.intrinsics, atol=EXACT)
+    flat = rcm.calibrate_stereo_from_corners(
+        target, views, realistic_rig.cam0.image_size,
+        realistic_rig.cam1.image_size, model="equidistant",
+        estimate_board_warp=False)
+    assert not flat.board_warp_estimated
+    np.testing.assert_array_equal(flat.board_warp, [0.0, 0.0])
+    assert flat.rms_px > 1e-3
+    # Under water too.
+    under = rcm.calibrate_underwater_from_corners(
+        target, views, realistic_rig, folds=0, fit_conventional_model=False,
+        initial_n=1.0)
+    assert under.board_warp_estimated
+    np.testing.assert_allclose(under.board_warp, warp, rtol=0, atol=EXACT)
+    assert np.all(under.board_warp_sigma > 0)
+
+
 def test_exact_underwater_calibration_recovers_n_and_drift(realistic_rig):
     # underwater_calibration_test.cc ExactThinPortRecoversNAndDrift: the air
     # rig drifted by 0.5 degrees and 0.3 mm in the water, n = 1.342.

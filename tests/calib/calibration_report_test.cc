@@ -314,9 +314,9 @@ TEST(CalibrationReport, StatisticsOfAHandBuiltCalibration) {
   EXPECT_EQ(cam1.coverage, 1.0 / 8.0);  // the outlier's cell does not count
   EXPECT_NEAR(cam0.view_rms_limit_px, 3.0 * cam0.rms_px, kRmsTolerance);
   // Uncertainty over the image: ordered, positive, finite.
-  EXPECT_GT(cam0.uncertainty_median_px, 0.0);
-  EXPECT_LE(cam0.uncertainty_median_px, cam0.uncertainty_p95_px);
-  EXPECT_LE(cam0.uncertainty_p95_px, cam0.uncertainty_max_px);
+  EXPECT_GT(cam0.intrinsics_only_uncertainty_median_px, 0.0);
+  EXPECT_LE(cam0.intrinsics_only_uncertainty_median_px, cam0.intrinsics_only_uncertainty_p95_px);
+  EXPECT_LE(cam0.intrinsics_only_uncertainty_p95_px, cam0.intrinsics_only_uncertainty_max_px);
   // No view reaches 3x its camera's RMS.
   for (const CalibrationReport::View& view : report.views) {
     EXPECT_FALSE(view.flagged) << view.view;
@@ -331,9 +331,9 @@ TEST(CalibrationReport, UncertaintyStatisticsOfAPinhole) {
   const CalibrationReport report =
       SummarizeCalibration(calibration, NamedViews(10), kVga, kVga);
   const double corner = 0.1 * std::sqrt(1.0 + 0.8 * 0.8);
-  EXPECT_LT(report.cameras[0].uncertainty_max_px, corner);
-  EXPECT_GT(report.cameras[0].uncertainty_max_px, 0.99 * corner);
-  EXPECT_GT(report.cameras[0].uncertainty_median_px, 0.1);
+  EXPECT_LT(report.cameras[0].intrinsics_only_uncertainty_max_px, corner);
+  EXPECT_GT(report.cameras[0].intrinsics_only_uncertainty_max_px, 0.99 * corner);
+  EXPECT_GT(report.cameras[0].intrinsics_only_uncertainty_median_px, 0.1);
 }
 
 TEST(CalibrationReport, NoWarningsForAGoodCalibration) {
@@ -407,8 +407,8 @@ TEST(CalibrationReport, WarnsAboutUncertaintyExactlyAboveTheMaximum) {
   calibration.cam0.covariance *= 100.0;
   const CalibrationReport reference =
       SummarizeCalibration(calibration, NamedViews(10), kVga, kVga);
-  const double p95 = reference.cameras[0].uncertainty_p95_px;
-  ASSERT_GT(p95, 10.0 * reference.cameras[1].uncertainty_p95_px * 0.999);
+  const double p95 = reference.cameras[0].intrinsics_only_uncertainty_p95_px;
+  ASSERT_GT(p95, 10.0 * reference.cameras[1].intrinsics_only_uncertainty_p95_px * 0.999);
   CalibrationReportOptions options;
   options.max_uncertainty_px = p95 * (1.0 + 1e-9);
   EXPECT_TRUE(
@@ -418,7 +418,7 @@ TEST(CalibrationReport, WarnsAboutUncertaintyExactlyAboveTheMaximum) {
   const CalibrationReport report =
       SummarizeCalibration(calibration, NamedViews(10), kVga, kVga, options);
   ASSERT_EQ(report.warnings.size(), 1u);
-  EXPECT_EQ(report.warnings[0].rfind("cam0: projection uncertainty", 0), 0u)
+  EXPECT_EQ(report.warnings[0].rfind("cam0: intrinsics-only projection uncertainty", 0), 0u)
       << report.warnings[0];
 }
 
@@ -694,7 +694,9 @@ TEST(CalibrationReport, WritesEveryFile) {
   ASSERT_TRUE(status.ok()) << status.message();
   for (const std::string name :
        {"residuals_cam0.png", "residuals_cam1.png", "coverage_cam0.png",
-        "coverage_cam1.png", "uncertainty_cam0.png", "uncertainty_cam1.png",
+        "coverage_cam1.png", "intrinsics_only_uncertainty_cam0.png",
+        "intrinsics_only_uncertainty_cam1.png",
+        "projection_uncertainty_cam0.png", "projection_uncertainty_cam1.png",
         "per_view_rms.png", "per_view.csv"}) {
     const fs::path path = fs::path(directory) / name;
     ASSERT_TRUE(fs::is_regular_file(path)) << path;

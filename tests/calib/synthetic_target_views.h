@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "rcm/calib/board_warp.h"
 #include "rcm/calib/calibration_target.h"
 #include "rcm/calib/target_observation.h"
 #include "rcm/camera/flat_port_camera.h"
@@ -112,14 +113,18 @@ inline PointProjection InAir(const Camera& camera) {
 
 // Stereo views at the given target poses of two cameras that image points
 // by `left` and `right` (each in its own frame), cam1 at right_from_left.
+// The corners are those of the board bowed by `board_warp` [m]
+// (board_warp.h; 0: flat).
 inline std::vector<StereoView> ObserveStereoWith(
     const Camera& left_camera, const PointProjection& left,
     const Camera& right_camera, const PointProjection& right,
     const Rigid3d& right_from_left, const CalibrationTarget& target,
     const std::vector<Rigid3d>& cam0_from_target, double noise_px,
-    unsigned seed) {
+    unsigned seed,
+    const Eigen::Vector2d& board_warp = Eigen::Vector2d::Zero()) {
   std::mt19937 rng(seed);
-  const std::vector<Eigen::Vector3d> points = TargetPoints(target);
+  const std::vector<Eigen::Vector3d> points =
+      WarpedTargetPoints(target, board_warp);
   std::vector<StereoView> views;
   for (size_t v = 0; v < cam0_from_target.size(); ++v) {
     StereoView view;
@@ -139,10 +144,11 @@ inline std::vector<StereoView> ObserveStereoWith(
 inline std::vector<StereoView> ObserveStereo(
     const StereoRig& rig, const CalibrationTarget& target,
     const std::vector<Rigid3d>& cam0_from_target, double noise_px,
-    unsigned seed) {
+    unsigned seed,
+    const Eigen::Vector2d& board_warp = Eigen::Vector2d::Zero()) {
   return ObserveStereoWith(rig.left(), InAir(rig.left()), rig.right(),
                            InAir(rig.right()), rig.right_from_left(), target,
-                           cam0_from_target, noise_px, seed);
+                           cam0_from_target, noise_px, seed, board_warp);
 }
 
 // Stereo views of `rig` under water, in a medium of index n, imaged through
@@ -151,7 +157,8 @@ inline std::vector<StereoView> ObserveStereo(
 inline std::vector<StereoView> ObserveStereoUnderwater(
     const StereoRig& rig, double n, const CalibrationTarget& target,
     const std::vector<Rigid3d>& cam0_from_target, double noise_px,
-    unsigned seed) {
+    unsigned seed,
+    const Eigen::Vector2d& board_warp = Eigen::Vector2d::Zero()) {
   const StereoRig::Ports ports =
       rig.ports() ? *rig.ports() : StereoRig::Ports{FlatPort(), FlatPort()};
   const FlatPortCamera left =
@@ -165,7 +172,7 @@ inline std::vector<StereoView> ObserveStereoUnderwater(
   };
   return ObserveStereoWith(rig.left(), through(left), rig.right(),
                            through(right), rig.right_from_left(), target,
-                           cam0_from_target, noise_px, seed);
+                           cam0_from_target, noise_px, seed, board_warp);
 }
 
 // Moves each corner of `views` with probability `fraction` by 8-20 px in a

@@ -199,7 +199,9 @@ TEST(CalibrateCli, FoldersToCamchainAndReport) {
   for (const char* file :
        {"calibration.json", "per_view.csv", "per_view_rms.png",
         "residuals_cam0.png", "residuals_cam1.png", "coverage_cam0.png",
-        "coverage_cam1.png", "uncertainty_cam0.png", "uncertainty_cam1.png"}) {
+        "coverage_cam1.png", "intrinsics_only_uncertainty_cam0.png",
+        "intrinsics_only_uncertainty_cam1.png",
+        "projection_uncertainty_cam0.png", "projection_uncertainty_cam1.png"}) {
     EXPECT_TRUE(fs::exists(dir + "/rig-report/" + file)) << file;
   }
   const nlohmann::json json = nlohmann::json::parse(

@@ -17,6 +17,14 @@
 // with pi(lens, P) = LensModel::ImgFromCam(lens, P_x / P_z, P_y / P_z).
 // A point at or behind the camera plane (P_z <= 1e-9 m) makes the residual
 // undefined: operator() returns false and Ceres rejects the step.
+//
+// The bowed-board variants (Cam0/Cam1WarpedBoardReprojectionError) take one
+// more block, the board's warp (board_warp.h),
+//   board_warp       [warp_x, warp_y]                  meters
+// and replace X by the point on the bowed board,
+//   X(warp) = (X_x, X_y, warp_x b_x + warp_y b_y),
+// b = (4 xr (1 - xr), 4 yr (1 - yr)) the point's warp basis (a constant
+// of the functor, BoardWarpBasis).
 #ifndef RCM_CALIB_BOARD_REPROJECTION_ERROR_H_
 #define RCM_CALIB_BOARD_REPROJECTION_ERROR_H_
 
@@ -60,6 +68,15 @@ void TransformPoint(const T* pose, const T point[3], T out[3]) {
   out[0] += pose[3];
   out[1] += pose[4];
   out[2] += pose[5];
+}
+
+// X(warp) = (X_x, X_y, X_z + warp . basis).
+template <typename T>
+void WarpedPoint(const Eigen::Vector3d& point, const Eigen::Vector2d& basis,
+                 const T* warp, T out[3]) {
+  out[0] = T(point.x());
+  out[1] = T(point.y());
+  out[2] = T(point.z()) + warp[0] * basis.x() + warp[1] * basis.y();
 }
 
 }  // namespace board_internal
@@ -122,6 +139,80 @@ struct Cam1BoardReprojectionError {
   }
 
   const Eigen::Vector3d point_in_target;
+  const Eigen::Vector2d pixel;
+};
+
+// A corner of the bowed board seen by cam0: blocks (lens, cam0_from_target,
+// board_warp).
+template <typename LensModel>
+struct Cam0WarpedBoardReprojectionError {
+  Cam0WarpedBoardReprojectionError(const Eigen::Vector3d& point_in_target,
+                                   const Eigen::Vector2d& warp_basis,
+                                   const Eigen::Vector2d& pixel)
+      : point_in_target(point_in_target), warp_basis(warp_basis), pixel(pixel) {}
+
+  template <typename T>
+  bool operator()(const T* lens, const T* cam0_from_target,
+                  const T* board_warp, T* residuals) const {
+    T point[3];
+    board_internal::WarpedPoint(point_in_target, warp_basis, board_warp,
+                                point);
+    T point_in_cam0[3];
+    board_internal::TransformPoint(cam0_from_target, point, point_in_cam0);
+    return board_internal::ProjectCameraPoint<LensModel>(lens, point_in_cam0,
+                                                         residuals, pixel);
+  }
+
+  static ceres::CostFunction* Create(const Eigen::Vector3d& point_in_target,
+                                     const Eigen::Vector2d& warp_basis,
+                                     const Eigen::Vector2d& pixel) {
+    return new ceres::AutoDiffCostFunction<Cam0WarpedBoardReprojectionError, 2,
+                                           LensModel::kNumParams, 6, 2>(
+        new Cam0WarpedBoardReprojectionError(point_in_target, warp_basis,
+                                             pixel));
+  }
+
+  const Eigen::Vector3d point_in_target;
+  const Eigen::Vector2d warp_basis;
+  const Eigen::Vector2d pixel;
+};
+
+// A corner of the bowed board seen by cam1: blocks (lens, cam0_from_target,
+// cam1_from_cam0, board_warp).
+template <typename LensModel>
+struct Cam1WarpedBoardReprojectionError {
+  Cam1WarpedBoardReprojectionError(const Eigen::Vector3d& point_in_target,
+                                   const Eigen::Vector2d& warp_basis,
+                                   const Eigen::Vector2d& pixel)
+      : point_in_target(point_in_target), warp_basis(warp_basis), pixel(pixel) {}
+
+  template <typename T>
+  bool operator()(const T* lens, const T* cam0_from_target,
+                  const T* cam1_from_cam0, const T* board_warp,
+                  T* residuals) const {
+    T point[3];
+    board_internal::WarpedPoint(point_in_target, warp_basis, board_warp,
+                                point);
+    T point_in_cam0[3];
+    board_internal::TransformPoint(cam0_from_target, point, point_in_cam0);
+    T point_in_cam1[3];
+    board_internal::TransformPoint(cam1_from_cam0, point_in_cam0,
+                                   point_in_cam1);
+    return board_internal::ProjectCameraPoint<LensModel>(lens, point_in_cam1,
+                                                         residuals, pixel);
+  }
+
+  static ceres::CostFunction* Create(const Eigen::Vector3d& point_in_target,
+                                     const Eigen::Vector2d& warp_basis,
+                                     const Eigen::Vector2d& pixel) {
+    return new ceres::AutoDiffCostFunction<Cam1WarpedBoardReprojectionError, 2,
+                                           LensModel::kNumParams, 6, 6, 2>(
+        new Cam1WarpedBoardReprojectionError(point_in_target, warp_basis,
+                                             pixel));
+  }
+
+  const Eigen::Vector3d point_in_target;
+  const Eigen::Vector2d warp_basis;
   const Eigen::Vector2d pixel;
 };
 

@@ -2,7 +2,14 @@
 // view and per camera, warnings in plain words, and the pictures a person
 // looks at before trusting the result.
 //
-// Projection uncertainty (what Kalibr-style uncertainty maps show). For a
+// Two projection uncertainties. The one reported as "projection
+// uncertainty" is mrcal's mean-frames figure (projection_uncertainty.h):
+// through every unknown, board poses included, at a stated distance
+// (CalibrationReportOptions::uncertainty_distance_m, infinity by default),
+// so that it compares with mrcal's. The other, "intrinsics-only", is below.
+//
+// Intrinsics-only projection uncertainty (what Kalibr-style uncertainty
+// maps show). For a
 // pixel u0 of a camera with parameters p = [fx, fy, cx, cy, d0..d3]
 // (lens_models.h order, n = camera.num_params() of them) and their
 // covariance C (n x n, CameraCalibration::covariance):
@@ -35,6 +42,7 @@
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -75,9 +83,12 @@ struct CalibrationReportOptions {
   int min_views = 10;
   // Fewer used views where both cameras saw the target -> warning.
   int min_stereo_views = 5;
-  // 95th percentile of ProjectionUncertainty over the image above this
-  // [px] -> warning.
+  // 95th percentile of the intrinsics-only ProjectionUncertainty over the
+  // image above this [px] -> warning.
   double max_uncertainty_px = 0.5;
+  // Distance [m] of the mean-frames projection uncertainty (> 0;
+  // kInfiniteDistance: at infinity).
+  double uncertainty_distance_m = std::numeric_limits<double>::infinity();
   // A view whose RMS in a camera exceeds this times that camera's overall
   // RMS is flagged (and warned about).
   double max_view_rms_factor = 3.0;
@@ -113,11 +124,17 @@ struct CalibrationReport {
     int outliers = 0;
     // Fraction of the coverage grid's cells with >= 1 inlier corner.
     double coverage = 0.0;
-    // ProjectionUncertainty over a grid of pixels covering the image [px]
-    // (NaN when no pixel of the grid can be unprojected).
-    double uncertainty_median_px = 0.0;
-    double uncertainty_p95_px = 0.0;
-    double uncertainty_max_px = 0.0;
+    // The intrinsics-only ProjectionUncertainty over a grid of pixels
+    // covering the image [px] (NaN when no pixel of the grid can be
+    // unprojected).
+    double intrinsics_only_uncertainty_median_px = 0.0;
+    double intrinsics_only_uncertainty_p95_px = 0.0;
+    double intrinsics_only_uncertainty_max_px = 0.0;
+    // MeanFramesProjectionUncertainty at options.uncertainty_distance_m
+    // over the same grid [px] (NaN without the full covariance).
+    double projection_uncertainty_median_px = 0.0;
+    double projection_uncertainty_p95_px = 0.0;
+    double projection_uncertainty_max_px = 0.0;
     // max_view_rms_factor * rms_px: views above it are flagged [px].
     double view_rms_limit_px = 0.0;
   };
@@ -185,6 +202,17 @@ cv::Mat DrawProjectionUncertainty(const CameraCalibration& calibration,
                                   double max_px = 0.0,
                                   const std::string& camera_name = "");
 
+// The same map of MeanFramesProjectionUncertainty (projection_
+// uncertainty.h) of `camera` (0 or 1) at `distance_m` (named in the title;
+// gray everywhere without the full covariance).
+cv::Mat DrawMeanFramesUncertainty(const StereoCalibration& calibration,
+                                  int camera, double distance_m,
+                                  double max_px = 0.0,
+                                  const std::string& camera_name = "");
+
+// "infinity" or "1.5 m".
+std::string DistanceName(double distance_m);
+
 // RMS residual of each view in both cameras against the view index
 // (rcm::LinePlot, 1000 x 600): each camera's overall RMS and flag limit as
 // horizontal lines, flagged views circled in red.
@@ -193,7 +221,12 @@ cv::Mat DrawPerViewRms(const CalibrationReport& report);
 // Creates `directory` if needed and writes, each atomically:
 //   residuals_cam0.png, residuals_cam1.png    DrawResidualField
 //   coverage_cam0.png, coverage_cam1.png      DrawCoverage
-//   uncertainty_cam0.png, uncertainty_cam1.png DrawProjectionUncertainty
+//   projection_uncertainty_cam0.png, ..._cam1.png
+//                                             DrawMeanFramesUncertainty at
+//                                             uncertainty_distance_m (when
+//                                             the full covariance is there)
+//   intrinsics_only_uncertainty_cam0.png, ..._cam1.png
+//                                             DrawProjectionUncertainty
 //   per_view_rms.png                          DrawPerViewRms
 //   per_view.csv  view,left,right,corners0,corners1,outliers0,outliers1,
 //                 rms0_px,rms1_px,used,flagged

@@ -3,8 +3,13 @@
 // Unknowns: the lens parameters of each camera (lens_models.h order,
 //   p_c = [fx, fy, cx, cy, d0, d1, d2, d3], radtan or equidistant), the
 //   extrinsics cam1_from_cam0 = (R_10, t_10) and one pose
-//   cam0_from_target_v = (R_v, t_v) per view. Target corners X_j lie on
-//   the target plane z = 0 (calibration_target.h).
+//   cam0_from_target_v = (R_v, t_v) per view, and (estimate_board_warp)
+//   the board's warp w = [warp_x, warp_y] shared by all views. Target
+//   corners X_j lie on the target plane z = 0 (calibration_target.h) or,
+//   with the warp, on the bowed board of board_warp.h (mrcal's
+//   calobject_warp):
+//     X_j(w) = (x_j, y_j, warp_x 4 xr (1 - xr) + warp_y 4 yr (1 - yr)),
+//   (xr, yr) the corner's position normalized over the target's extent.
 //
 // Residuals, for every corner j that camera c saw in view v at pixel u:
 //   e = pi(p_0, R_v X_j + t_v) - u                          (cam0)
@@ -28,12 +33,18 @@
 // Uncertainty: the covariance of all camera and extrinsic parameters is
 // (J^T J)^-1 sigma^2 at the solution (ceres::Covariance), with the pixel
 // noise sigma^2 = SSR / (2 m - p) estimated from the m inlier corners and
-// the p unknowns, board poses included.
+// the p unknowns, board poses (and the warp) included; the warp's 2x2
+// block likewise. The covariance of every unknown together (lenses,
+// extrinsics, board poses, warp), sigma^2 (J^T J)^-1 of the whole problem
+// (dense: ~40 poses of 6), is kept too (StereoCalibration::
+// full_covariance) for the projection uncertainty through the board poses
+// (projection_uncertainty.h).
 #ifndef RCM_CALIB_STEREO_CALIBRATION_H_
 #define RCM_CALIB_STEREO_CALIBRATION_H_
 
 #include <Eigen/Core>
 #include <array>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -78,6 +89,12 @@ struct StereoCalibrationOptions {
   // Compute the parameter covariance (cheap: dense over the cameras and
   // extrinsics only).
   bool compute_covariance = true;
+  // Estimate the board's flatness (board_warp.h): two parameters shared by
+  // all views. A printed board is rarely flat to a tenth of a millimetre,
+  // and a bow of 0.7 mm moves the focal lengths by ~1 % (measured on real
+  // images against mrcal, which estimates it by default). Off (a flat
+  // board) reproduces cv::stereoCalibrate's model.
+  bool estimate_board_warp = true;
   // Threads for Ceres.
   int num_threads = 2;
 
@@ -94,6 +111,22 @@ struct CameraCalibration {
   // camera.num_params() rows/cols are used) and their standard deviations.
   Eigen::Matrix<double, 8, 8> covariance = Eigen::Matrix<double, 8, 8>::Zero();
   std::array<double, 8> sigma{};
+};
+
+// The covariance of every unknown of the final least-squares problem,
+// sigma^2 (J^T J)^-1, in the raw parameters Ceres estimates: the lenses
+// ([fx, fy, cx, cy, d...], num_params each), cam1_from_cam0 and each used
+// view's cam0_from_target as [angle-axis (rad), translation (m)], and the
+// warp [m] when estimated. Empty when the covariance was not computed.
+struct FullCovariance {
+  Eigen::MatrixXd matrix;
+  std::array<int, 2> lens_offset{};
+  int num_lens_params = 0;
+  int extrinsics_offset = 0;
+  // Per input view; -1 for a view that was not used.
+  std::vector<int> pose_offset;
+  int warp_offset = -1;  // -1: the warp was not estimated
+  int size() const { return static_cast<int>(matrix.rows()); }
 };
 
 // A corner as the final solve saw it.
@@ -121,9 +154,27 @@ struct StereoCalibration {
   double baseline = 0.0;
   double baseline_sigma = 0.0;
 
+  // The board's warp [warp_x, warp_y] (m, board_warp.h; zero when not
+  // estimated), its covariance and standard deviations. The bowl at the
+  // board's centre is warp_x + warp_y.
+  bool board_warp_estimated = false;
+  Eigen::Vector2d board_warp = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d board_warp_covariance = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d board_warp_sigma = Eigen::Vector2d::Zero();
+  // The bowl at the centre, warp_x + warp_y [m], and its sigma.
+  double BoardBowl() const { return board_warp.sum(); }
+  double BoardBowlSigma() const {
+    return std::sqrt(board_warp_covariance.sum());
+  }
+
   // Per input view: cam0_from_target, nullopt when the view was not used
   // (no target, too few corners, or the pose failed to initialize).
   std::vector<std::optional<Rigid3d>> cam0_from_target;
+  // The covariance of all unknowns together (above; empty without
+  // compute_covariance), and the solution in its layout (the poses and
+  // extrinsics as the angle-axis vectors the solver held).
+  FullCovariance full_covariance;
+  Eigen::VectorXd full_parameters;
   // Every corner of every used view, inliers and outliers.
   std::vector<CornerResidual> corners;
 

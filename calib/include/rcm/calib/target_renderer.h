@@ -26,6 +26,16 @@
 // corners are mapped through the homography; the s^2 sub-samples of a
 // pixel are blends of its four corners' homogeneous target points.
 //
+// A bowed board (options.board_warp, board_warp.h): each pixel corner's
+// ray is intersected with the surface z = h(x, y) of the target frame by
+// Newton's method on the depth s along the ray, from the plane's hit,
+//   f(s) = P_z(s) - h(P_x(s), P_y(s)),   P(s) = R^T (s d - t),
+// until the step is below 1e-12 m (a few iterations: the slope of a bow
+// of millimetres over a board of decimetres is ~0.01); its texture point
+// is scaled by the plane hit's w so that the blends stay those of the
+// flat board when the warp is 0. A corner whose iteration does not
+// converge (a ray grazing the board) is background.
+//
 // Noise: the draw of pixel p is a function of (seed, p) only (SplitMix64
 // counter hash, Box-Muller), so images are identical for any num_threads.
 #ifndef RCM_CALIB_TARGET_RENDERER_H_
@@ -38,6 +48,7 @@
 #include <utility>
 #include <vector>
 
+#include "rcm/calib/board_warp.h"
 #include "rcm/calib/calibration_target.h"
 #include "rcm/calib/target_image.h"
 #include "rcm/camera/camera.h"
@@ -53,6 +64,8 @@ struct TargetRenderOptions {
   uint64_t seed = 0;           // the noise depends on it and the pixel only
   int background = 160;        // gray level where the target is not, 0..255
   int num_threads = 2;         // >= 1
+  // The board's bow (header); warp 0 (the default) is the flat board.
+  BoardWarpSurface board_warp;
   Status Check() const;
 };
 
@@ -86,10 +99,12 @@ class TargetRenderer {
 // The ground-truth pixel of each TargetPoints(target) point seen by
 // `camera` at `cam_from_target`; nullopt for a point behind the camera (or
 // on its plane), one the lens cannot project, or outside the image
-// (Camera::InImage).
+// (Camera::InImage). With `board_warp` [m], the points of the bowed board
+// (WarpedTargetPoints).
 std::vector<std::optional<Eigen::Vector2d>> ProjectTargetPoints(
     const Camera& camera, const Rigid3d& cam_from_target,
-    const CalibrationTarget& target);
+    const CalibrationTarget& target,
+    const Eigen::Vector2d& board_warp = Eigen::Vector2d::Zero());
 
 }  // namespace rcm::calib
 

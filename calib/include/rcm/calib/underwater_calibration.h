@@ -19,6 +19,8 @@
 //   N_c                camera c's port normal (estimate_port_tilt), two
 //                      parameters (a, b) = (N_x / N_z, N_y / N_z), started
 //                      from the port block's normal or the optical axis
+//   w                  the board's warp [warp_x, warp_y] (estimate_board_
+//                      warp, board_warp.h), shared by all views, from 0
 // A camera's port parameters are estimated only when that camera sees the
 // target. The glass thickness and index come from air_rig.ports() (none:
 // thin ports, no glass) and are never estimated.
@@ -41,7 +43,8 @@
 // Residuals, for every corner j that camera c saw in view v at pixel u (the
 // functors of underwater_reprojection_error.h):
 //   e = pi_c(port_c(n, d_c, N_c, P_c)) - u,
-//   P_0 = R_v X_j + t_v,  P_1 = R_10 P_0 + t_10,
+//   P_0 = R_v X_j(w) + t_v,  P_1 = R_10 P_0 + t_10,
+// X_j(w) the corner on the bowed board (X_j itself without the warp),
 // pi_c the air lens of camera c (lens_models.h), port_c the exact flat port
 // (rcm/camera/flat_port_projection.h), all by Ceres autodiff.
 //
@@ -119,6 +122,10 @@ struct UnderwaterCalibrationOptions {
   bool estimate_air_gap = false;
   // Estimate each port's normal (two parameters per port).
   bool estimate_port_tilt = false;
+  // Estimate the board's flatness (board_warp.h, as
+  // StereoCalibrationOptions::estimate_board_warp; also passed to the
+  // conventional fit).
+  bool estimate_board_warp = true;
 
   // Robust loss and outlier rejection, as StereoCalibrationOptions: Huber
   // scale [px]; outliers beyond outlier_sigmas robust sigmas of the
@@ -154,7 +161,8 @@ struct UnderwaterCalibrationOptions {
 struct UnderwaterParameterBlock {
   // "n"; "cam1_from_cam0" [w (rad, cam1 frame, left perturbation),
   // t_10 (m)]; "cam0 air_gap", "cam1 air_gap" (m); "cam0 port_tilt",
-  // "cam1 port_tilt" [N_x / N_z, N_y / N_z].
+  // "cam1 port_tilt" [N_x / N_z, N_y / N_z]; "board_warp" [warp_x,
+  // warp_y] (m).
   std::string name;
   int offset = 0;
   int size = 0;
@@ -261,6 +269,11 @@ struct UnderwaterCalibration {
       Eigen::Matrix<double, 6, 6>::Zero();
   ExtrinsicChange extrinsic_change;
   std::array<PortEstimate, 2> ports;
+  // The board's warp (m; zero when not estimated), as in StereoCalibration.
+  bool board_warp_estimated = false;
+  Eigen::Vector2d board_warp = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d board_warp_covariance = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d board_warp_sigma = Eigen::Vector2d::Zero();
   UnderwaterCovariance covariance;
   std::optional<UnderwaterLeaveOut> leave_out;
 

@@ -16,8 +16,12 @@
 //                                               N = (a, b, 1) / |(a, b, 1)|,
 //                                               i.e. a = N_x / N_z,
 //                                               b = N_y / N_z
+//   board_warp        [warp_x, warp_y]          the board's bow, meters
+//                                               (board_warp.h)
 //
-// Residuals (pixels), for a corner X (target frame, z = 0) seen at u:
+// Residuals (pixels), for a corner X (target frame, z = 0; on the bowed
+// board X = (X_x, X_y, warp . b), b the point's warp basis, a constant of
+// the functor, board_reprojection_error.h) seen at u:
 //   cam0:  e = pi(lens, port(n, d_0, N_0, R(w_v) X + t_v)) - u
 //   cam1:  e = pi(lens, port(n, d_1, N_1,
 //                            R(w_10) (R(w_v) X + t_v) + t_10)) - u
@@ -79,19 +83,26 @@ bool ProjectThroughPort(const UnderwaterCameraConstants& constants, const T& n,
 
 }  // namespace underwater_internal
 
-// A corner seen by cam0: blocks (n, cam0_from_target, air_gap, port_tilt).
+// A corner seen by cam0: blocks (n, cam0_from_target, air_gap, port_tilt,
+// board_warp).
 template <typename LensModel>
 struct Cam0UnderwaterReprojectionError {
   Cam0UnderwaterReprojectionError(const UnderwaterCameraConstants& constants,
                                   const Eigen::Vector3d& point_in_target,
+                                  const Eigen::Vector2d& warp_basis,
                                   const Eigen::Vector2d& pixel)
-      : constants(constants), point_in_target(point_in_target), pixel(pixel) {}
+      : constants(constants),
+        point_in_target(point_in_target),
+        warp_basis(warp_basis),
+        pixel(pixel) {}
 
   template <typename T>
   bool operator()(const T* n, const T* cam0_from_target, const T* air_gap,
-                  const T* port_tilt, T* residuals) const {
-    const T point[3] = {T(point_in_target.x()), T(point_in_target.y()),
-                        T(point_in_target.z())};
+                  const T* port_tilt, const T* board_warp,
+                  T* residuals) const {
+    T point[3];
+    board_internal::WarpedPoint(point_in_target, warp_basis, board_warp,
+                                point);
     T point_in_cam0[3];
     board_internal::TransformPoint(cam0_from_target, point, point_in_cam0);
     return underwater_internal::ProjectThroughPort<LensModel>(
@@ -101,32 +112,40 @@ struct Cam0UnderwaterReprojectionError {
 
   static ceres::CostFunction* Create(const UnderwaterCameraConstants& constants,
                                      const Eigen::Vector3d& point_in_target,
+                                     const Eigen::Vector2d& warp_basis,
                                      const Eigen::Vector2d& pixel) {
     return new ceres::AutoDiffCostFunction<Cam0UnderwaterReprojectionError, 2,
-                                           1, 6, 1, 2>(
-        new Cam0UnderwaterReprojectionError(constants, point_in_target, pixel));
+                                           1, 6, 1, 2, 2>(
+        new Cam0UnderwaterReprojectionError(constants, point_in_target,
+                                            warp_basis, pixel));
   }
 
   const UnderwaterCameraConstants constants;
   const Eigen::Vector3d point_in_target;
+  const Eigen::Vector2d warp_basis;
   const Eigen::Vector2d pixel;
 };
 
 // A corner seen by cam1: blocks (n, cam0_from_target, cam1_from_cam0,
-// air_gap, port_tilt).
+// air_gap, port_tilt, board_warp).
 template <typename LensModel>
 struct Cam1UnderwaterReprojectionError {
   Cam1UnderwaterReprojectionError(const UnderwaterCameraConstants& constants,
                                   const Eigen::Vector3d& point_in_target,
+                                  const Eigen::Vector2d& warp_basis,
                                   const Eigen::Vector2d& pixel)
-      : constants(constants), point_in_target(point_in_target), pixel(pixel) {}
+      : constants(constants),
+        point_in_target(point_in_target),
+        warp_basis(warp_basis),
+        pixel(pixel) {}
 
   template <typename T>
   bool operator()(const T* n, const T* cam0_from_target,
                   const T* cam1_from_cam0, const T* air_gap, const T* port_tilt,
-                  T* residuals) const {
-    const T point[3] = {T(point_in_target.x()), T(point_in_target.y()),
-                        T(point_in_target.z())};
+                  const T* board_warp, T* residuals) const {
+    T point[3];
+    board_internal::WarpedPoint(point_in_target, warp_basis, board_warp,
+                                point);
     T point_in_cam0[3];
     board_internal::TransformPoint(cam0_from_target, point, point_in_cam0);
     T point_in_cam1[3];
@@ -139,14 +158,17 @@ struct Cam1UnderwaterReprojectionError {
 
   static ceres::CostFunction* Create(const UnderwaterCameraConstants& constants,
                                      const Eigen::Vector3d& point_in_target,
+                                     const Eigen::Vector2d& warp_basis,
                                      const Eigen::Vector2d& pixel) {
     return new ceres::AutoDiffCostFunction<Cam1UnderwaterReprojectionError, 2,
-                                           1, 6, 6, 1, 2>(
-        new Cam1UnderwaterReprojectionError(constants, point_in_target, pixel));
+                                           1, 6, 6, 1, 2, 2>(
+        new Cam1UnderwaterReprojectionError(constants, point_in_target,
+                                            warp_basis, pixel));
   }
 
   const UnderwaterCameraConstants constants;
   const Eigen::Vector3d point_in_target;
+  const Eigen::Vector2d warp_basis;
   const Eigen::Vector2d pixel;
 };
 
