@@ -45,12 +45,24 @@ bool Reprojects(const Eigen::Vector2d& pixel, const Eigen::Vector2d& back) {
 }
 
 // Radial coefficients up to 0.3 and tangential ones up to 0.01 in
-// magnitude: beyond every lens in the test data and Kalibr's examples.
+// magnitude: beyond every lens in the test data and Kalibr's examples. For
+// the unified models, |xi| <= 0.5 and alpha <= 0.7 (ds), alpha <= 0.7 and
+// beta in [0.5, 2] (eucm): the range of real calibrations (TUM-VI, basalt).
 bool MildLens(const rcm::Camera& camera) {
   const std::vector<double> distortion = camera.Distortion();
+  switch (camera.model()) {
+    case rcm::LensModelId::kDoubleSphere:
+      return std::abs(distortion[0]) <= 0.5 && distortion[1] <= 0.7;
+    case rcm::LensModelId::kEucm:
+      return distortion[0] <= 0.7 && distortion[1] >= 0.5 &&
+             distortion[1] <= 2.0;
+    default:
+      break;
+  }
   for (size_t i = 0; i < distortion.size(); ++i) {
-    const bool tangential =
-        camera.model() == rcm::LensModelId::kRadTan && i >= 2;
+    const bool tangential = (camera.model() == rcm::LensModelId::kRadTan ||
+                             camera.model() == rcm::LensModelId::kRational) &&
+                            (i == 2 || i == 3);
     if (std::abs(distortion[i]) > (tangential ? 0.01 : 0.3)) return false;
   }
   return true;
@@ -68,7 +80,7 @@ bool NearTheImage(const rcm::Camera& camera, const Eigen::Vector2d& pixel) {
 
 std::optional<rcm::Camera> ConsumeCamera(FuzzedDataProvider& data) {
   const auto model = static_cast<rcm::LensModelId>(
-      data.ConsumeIntegralInRange<int>(0, 2));
+      data.ConsumeIntegralInRange<int>(0, rcm::kNumLensModels - 1));
   const int width = data.ConsumeIntegralInRange<int>(-1, 4000);
   const int height = data.ConsumeIntegralInRange<int>(-1, 4000);
   std::array<double, 4> intrinsics;
@@ -79,6 +91,15 @@ std::optional<rcm::Camera> ConsumeCamera(FuzzedDataProvider& data) {
   std::vector<double> distortion(rcm::NumDistortionParams(model));
   for (double& coefficient : distortion) {
     coefficient = ConsumeDouble(data, -1.0, 1.0);
+  }
+  // The unified models' second coefficient over its range and beyond
+  // (alpha of ds up to 1.1, beta of eucm up to 3), so that the range
+  // checks and the whole range are both reached.
+  if (model == rcm::LensModelId::kDoubleSphere) {
+    distortion[1] = ConsumeDouble(data, -0.1, 1.1);
+  } else if (model == rcm::LensModelId::kEucm) {
+    distortion[0] = ConsumeDouble(data, -0.1, 1.1);
+    distortion[1] = ConsumeDouble(data, -0.1, 3.0);
   }
   rcm::StatusOr<rcm::Camera> camera =
       rcm::Camera::Create(model, width, height, intrinsics, distortion);

@@ -35,11 +35,18 @@ using Jet = ceres::Jet<double, 4>;
 
 std::optional<rcm::Camera> ConsumeCamera(FuzzedDataProvider& data) {
   const auto model = static_cast<rcm::LensModelId>(
-      data.ConsumeIntegralInRange<int>(0, 2));
+      data.ConsumeIntegralInRange<int>(0, rcm::kNumLensModels - 1));
   const double f = ConsumeDouble(data, 100.0, 1500.0);
   std::vector<double> distortion(rcm::NumDistortionParams(model));
   for (double& coefficient : distortion) {
     coefficient = ConsumeDouble(data, -0.3, 0.3);
+  }
+  // The unified models over the range of real calibrations.
+  if (model == rcm::LensModelId::kDoubleSphere) {
+    distortion[1] = ConsumeDouble(data, 0.0, 0.7);  // alpha
+  } else if (model == rcm::LensModelId::kEucm) {
+    distortion[0] = ConsumeDouble(data, 0.0, 0.7);  // alpha
+    distortion[1] = ConsumeDouble(data, 0.5, 2.0);  // beta
   }
   rcm::StatusOr<rcm::Camera> camera = rcm::Camera::Create(
       model, 720, 540,

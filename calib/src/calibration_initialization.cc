@@ -41,6 +41,11 @@ bool RefineCamera(LensModelId model,
                                (*poses)[v].data());
     }
   }
+  if (!problem.HasParameterBlock(lens->data())) return false;
+  for (const DistortionBound& bound : DistortionBounds(model)) {
+    problem.SetParameterLowerBound(lens->data(), 4 + bound.index, bound.lower);
+    problem.SetParameterUpperBound(lens->data(), 4 + bound.index, bound.upper);
+  }
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_SCHUR;
   options.max_num_iterations = 100;
@@ -51,6 +56,17 @@ bool RefineCamera(LensModelId model,
 }
 
 }  // namespace
+
+std::vector<double> StartingDistortion(LensModelId model) {
+  switch (model) {
+    case LensModelId::kDoubleSphere:
+      return {0.0, 0.5};  // xi, alpha
+    case LensModelId::kEucm:
+      return {0.5, 1.0};  // alpha, beta
+    default:
+      return std::vector<double>(NumDistortionParams(model), 0.0);
+  }
+}
 
 StatusOr<Camera> InitializeCamera(
     LensModelId model, int width, int height,
@@ -81,7 +97,7 @@ StatusOr<Camera> InitializeCamera(
   }
   StatusOr<Camera> start =
       Camera::Create(model, width, height, {k(0, 0), k(1, 1), k(0, 2), k(1, 2)},
-                     std::vector<double>(NumDistortionParams(model), 0.0));
+                     StartingDistortion(model));
   if (!start.ok()) {
     return Status::Error(
         "OpenCV's closed-form intrinsics are not a camera (" +

@@ -310,7 +310,7 @@ void CheckSize(const ImageSize& size) {
 // ---------------------------------------------------------------------------
 // Uncertainty.
 
-Eigen::Matrix<double, 2, 8> PixelFromParamsJacobian(
+Eigen::Matrix<double, 2, kMaxLensParams> PixelFromParamsJacobian(
     const Camera& camera, const Eigen::Vector2d& normalized) {
   using Jet = ceres::Jet<double, kMaxLensParams>;
   Jet params[kMaxLensParams];
@@ -323,7 +323,7 @@ Eigen::Matrix<double, 2, 8> PixelFromParamsJacobian(
   Jet u, v;
   RCM_LENS_MODEL_SWITCH(
       camera.model(), LensModel::ImgFromCam(params, x, y, &u, &v); break;)
-  Eigen::Matrix<double, 2, 8> jacobian;
+  Eigen::Matrix<double, 2, kMaxLensParams> jacobian;
   jacobian.row(0) = u.v.transpose();
   jacobian.row(1) = v.v.transpose();
   return jacobian;

@@ -81,6 +81,16 @@ void AddResiduals(LensModelId model, const std::vector<Corner>& corners,
   if (!estimate_warp && problem->HasParameterBlock(warp)) {
     problem->SetParameterBlockConstant(warp);
   }
+  // The unified models' coefficients stay in their ranges.
+  for (auto& lens : parameters->lens) {
+    if (!problem->HasParameterBlock(lens.data())) continue;
+    for (const DistortionBound& bound : DistortionBounds(model)) {
+      problem->SetParameterLowerBound(lens.data(), 4 + bound.index,
+                                      bound.lower);
+      problem->SetParameterUpperBound(lens.data(), 4 + bound.index,
+                                      bound.upper);
+    }
+  }
 }
 
 // The residual of one corner at the current parameters; NaN when the
@@ -184,9 +194,9 @@ bool ComputeFullCovariance(const std::vector<bool>& view_used,
 }  // namespace
 
 Status StereoCalibrationOptions::Check() const {
-  if (model != LensModelId::kRadTan && model != LensModelId::kEquidistant &&
-      model != LensModelId::kPinhole) {
-    return Status::Error("lens model must be radtan, equidistant or none");
+  if (static_cast<int>(model) < 0 ||
+      static_cast<int>(model) >= kNumLensModels) {
+    return Status::Error("lens model must be one of " + LensModelNameList());
   }
   return internal::CheckSharedFitSettings(
       {huber_px, outlier_sigmas, min_outlier_threshold_px, max_outlier_rounds,
@@ -401,7 +411,7 @@ StatusOr<StereoCalibration> CalibrateStereo(
       out[c]->covariance.topLeftCorner(num_lens_params, num_lens_params) =
           variance * covariance.block(c * num_lens_params, c * num_lens_params,
                                       num_lens_params, num_lens_params);
-      for (int i = 0; i < 8; ++i) {
+      for (int i = 0; i < kMaxLensParams; ++i) {
         out[c]->sigma[i] = std::sqrt(out[c]->covariance(i, i));
       }
     }

@@ -39,15 +39,17 @@ namespace {
 constexpr char kUsage[] =
     "rcm export: the conventional water-side camera models of a rig\n\n"
     "usage:\n"
-    "  rcm export --calib camchain.yaml --n 1.333 [--model equidistant|radtan]"
-    "\n      --out DIR | FILE.yaml\n\n"
+    "  rcm export --calib camchain.yaml --n 1.333\n"
+    "      [--model equidistant|radtan|rational|ds|eucm] --out DIR | FILE.yaml"
+    "\n\n"
     "Fits, for each camera, the lens model (--model, default equidistant)\n"
     "that best reproduces the refractive model of the air calibration at\n"
     "index --n (least squares in pixels over a grid on the image), so a VIO\n"
     "that knows only conventional models can use the raw underwater images\n"
     "directly. Writes the Kalibr camchain of the fitted cameras (same\n"
     "extrinsics; T_cam_imu, timeshift and rostopic kept), one ROS\n"
-    "camera_info per camera, a fit-error map per camera (PNG) and\n"
+    "camera_info per camera (not for ds and eucm, which ROS has no\n"
+    "model for), a fit-error map per camera (PNG) and\n"
     "export.json; prints the RMS and maximum fit error inside the fit\n"
     "region (--fit-inset) and over the whole image.\n"
     "--out DIR writes DIR/camchain.yaml, DIR/left.yaml, DIR/right.yaml,\n"
@@ -221,10 +223,12 @@ int RunExport() {
   if (rig->HasThickPort()) json["reference_depth_m"] = FLAGS_reference_depth;
   for (int k = 0; k < 2; ++k) {
     const std::string name = names[k];
-    if (Status status = WriteCameraInfo(
-            paths.prefix + name + ".yaml",
-            CameraInfoFromCamera(name, fits[k].camera));
-        !status.ok()) {
+    if (!CheckCameraInfoModel(fits[k].camera).ok()) {
+      // ds, eucm: the camchain is the only file that can hold them.
+    } else if (Status status = WriteCameraInfo(
+                   paths.prefix + name + ".yaml",
+                   CameraInfoFromCamera(name, fits[k].camera));
+               !status.ok()) {
       PrintError(command, status.message());
       return kExitFailure;
     }

@@ -5,8 +5,9 @@
 #include "rcm/camera/camera.h"
 
 DEFINE_string(model, "",
-              "lens model: radtan, equidistant or none (default: radtan for "
-              "calibrate, equidistant for export)");
+              "lens model: radtan, equidistant, rational (OpenCV's 8 "
+              "coefficients), ds (double sphere), eucm or none (default: "
+              "radtan for calibrate, equidistant for export)");
 
 namespace rcm::cli {
 
@@ -17,7 +18,7 @@ StatusOr<LensModelId> LensModelFromFlag(LensModelId default_model) {
   const std::optional<LensModelId> model = LensModelFromName(FLAGS_model);
   if (!model.has_value()) {
     return Status::Error("unknown --model '" + FLAGS_model +
-                         "' (available: radtan, equidistant, none)");
+                         "' (available: " + LensModelNameList() + ")");
   }
   return *model;
 }

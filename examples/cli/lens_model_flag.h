@@ -17,7 +17,8 @@ namespace rcm::cli {
 extern const char kLensModelFlagSource[];
 
 // The model --model names, `default_model` when it is not given. Error:
-// "unknown --model 'fisheye' (available: radtan, equidistant, none)".
+// "unknown --model 'fisheye' (available: none, radtan, equidistant,
+// rational, ds, eucm)".
 StatusOr<LensModelId> LensModelFromFlag(LensModelId default_model);
 
 }  // namespace rcm::cli

@@ -172,8 +172,9 @@ calib::StereoCalibrationOptions StereoOptionsFrom(const std::string& model,
   calib::StereoCalibrationOptions o;
   const std::optional<LensModelId> lens = LensModelFromName(model);
   if (!lens || *lens == LensModelId::kPinhole) {
-    ThrowValueError("model must be 'radtan' or 'equidistant', got '" + model +
-                    "'");
+    ThrowValueError(
+        "model must be one of radtan, equidistant, rational, ds, eucm, got '" +
+        model + "'");
   }
   o.model = *lens;
   std::vector<OptionField> fields = BoardAdjustmentFields(&o);

@@ -20,8 +20,8 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 LensModelId LensModelOrThrow(const std::string& name) {
   const std::optional<LensModelId> model = LensModelFromName(name);
   if (!model) {
-    ThrowValueError("unknown lens model '" + name +
-                    "' (available: none, radtan, equidistant)");
+    ThrowValueError("unknown lens model '" + name + "' (available: " +
+                    LensModelNameList() + ")");
   }
   return *model;
 }
@@ -106,8 +106,11 @@ An in-air calibrated camera: lens model, intrinsics and image size.
 
 Camera(model, width, height, intrinsics, distortion=())
 
-model: 'none' (pinhole), 'radtan' (k1, k2, p1, p2, as OpenCV/Kalibr) or
-'equidistant' (Kannala-Brandt k1..k4, as OpenCV fisheye/Kalibr).
+model: 'none' (pinhole), 'radtan' (k1, k2, p1, p2, as OpenCV/Kalibr),
+'equidistant' (Kannala-Brandt k1..k4, as OpenCV fisheye/Kalibr),
+'rational' (OpenCV's k1, k2, p1, p2, k3, k4, k5, k6), 'ds' (double
+sphere xi, alpha, as Kalibr/basalt) or 'eucm' (alpha, beta, as
+Kalibr/basalt).
 intrinsics: [fx, fy, cx, cy] in pixels; width, height in pixels. Pixel
 centers are at integer coordinates. Raises ValueError with the library's
 message on a value outside the accepted ranges.
@@ -129,7 +132,8 @@ message on a value outside the accepted ranges.
       .def_property_readonly(
           "model",
           [](const Camera& c) { return std::string(LensModelName(c.model())); },
-          "Lens model name: 'none', 'radtan' or 'equidistant'.")
+          "Lens model name: 'none', 'radtan', 'equidistant', 'rational', "
+          "'ds' or 'eucm'.")
       .def_property_readonly("width", &Camera::width, "Image width, pixels.")
       .def_property_readonly("height", &Camera::height, "Image height, pixels.")
       .def_property_readonly(
@@ -143,7 +147,8 @@ message on a value outside the accepted ranges.
       .def_property_readonly("intrinsics", &IntrinsicsArray,
                              "[fx, fy, cx, cy] in pixels (float64 array).")
       .def_property_readonly("distortion", &DistortionArray,
-                             "Distortion coefficients (0 or 4; float64 array).")
+                             "Distortion coefficients (0, 2, 4 or 8; float64 "
+                             "array).")
       .def_property_readonly(
           "K",
           [](const Camera& c) {

@@ -160,3 +160,34 @@ def test_rectified_virtual_pinhole_rig_writes_its_camchain(tmp_path,
     back = rcm.read_stereo_rig(path)
     np.testing.assert_array_equal(back.cam1_from_cam0, rig.cam1_from_cam0)
     assert back.cam0.lens == corrected.left.pinhole
+
+
+# The lens models added with issue 21: each round-trips over its image
+# and names itself; out-of-range coefficients raise one line.
+@pytest.mark.parametrize("model, distortion", [
+    ("rational", [0.5, 0.1, 9.0e-4, -6.0e-4, 0.001, 0.75, 0.2, 0.001]),
+    ("ds", [-0.18, 0.59]),
+    ("eucm", [0.63, 1.04]),
+])
+def test_new_lens_models_round_trip(model, distortion):
+    lens = rcm.Camera(model, 640, 480, [300.0, 299.0, 319.5, 239.5],
+                      distortion)
+    assert lens.model == model
+    assert lens.distortion.shape == (len(distortion),)
+    pixels = image_grid(lens, 8.0)
+    normalized = lens.normalized_from_image(pixels)
+    assert np.isfinite(normalized).all()
+    back = lens.image_from_normalized(normalized)
+    assert np.max(np.abs(back - pixels)) < ROUND_TRIP_PX
+
+
+def test_new_lens_models_refuse_bad_coefficients():
+    with pytest.raises(ValueError) as error:
+        rcm.Camera("ds", 640, 480, [300.0, 300.0, 320.0, 240.0], [1.5, 0.5])
+    assert "ds xi = 1.5 is outside (-1, 1]" in one_line(error)
+    with pytest.raises(ValueError) as error:
+        rcm.Camera("eucm", 640, 480, [300.0, 300.0, 320.0, 240.0], [0.5, 0.0])
+    assert "eucm beta = 0" in one_line(error)
+    with pytest.raises(ValueError) as error:
+        rcm.Camera("fov", 640, 480, [300.0, 300.0, 320.0, 240.0], [0.5])
+    assert "rational, ds, eucm" in one_line(error)

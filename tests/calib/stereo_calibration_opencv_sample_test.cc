@@ -149,6 +149,40 @@ TEST(OpenCvSampleStereo, RmsNoWorseThanStereoCalibrate) {
   EXPECT_LE(calibration->rms_px, opencv_rms + 1e-6);
 }
 
+// OpenCV's rational model (issue 21) nests radtan (k3..k6 = 0), so its
+// least-squares RMS over the same corners cannot be higher at the global
+// minimum: rcm's calibration with it must reach radtan's RMS or better
+// (up to the last digits of convergence, 1e-6 px).
+TEST(OpenCvSampleStereo, RationalRmsAtOrBelowRadTan) {
+  const std::vector<StereoView>& views = SampleViews();
+  StereoCalibrationOptions radtan_options;
+  radtan_options.model = LensModelId::kRadTan;
+  StereoCalibrationOptions rational_options;
+  rational_options.model = LensModelId::kRational;
+  const StatusOr<StereoCalibration> radtan =
+      CalibrateStereo(SampleBoard(), views, kSize, kSize, radtan_options);
+  const StatusOr<StereoCalibration> rational =
+      CalibrateStereo(SampleBoard(), views, kSize, kSize, rational_options);
+  ASSERT_TRUE(radtan.ok()) << radtan.status().message();
+  ASSERT_TRUE(rational.ok()) << rational.status().message();
+  std::printf(
+      "radtan rms %.8f px (%d outliers), rational rms %.8f px (%d "
+      "outliers)\n",
+      radtan->rms_px, radtan->num_outliers, rational->rms_px,
+      rational->num_outliers);
+  for (const Camera* camera :
+       {&rational->cam0.camera, &rational->cam1.camera}) {
+    const std::vector<double> d = camera->Distortion();
+    std::printf("rational f %.3f %.3f c %.3f %.3f d", camera->fx(),
+                camera->fy(), camera->cx(), camera->cy());
+    for (double value : d) std::printf(" %.5g", value);
+    std::printf("\n");
+  }
+  EXPECT_EQ(rational->num_outliers, 0);
+  EXPECT_EQ(rational->num_inliers, radtan->num_inliers);
+  EXPECT_LE(rational->rms_px, radtan->rms_px + 1e-6);
+}
+
 TEST(OpenCvSampleStereo, LeaveOneOutIsStable) {
   // Leave-one-pair-out cross-validation: 13 calibrations of 12 pairs.
   // Stable means every leave-one-out estimate is within 0.5 % of the focal

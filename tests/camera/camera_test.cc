@@ -129,10 +129,16 @@ TEST(Camera, UnprojectionOfNonFinitePixelFails) {
 }
 
 TEST(Camera, LensModelNamesRoundTrip) {
-  for (LensModelId id : {LensModelId::kPinhole, LensModelId::kRadTan,
-                         LensModelId::kEquidistant}) {
+  for (LensModelId id : AllLensModels()) {
     EXPECT_EQ(LensModelFromName(LensModelName(id)), id);
   }
+  EXPECT_EQ(LensModelFromName("rational"), LensModelId::kRational);
+  EXPECT_EQ(LensModelFromName("ds"), LensModelId::kDoubleSphere);
+  EXPECT_EQ(LensModelFromName("eucm"), LensModelId::kEucm);
+  EXPECT_EQ(NumDistortionParams(LensModelId::kRational), 8);
+  EXPECT_EQ(NumDistortionParams(LensModelId::kDoubleSphere), 2);
+  EXPECT_EQ(NumDistortionParams(LensModelId::kEucm), 2);
+  EXPECT_EQ(LensModelNameList(), "none, radtan, equidistant, rational, ds, eucm");
   EXPECT_FALSE(LensModelFromName("fov").has_value());
   EXPECT_FALSE(LensModelFromName("").has_value());
 }
@@ -159,6 +165,40 @@ TEST(Camera, ImageFromNormalizedJacobianMatchesCentralDifferences) {
       EXPECT_NEAR((jacobian.col(k) - column).norm(), 0.0, 1e-6 * camera.fx());
     }
   }
+}
+
+// Out-of-range coefficients of the unified models: one line naming the
+// coefficient.
+TEST(Camera, RejectsUnifiedModelCoefficientsOutOfRange) {
+  const std::array<double, 4> k = {300.0, 300.0, 320.0, 240.0};
+  const struct {
+    LensModelId model;
+    std::vector<double> distortion;
+    const char* expected;
+  } kCases[] = {
+      {LensModelId::kDoubleSphere, {1.5, 0.5}, "ds xi = 1.5 is outside (-1, 1]"},
+      {LensModelId::kDoubleSphere, {-1.0, 0.5}, "ds xi = -1 is outside (-1, 1]"},
+      {LensModelId::kDoubleSphere, {0.1, -0.1}, "ds alpha = -0.1 is outside [0, 1]"},
+      {LensModelId::kDoubleSphere, {0.1, 1.2}, "ds alpha = 1.2 is outside [0, 1]"},
+      {LensModelId::kEucm, {1.01, 1.0}, "eucm alpha = 1.01 is outside [0, 1]"},
+      {LensModelId::kEucm, {0.5, 0.0}, "eucm beta = 0 is outside (0, 1000]"},
+      {LensModelId::kEucm, {0.5, -2.0}, "eucm beta = -2 is outside (0, 1000]"},
+  };
+  for (const auto& c : kCases) {
+    const StatusOr<Camera> camera =
+        Camera::Create(c.model, 640, 480, k, c.distortion);
+    ASSERT_FALSE(camera.ok()) << c.expected;
+    EXPECT_EQ(camera.status().message(), c.expected);
+    EXPECT_EQ(camera.status().message().find('\n'), std::string::npos);
+  }
+  // The edges of the ranges are accepted.
+  EXPECT_TRUE(Camera::Create(LensModelId::kDoubleSphere, 640, 480, k, {1.0, 0.0}).ok());
+  EXPECT_TRUE(Camera::Create(LensModelId::kDoubleSphere, 640, 480, k, {-0.99, 1.0}).ok());
+  EXPECT_TRUE(Camera::Create(LensModelId::kEucm, 640, 480, k, {1.0, 1e-3}).ok());
+  EXPECT_TRUE(Camera::Create(LensModelId::kEucm, 640, 480, k, {0.0, 1.0}).ok());
+  // Rational: 8 coefficients, any sign.
+  EXPECT_FALSE(Camera::Create(LensModelId::kRational, 640, 480, k,
+                              {0.1, 0.0, 0.0, 0.0}).ok());
 }
 
 TEST(Camera, LensInvertibleAtDetectsFold) {

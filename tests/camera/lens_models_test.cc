@@ -4,11 +4,15 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/LU>
+#include <algorithm>
+#include <iostream>
 #include <cmath>
 #include <limits>
 #include <random>
 
 #include "rcm/camera/camera.h"
+#include <opencv2/calib3d.hpp>
+
 #include "support/test_rigs.h"
 
 namespace rcm {
@@ -22,7 +26,8 @@ constexpr double kRoundTripPixelTolerance = 1e-9;
 // order: agreement to rounding, relative to the entry's magnitude.
 constexpr double kJacobianTolerance = 1e-12;
 
-void ExpectPixelRoundTrip(const Camera& camera, double step) {
+// Returns the largest pixel error of the round trip.
+double ExpectPixelRoundTrip(const Camera& camera, double step) {
   double worst = 0.0;
   int failures = 0;
   for (const Eigen::Vector2d& pixel : test::ImageGrid(camera, step)) {
@@ -37,6 +42,7 @@ void ExpectPixelRoundTrip(const Camera& camera, double step) {
   }
   EXPECT_EQ(failures, 0) << "pixels that did not undistort";
   EXPECT_LT(worst, kRoundTripPixelTolerance);
+  return worst;
 }
 
 TEST(LensModels, PinholeRoundTripFullImage) {
@@ -171,8 +177,9 @@ template <typename Lens>
 void ExpectJacobianMatchesJets(const double* dist,
                                const std::vector<Eigen::Vector2d>& points) {
   using Jet = ceres::Jet<double, 2>;
-  Jet dist_jet[4];
-  for (int i = 0; i < 4; ++i) dist_jet[i] = Jet(dist[i]);
+  constexpr int kNumDist = std::max(Lens::kNumDistortionParams, 1);
+  Jet dist_jet[kNumDist];
+  for (int i = 0; i < kNumDist; ++i) dist_jet[i] = Jet(dist[i]);
   for (const Eigen::Vector2d& p : points) {
     Jet xd, yd;
     Lens::Distort(dist_jet, Jet(p.x(), 0), Jet(p.y(), 1), &xd, &yd);
@@ -245,8 +252,9 @@ TEST(EquidistantLens, JacobianMatchesCentralDifferencesNearAxis) {
 template <typename Lens>
 void ExpectUndistortDerivativeIsInverseJacobian(const double* dist) {
   using Jet = ceres::Jet<double, 2>;
-  Jet dist_jet[4];
-  for (int i = 0; i < 4; ++i) dist_jet[i] = Jet(dist[i]);
+  constexpr int kNumDist = Lens::kNumDistortionParams;
+  Jet dist_jet[kNumDist];
+  for (int i = 0; i < kNumDist; ++i) dist_jet[i] = Jet(dist[i]);
   for (const Eigen::Vector2d& p :
        std::vector<Eigen::Vector2d>{{0.3, -0.2}, {-0.9, 0.7}, {1e-5, 2e-5}}) {
     double xd, yd, jacobian[4];
@@ -279,17 +287,18 @@ TEST(EquidistantLens, UndistortDerivativeIsInverseJacobian) {
 // (what calibration needs) against central differences.
 template <typename Lens>
 void ExpectUndistortParameterDerivative(const double* dist) {
-  using Jet = ceres::Jet<double, 4>;
+  constexpr int kNumDist = Lens::kNumDistortionParams;
+  using Jet = ceres::Jet<double, kNumDist>;
   const double xd = 0.55, yd = -0.42;
-  Jet dist_jet[4];
-  for (int i = 0; i < 4; ++i) dist_jet[i] = Jet(dist[i], i);
+  Jet dist_jet[kNumDist];
+  for (int i = 0; i < kNumDist; ++i) dist_jet[i] = Jet(dist[i], i);
   Jet x, y;
   ASSERT_TRUE(Lens::Undistort(dist_jet, Jet(xd), Jet(yd), &x, &y));
-  for (int i = 0; i < 4; ++i) {
+  for (int i = 0; i < kNumDist; ++i) {
     // Central differences: truncation O(h^2) ~ 1e-12, rounding 1e-16 / h.
     const double h = 1e-6;
-    double plus[4], minus[4];
-    for (int k = 0; k < 4; ++k) plus[k] = minus[k] = dist[k];
+    double plus[kNumDist], minus[kNumDist];
+    for (int k = 0; k < kNumDist; ++k) plus[k] = minus[k] = dist[k];
     plus[i] += h;
     minus[i] -= h;
     double xp, yp, xm, ym;
@@ -341,6 +350,207 @@ TEST(LensModels, UndistortRejectsNonFinite) {
   EXPECT_FALSE(RadTanLens::Undistort(dist, 0.1, inf, &x, &y));
   EXPECT_FALSE(EquidistantLens::Undistort(dist, nan, 0.1, &x, &y));
   EXPECT_FALSE(EquidistantLens::Undistort(dist, inf, 0.1, &x, &y));
+}
+
+// ---------------------------------------------------------------------------
+// The rational, double-sphere and EUCM models.
+
+TEST(LensModels, RationalRoundTripOverTheImage) {
+  const double worst = ExpectPixelRoundTrip(test::RationalCamera(), 2.0);
+  std::cout << "rational round trip: max " << worst << " px\n";
+}
+
+TEST(LensModels, DoubleSphereRoundTripOverTheImage) {
+  const double worst = ExpectPixelRoundTrip(test::DoubleSphereCamera(), 2.0);
+  std::cout << "ds round trip: max " << worst << " px\n";
+}
+
+TEST(LensModels, EucmRoundTripOverTheImage) {
+  const double worst = ExpectPixelRoundTrip(test::EucmCamera(), 2.0);
+  std::cout << "eucm round trip: max " << worst << " px\n";
+}
+
+// The unified models out to the edge of the half space z > 0: an image
+// whose corners see 88 degrees off axis.
+TEST(LensModels, UnifiedModelsRoundTripToEightyEightDegrees) {
+  for (const Camera& base : {test::DoubleSphereCamera(), test::EucmCamera()}) {
+    const double r = std::tan(88.0 * M_PI / 180.0);
+    double xd = 0.0, yd = 0.0;
+    RCM_LENS_MODEL_SWITCH(base.model(),
+                          LensModel::Distort(base.params() + 4, r, 0.0, &xd,
+                                             &yd);
+                          break;)
+    const double f = std::hypot(320.0, 240.0) / xd;
+    const Camera camera =
+        Camera::Create(base.model(), 640, 480, {f, f, 319.5, 239.5},
+                       base.Distortion())
+            .value();
+    const double worst = ExpectPixelRoundTrip(camera, 4.0);
+    std::cout << LensModelName(camera.model()) << " to 88 deg: max " << worst
+              << " px\n";
+  }
+}
+
+TEST(RationalLens, JacobianMatchesJets) {
+  ExpectJacobianMatchesJets<RationalLens>(test::RationalCamera().params() + 4,
+                                          JacobianTestPoints());
+}
+
+TEST(DoubleSphereLens, JacobianMatchesJets) {
+  ExpectJacobianMatchesJets<DoubleSphereLens>(
+      test::DoubleSphereCamera().params() + 4, JacobianTestPoints());
+  const double other[2] = {0.7, 0.2};
+  ExpectJacobianMatchesJets<DoubleSphereLens>(other, JacobianTestPoints());
+}
+
+TEST(EucmLens, JacobianMatchesJets) {
+  ExpectJacobianMatchesJets<EucmLens>(test::EucmCamera().params() + 4,
+                                      JacobianTestPoints());
+  const double other[2] = {0.3, 2.5};
+  ExpectJacobianMatchesJets<EucmLens>(other, JacobianTestPoints());
+}
+
+TEST(RationalLens, UndistortDerivativeIsInverseJacobian) {
+  ExpectUndistortDerivativeIsInverseJacobian<RationalLens>(
+      test::RationalCamera().params() + 4);
+}
+
+TEST(DoubleSphereLens, UndistortDerivativeIsInverseJacobian) {
+  ExpectUndistortDerivativeIsInverseJacobian<DoubleSphereLens>(
+      test::DoubleSphereCamera().params() + 4);
+}
+
+TEST(EucmLens, UndistortDerivativeIsInverseJacobian) {
+  ExpectUndistortDerivativeIsInverseJacobian<EucmLens>(
+      test::EucmCamera().params() + 4);
+}
+
+TEST(RationalLens, UndistortParameterDerivativeMatchesCentralDifferences) {
+  ExpectUndistortParameterDerivative<RationalLens>(
+      test::RationalCamera().params() + 4);
+}
+
+TEST(DoubleSphereLens, UndistortParameterDerivativeMatchesCentralDifferences) {
+  ExpectUndistortParameterDerivative<DoubleSphereLens>(
+      test::DoubleSphereCamera().params() + 4);
+}
+
+TEST(EucmLens, UndistortParameterDerivativeMatchesCentralDifferences) {
+  ExpectUndistortParameterDerivative<EucmLens>(test::EucmCamera().params() +
+                                               4);
+}
+
+// cv::projectPoints with the 8-coefficient vector (k1, k2, p1, p2, k3, k4,
+// k5, k6) is the reference of the rational model. Both evaluate the same
+// rational function in double; the orders of operations differ, so the
+// pixels agree to rounding (~1e-13 px), far inside 1e-9 px.
+constexpr double kOpenCvAgreementPixels = 1e-9;
+
+TEST(RationalLens, MatchesOpenCvProjectPoints) {
+  const Camera camera = test::RationalCamera();
+  std::vector<cv::Point3d> points;
+  for (double x = -0.9; x <= 0.9; x += 0.05) {
+    for (double y = -0.6; y <= 0.6; y += 0.05) points.emplace_back(x, y, 1.0);
+  }
+  const cv::Matx33d k(camera.fx(), 0.0, camera.cx(), 0.0, camera.fy(),
+                      camera.cy(), 0.0, 0.0, 1.0);
+  const std::vector<double> d = camera.Distortion();
+  ASSERT_EQ(d.size(), 8u);
+  std::vector<cv::Point2d> pixels;
+  cv::projectPoints(points, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), k, d,
+                    pixels);
+  double worst = 0.0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector2d ours =
+        camera.ImageFromNormalized(Eigen::Vector2d(points[i].x, points[i].y));
+    worst = std::max(worst, (ours - Eigen::Vector2d(pixels[i].x, pixels[i].y))
+                                .norm());
+  }
+  std::cout << "rational vs cv::projectPoints: max " << worst << " px over "
+            << points.size() << " points\n";
+  EXPECT_LT(worst, kOpenCvAgreementPixels);
+}
+
+TEST(RationalLens, ReducesToRadTan) {
+  const double rational[8] = {-0.28, 0.07, 2e-4, -3e-4, 0.0, 0.0, 0.0, 0.0};
+  const double radtan[4] = {-0.28, 0.07, 2e-4, -3e-4};
+  for (const Eigen::Vector2d& p : JacobianTestPoints()) {
+    double a[2], b[2];
+    RationalLens::Distort(rational, p.x(), p.y(), &a[0], &a[1]);
+    RadTanLens::Distort(radtan, p.x(), p.y(), &b[0], &b[1]);
+    EXPECT_DOUBLE_EQ(a[0], b[0]);
+    EXPECT_DOUBLE_EQ(a[1], b[1]);
+  }
+}
+
+// The double sphere with xi = 0 is the EUCM with beta = 1: both are
+// (x, y) / (alpha sqrt(r^2 + 1) + 1 - alpha).
+TEST(DoubleSphereLens, WithZeroXiIsEucmWithUnitBeta) {
+  const double ds[2] = {0.0, 0.57};
+  const double eucm[2] = {0.57, 1.0};
+  for (const Eigen::Vector2d& p : JacobianTestPoints()) {
+    double a[2], b[2];
+    DoubleSphereLens::Distort(ds, p.x(), p.y(), &a[0], &a[1]);
+    EucmLens::Distort(eucm, p.x(), p.y(), &b[0], &b[1]);
+    EXPECT_NEAR(a[0], b[0], 1e-15 * (1.0 + std::abs(b[0])));
+    EXPECT_NEAR(a[1], b[1], 1e-15 * (1.0 + std::abs(b[1])));
+  }
+}
+
+// Distorted radii beyond the image of 90 degrees off axis have no ray in
+// front of the camera.
+TEST(LensModels, UnifiedModelsUndistortFailsBeyondNinetyDegrees) {
+  const double ds[2] = {-0.18, 0.59};
+  const double eucm[2] = {0.63, 1.04};
+  // The limits as r -> infinity: r / N(r) -> 1 / (alpha sqrt(1 + xi^2) +
+  // (1 - alpha) xi) and 1 / (alpha sqrt(beta)).
+  const double ds_edge =
+      1.0 / (0.59 * std::sqrt(1.0 + 0.18 * 0.18) - 0.41 * 0.18);
+  const double eucm_edge = 1.0 / (0.63 * std::sqrt(1.04));
+  double x, y;
+  EXPECT_TRUE(DoubleSphereLens::Undistort(ds, 0.999 * ds_edge, 0.0, &x, &y));
+  EXPECT_GT(x, 50.0);
+  EXPECT_FALSE(DoubleSphereLens::Undistort(ds, 1.001 * ds_edge, 0.0, &x, &y));
+  EXPECT_TRUE(EucmLens::Undistort(eucm, 0.0, 0.999 * eucm_edge, &x, &y));
+  EXPECT_GT(y, 50.0);
+  EXPECT_FALSE(EucmLens::Undistort(eucm, 0.0, 1.001 * eucm_edge, &x, &y));
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(DoubleSphereLens::Undistort(ds, nan, 0.0, &x, &y));
+  EXPECT_FALSE(EucmLens::Undistort(eucm, 0.0, nan, &x, &y));
+  EXPECT_FALSE(RationalLens::Undistort(test::RationalCamera().params() + 4,
+                                       nan, 0.0, &x, &y));
+}
+
+TEST(LensModels, FoldsOfTheNewModels) {
+  // Rational with only k1 is radtan's r (1 + k1 r^2): fold at
+  // r^2 = -1 / (3 k1).
+  const Camera rational =
+      Camera::Create(LensModelId::kRational, 640, 480,
+                     {300.0, 300.0, 320.0, 240.0},
+                     {-0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0})
+          .value();
+  EXPECT_NEAR(rational.MaxInvertibleRadius(), std::sqrt(1.0 / 1.5), 1e-12);
+  // A denominator 1 - r^2 has a pole at r = 1: the lens ends there.
+  const Camera pole =
+      Camera::Create(LensModelId::kRational, 640, 480,
+                     {300.0, 300.0, 320.0, 240.0},
+                     {0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0})
+          .value();
+  EXPECT_NEAR(pole.MaxInvertibleRadius(), 1.0, 1e-12);
+  EXPECT_FALSE(pole.ProjectNormalized({0.0, 1.01}).has_value());
+  // Double sphere with alpha = 0, xi = -0.5: N = 1 - d1 / 2 reaches 0 at
+  // d1 = 2, r = sqrt(3).
+  const Camera ds = Camera::Create(LensModelId::kDoubleSphere, 640, 480,
+                                   {300.0, 300.0, 320.0, 240.0}, {-0.5, 0.0})
+                        .value();
+  EXPECT_NEAR(ds.MaxInvertibleRadius(), std::sqrt(3.0), 1e-9);
+  EXPECT_FALSE(ds.ProjectNormalized({1.75, 0.0}).has_value());
+  EXPECT_TRUE(ds.ProjectNormalized({1.7, 0.0}).has_value());
+  // The real lenses of the tests never fold in front of the camera.
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(test::DoubleSphereCamera().MaxInvertibleRadius(), kInfinity);
+  EXPECT_EQ(test::EucmCamera().MaxInvertibleRadius(), kInfinity);
+  EXPECT_GT(test::RationalCamera().MaxInvertibleRadius(), 1.2);
 }
 
 }  // namespace

@@ -65,6 +65,25 @@ TEST(WaterSideModelFit, ExactAtUnitIndexRadtan) {
   EXPECT_LT(fit->full.max_px, 1e-9);
 }
 
+// The models of issue 21, each fitted to a camera of its own model at
+// n = 1: the fit returns the camera (from the virtual pinhole start, with
+// the ds and eucm coefficients kept in their ranges by the solve's
+// bounds).
+TEST(WaterSideModelFit, ExactAtUnitIndexNewModels) {
+  for (const Camera& camera : {test::RationalCamera(),
+                               test::DoubleSphereCamera(), test::EucmCamera()}) {
+    WaterSideModelFitOptions options;
+    options.model = camera.model();
+    const StatusOr<WaterSideModelFit> fit =
+        FitWaterSideModel(InWater(camera, 1.0), options);
+    ASSERT_TRUE(fit.ok()) << fit.status().message();
+    SCOPED_TRACE(LensModelName(camera.model()));
+    ExpectSameParameters(fit->camera, camera);
+    EXPECT_LT(fit->full.max_px, 1e-9);
+    EXPECT_EQ(fit->num_not_invertible, 0);
+  }
+}
+
 // Acceptance (issue 9): an exported equidistant model reproduces the
 // refractive model of the dataset rig at n = 1.333 within 0.1 px RMS over
 // the image inset by 5 % on each side. The whole-image figure is larger:

@@ -379,6 +379,114 @@ TEST(Camchain, NoneModelRoundTrips) {
   ExpectCamchainsBitwiseEqual(*parsed, camchain);
 }
 
+// The models of issue 21. ds and eucm as Kalibr writes them (the camera
+// model, its two parameters before fu, fv, pu, pv, distortion_model none);
+// rational as rcm's extension (a pinhole with 8 distortion_coeffs).
+TEST(Camchain, DoubleSphereIsWrittenAsKalibrDoes) {
+  Camchain camchain;
+  camchain.cameras.push_back(
+      MakeEntry(test::DoubleSphereCamera(), std::nullopt));
+  const std::string text = FormatCamchain(camchain);
+  EXPECT_EQ(text,
+            "cam0:\n"
+            "  cam_overlaps: []\n"
+            "  camera_model: ds\n"
+            "  distortion_coeffs: []\n"
+            "  distortion_model: none\n"
+            "  intrinsics: [-0.18, 0.59, 300.2, 299.7, 318.4, 241.9]\n"
+            "  resolution: [640, 480]\n");
+  const StatusOr<Camchain> parsed = ParseCamchain(text, "rig.yaml");
+  ASSERT_TRUE(parsed.ok()) << parsed.status().message();
+  ExpectCamchainsBitwiseEqual(*parsed, camchain);
+  EXPECT_EQ(FormatCamchain(*parsed), text);
+}
+
+TEST(Camchain, NewModelsRoundTripBitExactly) {
+  Camchain camchain;
+  camchain.cameras.push_back(MakeEntry(test::RationalCamera(), std::nullopt));
+  camchain.cameras.push_back(
+      MakeEntry(test::EucmCamera(),
+                MakeTransform(Eigen::Vector3d(0.002, 0.0003, -0.0004),
+                              Eigen::Vector3d(-0.11, 0.0004, -0.0009))));
+  camchain.cameras.push_back(
+      MakeEntry(test::DoubleSphereCamera(),
+                MakeTransform(Eigen::Vector3d(-0.001, 0.0002, 0.0001),
+                              Eigen::Vector3d(-0.09, 0.0001, 0.0002))));
+  const std::string text = FormatCamchain(camchain);
+  EXPECT_THAT(text, HasSubstr("  camera_model: pinhole\n  distortion_coeffs: "
+                              "[0.5, 0.1, 0.0009, -0.0006, 0.001, 0.75, "
+                              "0.2, 0.001]\n  distortion_model: rational\n"));
+  EXPECT_THAT(text, HasSubstr("  camera_model: eucm\n  distortion_coeffs: []\n"
+                              "  distortion_model: none\n  intrinsics: [0.63, "
+                              "1.04, 320.4, 319.8, 321.1, 238.6]\n"));
+  const StatusOr<Camchain> parsed = ParseCamchain(text, "rig.yaml");
+  ASSERT_TRUE(parsed.ok()) << parsed.status().message();
+  ExpectCamchainsBitwiseEqual(*parsed, camchain);
+  EXPECT_EQ(FormatCamchain(*parsed), text);
+  // Through a file too.
+  const std::string path = test::TempFilePath("new_models.yaml");
+  ASSERT_TRUE(WriteCamchain(path, camchain).ok());
+  const StatusOr<Camchain> read = ReadCamchain(path);
+  ASSERT_TRUE(read.ok()) << read.status().message();
+  ExpectCamchainsBitwiseEqual(*read, camchain);
+}
+
+// A Kalibr ds camchain as Kalibr's own files have it, without the
+// (empty) distortion_coeffs.
+constexpr char kKalibrDs[] =
+    "cam0:\n"
+    "  camera_model: ds\n"
+    "  distortion_model: none\n"
+    "  intrinsics: [-0.2, 0.58, 190.5, 190.4, 254.9, 256.8]\n"
+    "  resolution: [512, 512]\n";
+
+TEST(Camchain, ReadsKalibrDoubleSphere) {
+  const StatusOr<Camchain> parsed = ParseCamchain(kKalibrDs, "ds.yaml");
+  ASSERT_TRUE(parsed.ok()) << parsed.status().message();
+  const Camera& camera = parsed->cameras[0].camera;
+  EXPECT_EQ(camera.model(), LensModelId::kDoubleSphere);
+  EXPECT_EQ(camera.Distortion(), (std::vector<double>{-0.2, 0.58}));
+  EXPECT_EQ(camera.fx(), 190.5);
+  EXPECT_EQ(camera.cy(), 256.8);
+}
+
+TEST(Camchain, RejectsBadNewModelEntries) {
+  const auto error = [](const std::string& text) {
+    const StatusOr<Camchain> parsed = ParseCamchain(text, "ds.yaml");
+    return parsed.ok() ? std::string() : parsed.status().message();
+  };
+  EXPECT_EQ(error(ReplaceOnce(kKalibrDs, "[-0.2, 0.58, ", "[1.2, 0.58, ")),
+            "ds.yaml:4: cam0.intrinsics: ds xi = 1.2 is outside (-1, 1]");
+  EXPECT_EQ(error(ReplaceOnce(kKalibrDs, "[-0.2, 0.58, ", "[-0.2, 1.5, ")),
+            "ds.yaml:4: cam0.intrinsics: ds alpha = 1.5 is outside [0, 1]");
+  EXPECT_EQ(
+      error(ReplaceOnce(ReplaceOnce(kKalibrDs, "ds\n", "eucm\n"),
+                        "[-0.2, 0.58, ", "[0.6, -1, ")),
+      "ds.yaml:4: cam0.intrinsics: eucm beta = -1 is outside (0, 1000]");
+  EXPECT_THAT(error(ReplaceOnce(kKalibrDs, "[-0.2, 0.58, ", "[")),
+              HasSubstr("cam0.intrinsics: expected 6"));
+  EXPECT_EQ(error(ReplaceOnce(kKalibrDs, "model: none", "model: radtan")),
+            "ds.yaml:3: cam0.distortion_model: camera_model 'ds' takes "
+            "distortion_model 'none', got 'radtan'");
+  EXPECT_THAT(error(ReplaceOnce(ReplaceOnce(kKalibrDs, "model: ds",
+                                            "model: pinhole"),
+                                "model: none", "model: ds")),
+              HasSubstr("unknown model 'ds' (supported: none, radtan, "
+                        "equidistant, rational; 'ds' is a camera_model, "
+                        "with distortion_model 'none')"));
+  EXPECT_EQ(error(ReplaceOnce(kKalibrDs, "  distortion_model",
+                              "  distortion_coeffs: [0.1]\n  "
+                              "distortion_model")),
+            "ds.yaml:3: cam0.distortion_coeffs: expected 0 numbers for "
+            "camera_model 'ds', got 1");
+  // A rational camera needs its 8 coefficients.
+  EXPECT_THAT(
+      error("cam0:\n  camera_model: pinhole\n  distortion_coeffs: [0.1, 0.0, "
+            "0.0, 0.0]\n  distortion_model: rational\n  intrinsics: [300, "
+            "300, 320, 240]\n  resolution: [640, 480]\n"),
+      HasSubstr("expected 8 numbers for distortion_model 'rational', got 4"));
+}
+
 TEST(Camchain, PortBlockRoundTrips) {
   Camchain camchain;
   camchain.cameras.push_back(
@@ -648,7 +756,7 @@ TEST(Camchain, RejectsUnknownCameraModel) {
                                    "camera_model: omni\n  distortion_coeffs: "
                                    "[-0.0379")),
             "rig.yaml:3: cam0.camera_model: unknown model 'omni' (supported: "
-            "pinhole)");
+            "pinhole, ds, eucm)");
 }
 
 TEST(Camchain, RejectsUnknownDistortionModel) {
@@ -658,7 +766,7 @@ TEST(Camchain, RejectsUnknownDistortionModel) {
                                    "  distortion_model: fov\n  intrinsics: "
                                    "[346.7")),
             "rig.yaml:5: cam0.distortion_model: unknown model 'fov' "
-            "(supported: none, radtan, equidistant)");
+            "(supported: none, radtan, equidistant, rational)");
 }
 
 TEST(Camchain, RejectsNonOrthonormalRotation) {
@@ -828,7 +936,7 @@ TEST(Camchain, ErrorStaysOnOneLine) {
       "camera_model: \"pin\\nhole\"\n  distortion_coeffs: [-0.0379"));
   EXPECT_EQ(message,
             "rig.yaml:3: cam0.camera_model: unknown model 'pin\\x0ahole' "
-            "(supported: pinhole)");
+            "(supported: pinhole, ds, eucm)");
 }
 
 TEST(Camchain, ReadRejectsMissingFile) {

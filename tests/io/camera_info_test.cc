@@ -303,10 +303,28 @@ TEST(CameraInfo, RejectsColsThatDisagreeWithData) {
 }
 
 TEST(CameraInfo, RejectsUnknownModel) {
-  EXPECT_EQ(ParseError(ReplaceOnce(kLeft, "plumb_bob", "rational_polynomial")),
+  EXPECT_EQ(ParseError(ReplaceOnce(kLeft, "plumb_bob", "fov")),
             "left.yaml:8: distortion_model: unknown model "
-            "'rational_polynomial' (supported: plumb_bob, radtan, "
-            "equidistant, none)");
+            "'fov' (supported: plumb_bob, radtan, "
+            "equidistant, rational_polynomial, none)");
+}
+
+TEST(CameraInfo, ReadsRationalPolynomial) {
+  const std::string text = ReplaceOnce(
+      ReplaceOnce(ReplaceOnce(kLeft, "plumb_bob", "rational_polynomial"),
+                  "cols: 5", "cols: 8"),
+      "[-0.28, 0.07, 0.0002, -0.00003, 0]",
+      "[0.5, 0.1, 0.0009, -0.0006, 0.001, 0.75, 0.2, 0.001]");
+  const StatusOr<CameraInfo> info = ParseCameraInfo(text, "left.yaml");
+  ASSERT_TRUE(info.ok()) << info.status().message();
+  EXPECT_EQ(info->camera.model(), LensModelId::kRational);
+  EXPECT_EQ(info->camera.Distortion(),
+            (std::vector<double>{0.5, 0.1, 0.0009, -0.0006, 0.001, 0.75, 0.2,
+                                 0.001}));
+  EXPECT_EQ(ParseError(ReplaceOnce(kLeft, "plumb_bob", "rational_polynomial")),
+            "left.yaml:12: distortion_coefficients.data: expected 8 numbers "
+            "(k1, k2, p1, p2, k3, k4, k5, k6) for distortion_model "
+            "'rational_polynomial', got 5");
 }
 
 TEST(CameraInfo, RejectsNonzeroK3) {
@@ -505,6 +523,42 @@ TEST(CameraInfo, RoundTripsEquidistantBitExactly) {
     const CameraInfo parsed = FormatAndParse(info);
     EXPECT_EQ(parsed.camera, camera);
     EXPECT_EQ(parsed.projection, info.projection);
+  }
+}
+
+TEST(CameraInfo, RoundTripsRationalBitExactly) {
+  const Camera camera = test::RationalCamera();
+  const CameraInfo info = CameraInfoFromCamera("rational", camera);
+  EXPECT_THAT(FormatCameraInfo(info),
+              HasSubstr("\ndistortion_model: rational_polynomial\n"
+                        "distortion_coefficients:\n  rows: 1\n  cols: 8\n"
+                        "  data: [0.5, 0.1, 0.0009, -0.0006, 0.001, 0.75, "
+                        "0.2, 0.001]\n"));
+  const CameraInfo parsed = FormatAndParse(info);
+  EXPECT_EQ(parsed.camera, camera);
+  EXPECT_EQ(parsed.projection, info.projection);
+  // And through a file.
+  const std::string path = test::TempFilePath("rational_info.yaml");
+  ASSERT_TRUE(WriteCameraInfo(path, info).ok());
+  const StatusOr<CameraInfo> read = ReadCameraInfo(path);
+  ASSERT_TRUE(read.ok()) << read.status().message();
+  EXPECT_EQ(read->camera, camera);
+}
+
+// ROS has no double-sphere or EUCM model: writing one is a one-line error
+// that leaves no file.
+TEST(CameraInfo, RefusesToWriteUnifiedModels) {
+  for (const Camera& camera : {test::DoubleSphereCamera(), test::EucmCamera()}) {
+    const std::string path = test::TempFilePath("unified_info.yaml");
+    const Status status =
+        WriteCameraInfo(path, CameraInfoFromCamera("cam", camera));
+    ASSERT_FALSE(status.ok());
+    EXPECT_EQ(status.message(),
+              path + ": a camera_info cannot hold the lens model '" +
+                  std::string(LensModelName(camera.model())) +
+                  "' (ROS has plumb_bob, rational_polynomial, equidistant): "
+                  "write a Kalibr camchain instead");
+    EXPECT_FALSE(std::filesystem::exists(path));
   }
 }
 

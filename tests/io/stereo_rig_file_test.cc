@@ -6,10 +6,12 @@
 #include <optional>
 #include <string>
 
+#include "rcm/io/calibration_covariance_file.h"
 #include "rcm/io/camchain.h"
 #include "support/camera_info_text.h"
 #include "support/reader_inputs.h"
 #include "support/temp_file.h"
+#include "support/test_rigs.h"
 
 namespace rcm {
 namespace {
@@ -86,6 +88,32 @@ TEST(StereoRigFile, ReadsCamchainDefaultPair) {
             Eigen::Vector3d(-0.11, 0.0, 0.0));
 }
 
+// A rig of the unified models (issue 21) through a camchain file, with
+// the covariance sidecar of its 6-parameter lenses beside it.
+TEST(StereoRigFile, ReadsUnifiedModelRigWithItsCovariance) {
+  Rigid3d right_from_left;
+  right_from_left.translation = Eigen::Vector3d(-0.1, 0.001, 0.0);
+  const StereoRig rig = StereoRig::Create(test::DoubleSphereCamera(),
+                                          test::EucmCamera(), right_from_left)
+                            .value();
+  const std::string path = test::TempFilePath("unified.yaml");
+  ASSERT_TRUE(WriteCamchain(path, CamchainFromStereoRig(rig)).ok());
+  CalibrationCovarianceFile covariance;
+  covariance.cameras.resize(2);
+  for (auto& camera : covariance.cameras) {
+    camera.intrinsics_covariance = 1e-4 * Eigen::MatrixXd::Identity(6, 6);
+  }
+  covariance.cameras[1].from_previous_covariance =
+      1e-8 * Eigen::Matrix<double, 6, 6>::Identity();
+  ASSERT_TRUE(
+      WriteCalibrationCovariance(CovarianceSidecarPath(path), covariance).ok());
+  const StatusOr<StereoRig> read = ReadStereoRig(path);
+  ASSERT_TRUE(read.ok()) << read.status().message();
+  EXPECT_EQ(read->left(), rig.left());
+  EXPECT_EQ(read->right(), rig.right());
+  EXPECT_EQ(read->right_from_left().translation, right_from_left.translation);
+}
+
 TEST(StereoRigFile, SelectsNamedCameras) {
   const std::string path = WriteTempFile("named.yaml", ThreeCameraCamchain());
   const StatusOr<StereoRig> rig = ReadStereoRig(path, "cam0", "cam2");
@@ -137,7 +165,7 @@ TEST(StereoRigFile, ReportsCamchainErrorsWithPath) {
   EXPECT_EQ(ErrorMessage(ReadStereoRig(path)),
             path +
                 ":3: cam0.camera_model: unknown model 'omni' (supported: "
-                "pinhole)");
+                "pinhole, ds, eucm)");
 }
 
 TEST(StereoRigFile, ReportsYamlSyntaxError) {

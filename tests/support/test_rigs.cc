@@ -32,9 +32,30 @@ Camera WideEquidistantCamera() {
       .value();
 }
 
+Camera RationalCamera() {
+  return Camera::Create(LensModelId::kRational, 752, 480,
+                        {461.3, 460.8, 371.9, 243.6},
+                        {0.5, 0.1, 9.0e-4, -6.0e-4, 0.001, 0.75, 0.2, 0.001})
+      .value();
+}
+
+Camera DoubleSphereCamera() {
+  return Camera::Create(LensModelId::kDoubleSphere, 640, 480,
+                        {300.2, 299.7, 318.4, 241.9}, {-0.18, 0.59})
+      .value();
+}
+
+Camera EucmCamera() {
+  return Camera::Create(LensModelId::kEucm, 640, 480,
+                        {320.4, 319.8, 321.1, 238.6}, {0.63, 1.04})
+      .value();
+}
+
 std::vector<Camera> AllTestCameras() {
-  return {PinholeCamera(), EurocRadtanCamera(), AlphasenseCam0(),
-          AlphasenseCam1(), WideEquidistantCamera()};
+  return {PinholeCamera(),         EurocRadtanCamera(), AlphasenseCam0(),
+          AlphasenseCam1(),        WideEquidistantCamera(),
+          RationalCamera(),        DoubleSphereCamera(),
+          EucmCamera()};
 }
 
 StereoRig IdealRig(const Camera& left, const Camera& right, double baseline) {

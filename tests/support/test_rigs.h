@@ -23,6 +23,15 @@ Camera PinholeCamera();
 // 1024x1024 equidistant (Alphasense coefficients) whose image corners see
 // rays 89.5 degrees off axis.
 Camera WideEquidistantCamera();
+// 752x480 rational (OpenCV's 8 coefficients, a moderately wide lens with
+// tangential terms), f ~ 460 px.
+Camera RationalCamera();
+// 640x480 double sphere, f = 300 px, xi = -0.18, alpha = 0.59 (TUM-VI's
+// fisheye coefficients as basalt calibrates them; the corners see ~75
+// degrees off axis).
+Camera DoubleSphereCamera();
+// 640x480 EUCM, f = 320 px, alpha = 0.63, beta = 1.04 (TUM-VI-like).
+Camera EucmCamera();
 // Every camera above, for tests that sweep them.
 std::vector<Camera> AllTestCameras();
 

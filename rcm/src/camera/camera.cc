@@ -44,6 +44,27 @@ double FirstFoldRadius(LensModelId model,
           EquidistantLens::FirstFoldAngle(distortion.data(), kFoldScanSteps);
       return fold < EquidistantLens::kHalfPi ? std::tan(fold) : kInfinity;
     }
+    case LensModelId::kRational: {
+      // Once per camera: a fine scan, in steps of pi/8192 in the angle off
+      // axis (n / q is a ratio of cubics in r^2 and may turn more than
+      // once).
+      constexpr int kFoldScanSteps = 4096;
+      return lens_internal::FirstRadiusWhereFalse(
+          [&](double r) {
+            return RationalLens::RadiallyIncreasing(distortion.data(), r);
+          },
+          kFoldScanSteps);
+    }
+    case LensModelId::kDoubleSphere: {
+      constexpr int kFoldScanSteps = 1024;
+      return lens_internal::FirstRadiusWhereFalse(
+          [&](double r) {
+            return DoubleSphereLens::RadiallyIncreasing(distortion.data(), r);
+          },
+          kFoldScanSteps);
+    }
+    case LensModelId::kEucm:
+      return kInfinity;  // Never folds (lens_models.h).
   }
   return kInfinity;
 }
@@ -58,17 +79,51 @@ std::string_view LensModelName(LensModelId model) {
       return "radtan";
     case LensModelId::kEquidistant:
       return "equidistant";
+    case LensModelId::kRational:
+      return "rational";
+    case LensModelId::kDoubleSphere:
+      return "ds";
+    case LensModelId::kEucm:
+      return "eucm";
   }
   LOG(FATAL) << "unknown LensModelId " << static_cast<int>(model);
   return "";
 }
 
+const std::array<LensModelId, kNumLensModels>& AllLensModels() {
+  static const std::array<LensModelId, kNumLensModels> kModels = {
+      LensModelId::kPinhole,  LensModelId::kRadTan,       LensModelId::kEquidistant,
+      LensModelId::kRational, LensModelId::kDoubleSphere, LensModelId::kEucm};
+  return kModels;
+}
+
+std::string LensModelNameList() {
+  std::string list;
+  for (LensModelId id : AllLensModels()) {
+    if (!list.empty()) list += ", ";
+    list += LensModelName(id);
+  }
+  return list;
+}
+
 std::optional<LensModelId> LensModelFromName(std::string_view name) {
-  for (LensModelId id : {LensModelId::kPinhole, LensModelId::kRadTan,
-                         LensModelId::kEquidistant}) {
+  for (LensModelId id : AllLensModels()) {
     if (name == LensModelName(id)) return id;
   }
   return std::nullopt;
+}
+
+std::vector<DistortionBound> DistortionBounds(LensModelId model) {
+  constexpr double kInside = 1e-6;
+  switch (model) {
+    case LensModelId::kDoubleSphere:
+      return {{0, -1.0 + kInside, 1.0}, {1, 0.0, 1.0}};
+    case LensModelId::kEucm:
+      return {{0, 0.0, 1.0},
+              {1, kInside, Camera::kMaxDistortionCoefficient}};
+    default:
+      return {};
+  }
 }
 
 int NumDistortionParams(LensModelId model) {
@@ -150,6 +205,30 @@ Status Camera::CheckDistortion(LensModelId model,
               << kMaxDistortionCoefficient;
       return Status::Error(message.str());
     }
+  }
+  // The ranges of the unified models (lens_models.h says why).
+  const auto outside = [&](const char* key, double value,
+                           const char* range) {
+    std::ostringstream message;
+    message << LensModelName(model) << " " << key << " = " << value
+            << " is outside " << range;
+    return Status::Error(message.str());
+  };
+  if (model == LensModelId::kDoubleSphere) {
+    const double xi = distortion[0];
+    const double alpha = distortion[1];
+    if (!(xi > -1.0 && xi <= 1.0)) return outside("xi", xi, "(-1, 1]");
+    if (!(alpha >= 0.0 && alpha <= 1.0)) {
+      return outside("alpha", alpha, "[0, 1]");
+    }
+  }
+  if (model == LensModelId::kEucm) {
+    const double alpha = distortion[0];
+    const double beta = distortion[1];
+    if (!(alpha >= 0.0 && alpha <= 1.0)) {
+      return outside("alpha", alpha, "[0, 1]");
+    }
+    if (!(beta > 0.0)) return outside("beta", beta, "(0, 1000]");
   }
   return Status::Ok();
 }

@@ -38,6 +38,13 @@ ceres::Solver::Summary Solve(const std::vector<RaySample>& samples,
                                  sample.normalized, sample.pixel),
                              nullptr, params);
   }
+  if (problem.HasParameterBlock(params)) {
+    for (const DistortionBound& bound :
+         DistortionBounds(LensModel::kModelId)) {
+      problem.SetParameterLowerBound(params, 4 + bound.index, bound.lower);
+      problem.SetParameterUpperBound(params, 4 + bound.index, bound.upper);
+    }
+  }
   ceres::Solver::Options solver_options;
   solver_options.linear_solver_type = ceres::DENSE_QR;
   solver_options.max_num_iterations = max_iterations;
@@ -95,6 +102,9 @@ StatusOr<WaterSideModelFit> FitWaterSideModel(
   params[1] = camera.n() * lens.fy();
   params[2] = lens.cx();
   params[3] = lens.cy();
+  // Zero distortion, the virtual pinhole; the EUCM's pinhole is alpha = 0
+  // with any beta (beta = 0 is outside its range).
+  if (options.model == LensModelId::kEucm) params[5] = 1.0;
   const int num_params = 4 + NumDistortionParams(options.model);
   if (num_fitted < 2 * num_params) {
     std::ostringstream message;

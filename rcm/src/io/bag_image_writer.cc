@@ -140,6 +140,8 @@ Status BagImageWriter::WriteCameraInfo(const std::string& topic, double stamp_s,
   const StatusOr<ros::Time> time =
       impl_->CheckMessage(topic, stamp_s, "a camera_info");
   RCM_RETURN_IF_ERROR(time.status());
+  RCM_RETURN_IF_ERROR(CheckCameraInfoModel(info.camera)
+                          .WithContext(impl_->path() + ": " + topic));
   sensor_msgs::CameraInfo message = CameraInfoMessage(info);
   return impl_->Write(topic, *time, frame_id, &message);
 }

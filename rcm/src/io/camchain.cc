@@ -117,10 +117,16 @@ StatusOr<CamchainCamera> ParseCamera(const YamlReader& reader, int index,
   const StatusOr<std::string> camera_model =
       reader.String(**camera_model_node, field("camera_model"));
   if (!camera_model.ok()) return camera_model.status();
-  if (*camera_model != "pinhole") {
+  // Kalibr's camera models: "pinhole" with a distortion_model, or the
+  // unified models "ds" and "eucm", whose two distortion parameters lead
+  // the intrinsics and whose distortion_model is "none".
+  std::optional<LensModelId> unified_model;
+  if (*camera_model == "ds") unified_model = LensModelId::kDoubleSphere;
+  if (*camera_model == "eucm") unified_model = LensModelId::kEucm;
+  if (*camera_model != "pinhole" && !unified_model.has_value()) {
     return reader.Error(**camera_model_node, field("camera_model"),
                         "unknown model " + QuoteForMessage(*camera_model) +
-                            " (supported: pinhole)");
+                            " (supported: pinhole, ds, eucm)");
   }
 
   // The distortion model is read before its coefficients, whose number it
@@ -130,38 +136,70 @@ StatusOr<CamchainCamera> ParseCamera(const YamlReader& reader, int index,
   const StatusOr<std::string> model_name =
       reader.String(**model_node, field("distortion_model"));
   if (!model_name.ok()) return model_name.status();
-  const std::optional<LensModelId> model = LensModelFromName(*model_name);
-  if (!model.has_value()) {
+  std::optional<LensModelId> model = LensModelFromName(*model_name);
+  if (unified_model.has_value()) {
+    if (*model_name != "none") {
+      return reader.Error(**model_node, field("distortion_model"),
+                          "camera_model '" + *camera_model +
+                              "' takes distortion_model 'none', got " +
+                              QuoteForMessage(*model_name));
+    }
+    model = unified_model;
+  } else if (!model.has_value() || *model == LensModelId::kDoubleSphere ||
+             *model == LensModelId::kEucm) {
+    const std::string hint =
+        model.has_value() ? "; '" + *model_name +
+                                "' is a camera_model, with distortion_model "
+                                "'none'"
+                          : "";
     return reader.Error(**model_node, field("distortion_model"),
                         "unknown model " + QuoteForMessage(*model_name) +
-                            " (supported: none, radtan, equidistant)");
+                            " (supported: none, radtan, equidistant, "
+                            "rational" +
+                            hint + ")");
   }
 
+  // The coefficients of a pinhole camera's distortion model; none for the
+  // unified models (an empty list, as Kalibr writes, is accepted).
   std::vector<double> distortion;
+  const int num_coeffs =
+      unified_model.has_value() ? 0 : NumDistortionParams(*model);
   const YAML::Node* coeffs_node = Find(*entries, "distortion_coeffs");
   if (coeffs_node == nullptr) {
-    if (NumDistortionParams(*model) > 0) {
+    if (num_coeffs > 0) {
       return reader.MissingKey(name, "distortion_coeffs");
     }
   } else {
     const StatusOr<std::vector<double>> coeffs =
         reader.NumberList(*coeffs_node, field("distortion_coeffs"));
     if (!coeffs.ok()) return coeffs.status();
-    const int expected = NumDistortionParams(*model);
-    if (static_cast<int>(coeffs->size()) != expected) {
+    if (static_cast<int>(coeffs->size()) != num_coeffs) {
       return reader.Error(*coeffs_node, field("distortion_coeffs"),
-                          "expected " + std::to_string(expected) +
-                              " numbers for distortion_model '" + *model_name +
-                              "', got " + std::to_string(coeffs->size()));
+                          "expected " + std::to_string(num_coeffs) +
+                              " numbers for " +
+                              (unified_model.has_value()
+                                   ? "camera_model '" + *camera_model + "'"
+                                   : "distortion_model '" + *model_name + "'") +
+                              ", got " + std::to_string(coeffs->size()));
     }
     distortion = *coeffs;
   }
 
+  // intrinsics: [fu, fv, pu, pv], or [xi, alpha, fu, fv, pu, pv] (ds) and
+  // [alpha, beta, fu, fv, pu, pv] (eucm).
+  const int num_unified = unified_model.has_value() ? 2 : 0;
   const StatusOr<const YAML::Node*> intrinsics_node = required("intrinsics");
   if (!intrinsics_node.ok()) return intrinsics_node.status();
-  const StatusOr<std::vector<double>> intrinsics =
-      reader.NumberList(**intrinsics_node, field("intrinsics"), 4);
-  if (!intrinsics.ok()) return intrinsics.status();
+  const StatusOr<std::vector<double>> read_intrinsics = reader.NumberList(
+      **intrinsics_node, field("intrinsics"), 4 + num_unified);
+  if (!read_intrinsics.ok()) return read_intrinsics.status();
+  if (num_unified > 0) {
+    distortion.assign(read_intrinsics->begin(),
+                      read_intrinsics->begin() + num_unified);
+  }
+  const std::vector<double> intrinsics_values(
+      read_intrinsics->begin() + num_unified, read_intrinsics->end());
+  const std::vector<double>* intrinsics = &intrinsics_values;
 
   const StatusOr<const YAML::Node*> resolution_node = required("resolution");
   if (!resolution_node.ok()) return resolution_node.status();
@@ -186,6 +224,10 @@ StatusOr<CamchainCamera> ParseCamera(const YamlReader& reader, int index,
   }
   if (const Status status = Camera::CheckDistortion(*model, distortion);
       !status.ok()) {
+    if (num_unified > 0) {
+      return reader.Error(**intrinsics_node, field("intrinsics"),
+                          status.message());
+    }
     return reader.Error(coeffs_node != nullptr ? *coeffs_node : node,
                         field("distortion_coeffs"), status.message());
   }
@@ -449,13 +491,29 @@ void AppendCamera(const std::string& name, const CamchainCamera& entry,
   for (int index : entry.cam_overlaps)
     overlaps.push_back(std::to_string(index));
   AppendListField("cam_overlaps", overlaps, out);
-  *out += "  camera_model: pinhole\n";
-  AppendListField("distortion_coeffs", FloatItems(camera.Distortion()), out);
-  *out += "  distortion_model: " + std::string(LensModelName(camera.model())) +
-          "\n";
-  AppendListField(
-      "intrinsics",
-      FloatItems({camera.fx(), camera.fy(), camera.cx(), camera.cy()}), out);
+  // ds and eucm as Kalibr writes them: the camera_model, no distortion
+  // coefficients, the two model parameters before fu, fv, pu, pv. Every
+  // other model is a pinhole camera_model with a distortion_model;
+  // "rational" (OpenCV's 8 coefficients k1, k2, p1, p2, k3, k4, k5, k6) is
+  // rcm's extension, Kalibr has no such model (docs/file_formats.md).
+  const bool unified = camera.model() == LensModelId::kDoubleSphere ||
+                       camera.model() == LensModelId::kEucm;
+  std::vector<double> intrinsics = {camera.fx(), camera.fy(), camera.cx(),
+                                    camera.cy()};
+  if (unified) {
+    const std::vector<double> distortion = camera.Distortion();
+    intrinsics.insert(intrinsics.begin(), distortion.begin(), distortion.end());
+    *out += "  camera_model: " + std::string(LensModelName(camera.model())) +
+            "\n";
+    *out += "  distortion_coeffs: []\n";
+    *out += "  distortion_model: none\n";
+  } else {
+    *out += "  camera_model: pinhole\n";
+    AppendListField("distortion_coeffs", FloatItems(camera.Distortion()), out);
+    *out += "  distortion_model: " +
+            std::string(LensModelName(camera.model())) + "\n";
+  }
+  AppendListField("intrinsics", FloatItems(intrinsics), out);
   AppendListField(
       "resolution",
       {std::to_string(camera.width()), std::to_string(camera.height())}, out);

@@ -1,5 +1,6 @@
 #include "rcm/io/camera_info.h"
 
+#include <glog/logging.h>
 #include <yaml-cpp/yaml.h>
 
 #include <array>
@@ -85,6 +86,7 @@ StatusOr<std::string> OptionalString(const YamlReader& reader,
 std::optional<LensModelId> LensModelFromRosName(const std::string& name) {
   if (name == "plumb_bob" || name == "radtan") return LensModelId::kRadTan;
   if (name == "equidistant") return LensModelId::kEquidistant;
+  if (name == "rational_polynomial") return LensModelId::kRational;
   if (name == "none" || name.empty()) return LensModelId::kPinhole;
   return std::nullopt;
 }
@@ -129,6 +131,19 @@ StatusOr<std::vector<double>> DistortionFromRos(
                                 model_name + "', got " + std::to_string(size));
       }
       return ros;
+    case LensModelId::kRational:
+      // ROS's rational_polynomial, D = [k1, k2, p1, p2, k3, k4, k5, k6]:
+      // OpenCV's order, which is rcm's.
+      if (size != 8) {
+        return reader.Error(at, field,
+                            "expected 8 numbers (k1, k2, p1, p2, k3, k4, k5, "
+                            "k6) for distortion_model '" +
+                                model_name + "', got " + std::to_string(size));
+      }
+      return ros;
+    case LensModelId::kDoubleSphere:
+    case LensModelId::kEucm:
+      break;  // No ROS name maps to them.
   }
   return reader.Error(at, field, "unhandled lens model");
 }
@@ -198,7 +213,7 @@ StatusOr<CameraInfo> ParseCameraInfoNode(const YamlReader& reader,
     return reader.Error(model_entry->value, "distortion_model",
                         "unknown model " + QuoteForMessage(model_name) +
                             " (supported: plumb_bob, radtan, equidistant, "
-                            "none)");
+                            "rational_polynomial, none)");
   }
   std::vector<double> distortion;
   const YamlEntry* d_entry = FindYamlEntry(*entries, "distortion_coefficients");
@@ -341,7 +356,21 @@ CameraInfo CameraInfoFromCamera(const std::string& camera_name,
                     projection};
 }
 
+Status CheckCameraInfoModel(const Camera& camera) {
+  if (camera.model() == LensModelId::kDoubleSphere ||
+      camera.model() == LensModelId::kEucm) {
+    return Status::Error(
+        "a camera_info cannot hold the lens model '" +
+        std::string(LensModelName(camera.model())) +
+        "' (ROS has plumb_bob, rational_polynomial, equidistant): write a "
+        "Kalibr camchain instead");
+  }
+  return Status::Ok();
+}
+
 RosDistortion RosDistortionOf(const Camera& camera) {
+  CHECK(CheckCameraInfoModel(camera).ok())
+      << CheckCameraInfoModel(camera).message();
   switch (camera.model()) {
     case LensModelId::kRadTan: {
       // ROS's plumb_bob has a k3; rcm's radtan model holds it at 0.
@@ -351,6 +380,11 @@ RosDistortion RosDistortionOf(const Camera& camera) {
     }
     case LensModelId::kEquidistant:
       return {"equidistant", camera.Distortion()};
+    case LensModelId::kRational:
+      return {"rational_polynomial", camera.Distortion()};
+    case LensModelId::kDoubleSphere:
+    case LensModelId::kEucm:
+      break;  // Refused above.
     case LensModelId::kPinhole:
       // ROS tools treat plumb_bob with zero coefficients as undistorted;
       // some reject "none".
@@ -378,6 +412,9 @@ std::string FormatCameraInfo(const CameraInfo& info) {
 }
 
 Status WriteCameraInfo(const std::string& path, const CameraInfo& info) {
+  if (Status status = CheckCameraInfoModel(info.camera); !status.ok()) {
+    return Status::Error(path + ": " + status.message());
+  }
   return WriteFileAtomically(path, FormatCameraInfo(info));
 }
 

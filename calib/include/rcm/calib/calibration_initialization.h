@@ -8,7 +8,14 @@
 //      image center, no distortion;
 //   2. target poses from those intrinsics (InitializeTargetPose);
 //   3. a single-camera bundle adjustment (Ceres, Huber loss at 1 px) of the
-//      camera's lens parameters and its poses, from zero distortion.
+//      camera's lens parameters and its poses, from StartingDistortion:
+//      zero distortion for the polynomial models (radtan, equidistant,
+//      rational), and for the unified models the start basalt uses,
+//      ds xi = 0, alpha = 0.5 and eucm alpha = 0.5, beta = 1 (the same
+//      lens, (x, y) / (0.5 sqrt(r^2 + 1) + 0.5): a pinhole at the center,
+//      whose focal length the closed form gives, with moderate barrel
+//      distortion off axis). The ds and eucm coefficients are kept in
+//      their ranges (DistortionBounds) here and in the stereo adjustment.
 // Step 3 is what cv::calibrateCamera / cv::fisheye::calibrate do after
 // step 1, for our lens models and with a sparse solver: OpenCV's dense LM
 // costs ~175 ms (calibrateCamera) and ~250 ms (fisheye::calibrate) on 18
@@ -35,6 +42,9 @@
 #include "rcm/util/status.h"
 
 namespace rcm::calib {
+
+// The distortion the single-camera adjustment starts from (see above).
+std::vector<double> StartingDistortion(LensModelId model);
 
 // The lens of one camera from the target's views in its images
 // (observations of one camera; at least 3, each with >= 4 corners).

@@ -60,7 +60,7 @@ inline constexpr double kUncertaintySpacingPx = 8.0;
 // d pi(p, x) / d p at the normalized point x: row 0 is d u, row 1 d v,
 // column k the k-th entry of camera.params(); columns from
 // camera.num_params() on are zero. Exact (automatic differentiation).
-Eigen::Matrix<double, 2, 8> PixelFromParamsJacobian(
+Eigen::Matrix<double, 2, kMaxLensParams> PixelFromParamsJacobian(
     const Camera& camera, const Eigen::Vector2d& normalized);
 
 // Sigma_u = J C J^T above; nullopt where `pixel` cannot be unprojected.

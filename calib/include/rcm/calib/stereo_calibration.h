@@ -63,7 +63,8 @@ struct ImageSize {
 };
 
 struct StereoCalibrationOptions {
-  // Lens model of both cameras: kRadTan or kEquidistant.
+  // Lens model of both cameras: any LensModelId (none, radtan,
+  // equidistant, rational, ds, eucm).
   LensModelId model = LensModelId::kRadTan;
   // Huber loss scale [px] for the robust solves.
   double huber_px = 1.0;
@@ -107,10 +108,11 @@ struct CameraCalibration {
   explicit CameraCalibration(const Camera& camera) : camera(camera) {}
 
   Camera camera;
-  // Covariance of camera.params() ([fx, fy, cx, cy, d0..d3]; the first
+  // Covariance of camera.params() ([fx, fy, cx, cy, d...]; the first
   // camera.num_params() rows/cols are used) and their standard deviations.
-  Eigen::Matrix<double, 8, 8> covariance = Eigen::Matrix<double, 8, 8>::Zero();
-  std::array<double, 8> sigma{};
+  Eigen::Matrix<double, kMaxLensParams, kMaxLensParams> covariance =
+      Eigen::Matrix<double, kMaxLensParams, kMaxLensParams>::Zero();
+  std::array<double, kMaxLensParams> sigma{};
 };
 
 // The covariance of every unknown of the final least-squares problem,

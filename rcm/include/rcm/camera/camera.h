@@ -17,11 +17,29 @@
 
 namespace rcm {
 
-// Kalibr's distortion_model names: "none", "radtan", "equidistant".
+// The model names: Kalibr's distortion_model names "none", "radtan",
+// "equidistant", Kalibr's camera_model names "ds" (double sphere) and
+// "eucm", and "rational" (OpenCV's rational model, which Kalibr does not
+// have; rcm's name, see docs/file_formats.md).
 std::string_view LensModelName(LensModelId model);
 std::optional<LensModelId> LensModelFromName(std::string_view name);
-// Number of distortion coefficients of a model (0 or 4).
+// Every model, in LensModelId order.
+const std::array<LensModelId, kNumLensModels>& AllLensModels();
+// "none, radtan, equidistant, rational, ds, eucm": for messages.
+std::string LensModelNameList();
+// Number of distortion coefficients of a model (0, 2, 4 or 8).
 int NumDistortionParams(LensModelId model);
+
+// Box bounds on a distortion coefficient (index into the distortion
+// coefficients, params + 4) that a solver fitting the lens must keep: the
+// ranges of Camera::CheckDistortion, closed 1e-6 inside their open ends
+// (ds xi > -1, eucm beta > 0). Empty for the polynomial models.
+struct DistortionBound {
+  int index = 0;
+  double lower = 0.0;
+  double upper = 0.0;
+};
+std::vector<DistortionBound> DistortionBounds(LensModelId model);
 
 // Calls `body` with `LensModel` bound to the static model struct of `id`,
 // e.g. RCM_LENS_MODEL_SWITCH(model_, return LensModel::kNumParams;)
@@ -37,6 +55,18 @@ int NumDistortionParams(LensModelId model);
     }                                           \
     case ::rcm::LensModelId::kEquidistant: {    \
       using LensModel = ::rcm::EquidistantLens; \
+      __VA_ARGS__                               \
+    }                                           \
+    case ::rcm::LensModelId::kRational: {       \
+      using LensModel = ::rcm::RationalLens;    \
+      __VA_ARGS__                               \
+    }                                           \
+    case ::rcm::LensModelId::kDoubleSphere: {   \
+      using LensModel = ::rcm::DoubleSphereLens; \
+      __VA_ARGS__                               \
+    }                                           \
+    case ::rcm::LensModelId::kEucm: {           \
+      using LensModel = ::rcm::EucmLens;        \
       __VA_ARGS__                               \
     }                                           \
   }
@@ -71,7 +101,9 @@ class Camera {
   // All four finite, focal lengths and principal point in the ranges above.
   static Status CheckIntrinsics(const std::array<double, 4>& intrinsics);
   // NumDistortionParams(model) coefficients, all finite and within the
-  // magnitude above.
+  // magnitude above; for the double sphere xi in (-1, 1] and alpha in
+  // [0, 1], for the EUCM alpha in [0, 1] and beta > 0 (lens_models.h says
+  // why). The message names the coefficient ("ds xi = 1.5 ...").
   static Status CheckDistortion(LensModelId model,
                                 const std::vector<double>& distortion);
 
@@ -119,9 +151,11 @@ class Camera {
   bool LensInvertibleAt(const Eigen::Vector2d& normalized) const;
 
   // The normalized radius at which the radial distortion first stops
-  // increasing (infinity when it never does: pinhole, and most real
+  // increasing (infinity when it never does: pinhole, EUCM, and most real
   // lenses within the field of view): radtan r (1 + k1 r^2 + k2 r^4),
-  // equidistant theta_d(theta) with r = tan(theta) (theta < pi/2).
+  // equidistant theta_d(theta) with r = tan(theta) (theta < pi/2),
+  // rational r n(r^2) / q(r^2) (or where q first reaches 0), double sphere
+  // r / N(r) (or where N first reaches 0).
   double MaxInvertibleRadius() const { return max_invertible_radius_; }
 
   // True when the pixel lies on the sensor: [-0.5, width - 0.5] x

@@ -21,6 +21,11 @@
 //                                                        OpenCV plumb bob k3=0)
 //   EquidistantLens   k1, k2, k3, k4                    (Kalibr "equidistant",
 //                                                        OpenCV fisheye)
+//   RationalLens      k1, k2, p1, p2, k3, k4, k5, k6    (OpenCV
+//                                                        CALIB_RATIONAL_MODEL,
+//                                                        mrcal OPENCV8)
+//   DoubleSphereLens  xi, alpha                         (Kalibr "ds", basalt)
+//   EucmLens          alpha, beta                       (Kalibr "eucm", basalt)
 //
 // Undistortion is iterative. It is solved in double precision (safeguarded
 // Newton), then one Newton step is taken in the scalar type T from the
@@ -31,15 +36,29 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "rcm/util/scalar.h"
 
 namespace rcm {
 
-enum class LensModelId { kPinhole = 0, kRadTan = 1, kEquidistant = 2 };
+enum class LensModelId {
+  kPinhole = 0,
+  kRadTan = 1,
+  kEquidistant = 2,
+  kRational = 3,
+  kDoubleSphere = 4,
+  kEucm = 5,
+};
 
-// The largest number of parameters of any lens model (fx, fy, cx, cy + 4).
-inline constexpr int kMaxLensParams = 8;
+// The number of lens models; LensModelId values are 0 .. kNumLensModels - 1.
+inline constexpr int kNumLensModels = 6;
+
+// The largest number of parameters of any lens model (fx, fy, cx, cy + 8,
+// the rational model), rounded up to 12 so that a model of up to 8
+// distortion coefficients more does not change the parameter blocks'
+// size again.
+inline constexpr int kMaxLensParams = 12;
 
 namespace lens_internal {
 
@@ -60,6 +79,31 @@ bool Solve2x2(const T a[4], const T b[2], T x[2]) {
   x[0] = (a[3] * b[0] - a[1] * b[1]) / det;
   x[1] = (a[0] * b[1] - a[2] * b[0]) / det;
   return true;
+}
+
+// The first normalized radius r = tan(theta) at which `increasing(r)`
+// stops holding, scanning theta in (0, pi/2) in `steps` steps and then
+// bisecting 60 times on the angle; infinity when it holds all the way. A
+// coarse scan can step over a failure narrower than its step.
+template <typename Predicate>
+double FirstRadiusWhereFalse(const Predicate& increasing, int steps) {
+  constexpr double kHalfPi = 1.5707963267948966;
+  for (int k = 1; k < steps; ++k) {
+    const double theta = kHalfPi * k / steps;
+    if (increasing(std::tan(theta))) continue;
+    double good = kHalfPi * (k - 1) / steps;
+    double bad = theta;
+    for (int it = 0; it < 60; ++it) {
+      const double middle = 0.5 * (good + bad);
+      if (increasing(std::tan(middle))) {
+        good = middle;
+      } else {
+        bad = middle;
+      }
+    }
+    return std::tan(good);
+  }
+  return std::numeric_limits<double>::infinity();
 }
 
 }  // namespace lens_internal
@@ -96,7 +140,7 @@ struct BaseLens {
     for (int i = 0; i < kNumDist; ++i) dist_value[i] = ScalarPart(dist[i]);
     const double target[2] = {ScalarPart(xd), ScalarPart(yd)};
     double point[2];
-    if (!UndistortScalar(dist_value, target, point)) return false;
+    if (!Derived::UndistortScalar(dist_value, target, point)) return false;
 
     // One Newton step in T from the converged point (see file comment).
     T fx, fy, jacobian[4];
@@ -110,15 +154,25 @@ struct BaseLens {
     return true;
   }
 
-  // The double-precision solve behind Undistort.
+  // The double-precision solve behind Undistort: Newton from the distorted
+  // point itself. A model with a closed-form inverse hides this with its
+  // own (which may end in NewtonFrom to polish).
   static bool UndistortScalar(const double* dist, const double target[2],
                               double point[2]) {
-    using lens_internal::kUndistortTolerance;
     if (!std::isfinite(target[0]) || !std::isfinite(target[1])) return false;
-    const double tolerance =
-        kUndistortTolerance * (1.0 + std::hypot(target[0], target[1]));
     point[0] = target[0];
     point[1] = target[1];
+    return NewtonFrom(dist, target, point);
+  }
+
+  // Safeguarded Newton on Distort(point) = target from the starting point
+  // in `point`; true when the residual reaches the tolerance.
+  static bool NewtonFrom(const double* dist, const double target[2],
+                         double point[2]) {
+    using lens_internal::kUndistortTolerance;
+    if (!std::isfinite(point[0]) || !std::isfinite(point[1])) return false;
+    const double tolerance =
+        kUndistortTolerance * (1.0 + std::hypot(target[0], target[1]));
     double f[2], jacobian[4];
     Derived::DistortWithJacobian(dist, point[0], point[1], &f[0], &f[1],
                                  jacobian);
@@ -421,6 +475,241 @@ struct EquidistantLens : public BaseLens<EquidistantLens> {
     return std::abs(f) <=
                1e3 * lens_internal::kUndistortTolerance * (1.0 + target) &&
            t < kHalfPi;
+  }
+};
+
+// Rational (OpenCV's CALIB_RATIONAL_MODEL, mrcal LENSMODEL_OPENCV8),
+// coefficients in OpenCV's order d = [k1, k2, p1, p2, k3, k4, k5, k6]:
+//   r^2 = x^2 + y^2
+//   radial = (1 + k1 r^2 + k2 r^4 + k3 r^6) / (1 + k4 r^2 + k5 r^4 + k6 r^6)
+//   xd = x radial + 2 p1 x y + p2 (r^2 + 2 x^2)
+//   yd = y radial + p1 (r^2 + 2 y^2) + 2 p2 x y
+// (OpenCV's documentation of cv::projectPoints, "Detailed description" of
+// the calib3d module). With k3..k6 = 0 it is RadTanLens.
+struct RationalLens : public BaseLens<RationalLens> {
+  static constexpr LensModelId kModelId = LensModelId::kRational;
+  static constexpr int kNumDistortionParams = 8;
+  static constexpr int kNumParams = 12;
+  static constexpr const char* kParamsInfo =
+      "fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, k5, k6";
+
+  // Numerator n(s), denominator q(s) of the radial factor at s = r^2 and
+  // their derivatives d/ds.
+  template <typename T>
+  static void RadialParts(const T* dist, const T& s, T* n, T* q, T* dn,
+                          T* dq) {
+    const T& k1 = dist[0];
+    const T& k2 = dist[1];
+    const T& k3 = dist[4];
+    const T& k4 = dist[5];
+    const T& k5 = dist[6];
+    const T& k6 = dist[7];
+    *n = T(1.0) + s * (k1 + s * (k2 + s * k3));
+    *q = T(1.0) + s * (k4 + s * (k5 + s * k6));
+    *dn = k1 + s * (T(2.0) * k2 + s * T(3.0) * k3);
+    *dq = k4 + s * (T(2.0) * k5 + s * T(3.0) * k6);
+  }
+
+  template <typename T>
+  static void Distort(const T* dist, const T& x, const T& y, T* xd, T* yd) {
+    DistortWithJacobian(dist, x, y, xd, yd, static_cast<T*>(nullptr));
+  }
+
+  // Analytic jacobian = d(xd, yd) / d(x, y), row-major 2x2, skipped when
+  // `jacobian` is null: as RadTanLens with
+  //   g = 2 d radial / ds = 2 (n' q - n q') / q^2
+  // for radial = n / q.
+  template <typename T>
+  static void DistortWithJacobian(const T* dist, const T& x, const T& y, T* xd,
+                                  T* yd, T* jacobian) {
+    const T& p1 = dist[2];
+    const T& p2 = dist[3];
+    const T x2 = x * x;
+    const T y2 = y * y;
+    const T xy = x * y;
+    const T r2 = x2 + y2;
+    T n, q, dn, dq;
+    RadialParts(dist, r2, &n, &q, &dn, &dq);
+    const T radial = n / q;
+    *xd = x * radial + T(2.0) * p1 * xy + p2 * (r2 + T(2.0) * x2);
+    *yd = y * radial + p1 * (r2 + T(2.0) * y2) + T(2.0) * p2 * xy;
+    if (jacobian == nullptr) return;
+    const T g = T(2.0) * (dn - radial * dq) / q;
+    const T cross = g * xy + T(2.0) * (p1 * x + p2 * y);
+    jacobian[0] = radial + g * x2 + T(2.0) * p1 * y + T(6.0) * p2 * x;
+    jacobian[1] = cross;
+    jacobian[2] = cross;
+    jacobian[3] = radial + g * y2 + T(6.0) * p1 * y + T(2.0) * p2 * x;
+  }
+
+  // True while the radial part r radial(r^2) is rising and its denominator
+  // positive (past a pole of the denominator it is not the lens any more).
+  static bool RadiallyIncreasing(const double* dist, double r) {
+    const double s = r * r;
+    double n, q, dn, dq;
+    RadialParts(dist, s, &n, &q, &dn, &dq);
+    // d/dr [r n / q] = ((n + 2 s n') q - 2 s n q') / q^2.
+    return q > 0.0 && (n + 2.0 * s * dn) * q - 2.0 * s * n * dq > 0.0;
+  }
+};
+
+// Double sphere (Usenko, Demmel, Cremers, "The Double Sphere Camera
+// Model", 3DV 2018; Kalibr "ds", basalt DoubleSphereCamera), d = [xi, alpha]:
+//   d1 = sqrt(x^2 + y^2 + 1)
+//   k  = xi d1 + 1
+//   d2 = sqrt(x^2 + y^2 + k^2)
+//   N  = alpha d2 + (1 - alpha) k
+//   (xd, yd) = (x, y) / N
+// On the plane z = 1 only rays in front of the camera exist, so the model
+// here covers fields of view below 180 degrees.
+// Unprojection is the paper's closed form (eq. 47-50, as basalt), with
+// (mx, my) = (xd, yd), r^2 = mx^2 + my^2:
+//   mz = (1 - alpha^2 r^2) / (alpha sqrt(1 - (2 alpha - 1) r^2) + 1 - alpha)
+//   s  = (mz xi + sqrt(mz^2 + (1 - xi^2) r^2)) / (mz^2 + r^2)
+//   ray = (s mx, s my, s mz - xi),  (x, y) = (s mx, s my) / (s mz - xi)
+// defined for r^2 < 1 / (2 alpha - 1) when alpha > 1/2, and in front of
+// the camera for s mz - xi > 0; then polished by Newton in double.
+// Accepted ranges (Camera::CheckDistortion): alpha in [0, 1] (the paper's
+// range; outside it N can vanish inside the image), xi in (-1, 1] (at
+// xi = -1 the optical axis itself is singular, k = 0; beyond 1 the sqrt of
+// the closed form goes negative and real lenses calibrate to |xi| < 1).
+struct DoubleSphereLens : public BaseLens<DoubleSphereLens> {
+  static constexpr LensModelId kModelId = LensModelId::kDoubleSphere;
+  static constexpr int kNumDistortionParams = 2;
+  static constexpr int kNumParams = 6;
+  static constexpr const char* kParamsInfo = "fx, fy, cx, cy, xi, alpha";
+
+  template <typename T>
+  static void Distort(const T* dist, const T& x, const T& y, T* xd, T* yd) {
+    DistortWithJacobian(dist, x, y, xd, yd, static_cast<T*>(nullptr));
+  }
+
+  // Analytic jacobian = d(xd, yd) / d(x, y), row-major 2x2, skipped when
+  // `jacobian` is null: dN/dx = c x, dN/dy = c y with
+  //   c = alpha (1 + xi k / d1) / d2 + (1 - alpha) xi / d1,
+  // so J = I / N - (c / N^2) (x, y)^T (x, y).
+  template <typename T>
+  static void DistortWithJacobian(const T* dist, const T& x, const T& y, T* xd,
+                                  T* yd, T* jacobian) {
+    using std::sqrt;
+    const T& xi = dist[0];
+    const T& alpha = dist[1];
+    const T r2 = x * x + y * y;
+    const T d1 = sqrt(r2 + T(1.0));
+    const T k = xi * d1 + T(1.0);
+    const T d2 = sqrt(r2 + k * k);
+    const T norm = alpha * d2 + (T(1.0) - alpha) * k;
+    const T inverse = T(1.0) / norm;
+    *xd = x * inverse;
+    *yd = y * inverse;
+    if (jacobian == nullptr) return;
+    const T c =
+        alpha * (T(1.0) + xi * k / d1) / d2 + (T(1.0) - alpha) * xi / d1;
+    const T b = c * inverse * inverse;
+    jacobian[0] = inverse - b * x * x;
+    jacobian[1] = -b * x * y;
+    jacobian[2] = jacobian[1];
+    jacobian[3] = inverse - b * y * y;
+  }
+
+  // The closed form above, then Newton from it.
+  static bool UndistortScalar(const double* dist, const double target[2],
+                              double point[2]) {
+    if (!std::isfinite(target[0]) || !std::isfinite(target[1])) return false;
+    const double xi = dist[0];
+    const double alpha = dist[1];
+    const double mx = target[0];
+    const double my = target[1];
+    const double r2 = mx * mx + my * my;
+    const double under = 1.0 - (2.0 * alpha - 1.0) * r2;
+    if (!(under >= 0.0)) return false;
+    const double mz =
+        (1.0 - alpha * alpha * r2) / (alpha * std::sqrt(under) + 1.0 - alpha);
+    const double inner = mz * mz + (1.0 - xi * xi) * r2;
+    if (!(inner >= 0.0)) return false;
+    const double s = (mz * xi + std::sqrt(inner)) / (mz * mz + r2);
+    const double z = s * mz - xi;
+    if (!(z > 0.0) || !std::isfinite(s)) return false;
+    point[0] = s * mx / z;
+    point[1] = s * my / z;
+    if (!RadiallyIncreasing(dist, std::hypot(point[0], point[1]))) {
+      return false;
+    }
+    return NewtonFrom(dist, target, point);
+  }
+
+  // True while the radial map r -> r / N(r) is rising and N positive.
+  static bool RadiallyIncreasing(const double* dist, double r) {
+    double xd, yd, jacobian[4];
+    DistortWithJacobian(dist, r, 0.0, &xd, &yd, jacobian);
+    return std::isfinite(xd) && (r == 0.0 || xd > 0.0) && jacobian[0] > 0.0;
+  }
+};
+
+// Enhanced unified camera model (Khomutenko, Garcia, Martinet, "An
+// Enhanced Unified Camera Model", RA-L 2016; Kalibr "eucm", basalt
+// ExtendedUnifiedCamera), d = [alpha, beta]:
+//   rho = sqrt(beta (x^2 + y^2) + 1)
+//   N   = alpha rho + 1 - alpha
+//   (xd, yd) = (x, y) / N
+// r / N(r) rises for every r (its derivative is (alpha / rho + 1 - alpha)
+// / N^2 > 0), so the map never folds in front of the camera.
+// Unprojection in closed form (as basalt), r^2 = xd^2 + yd^2:
+//   m = (1 - alpha^2 beta r^2) /
+//       (alpha sqrt(1 - (2 alpha - 1) beta r^2) + 1 - alpha)
+//   (x, y) = (xd, yd) / m
+// (m = 1 / N), in front of the camera for m > 0, then polished by Newton.
+// Accepted ranges (Camera::CheckDistortion): alpha in [0, 1] (the paper's),
+// beta > 0 (at beta = 0 the ellipsoid degenerates, N = 1, and alpha is
+// unobservable; negative beta has no ray beyond rho = 0).
+struct EucmLens : public BaseLens<EucmLens> {
+  static constexpr LensModelId kModelId = LensModelId::kEucm;
+  static constexpr int kNumDistortionParams = 2;
+  static constexpr int kNumParams = 6;
+  static constexpr const char* kParamsInfo = "fx, fy, cx, cy, alpha, beta";
+
+  template <typename T>
+  static void Distort(const T* dist, const T& x, const T& y, T* xd, T* yd) {
+    DistortWithJacobian(dist, x, y, xd, yd, static_cast<T*>(nullptr));
+  }
+
+  // Analytic jacobian = d(xd, yd) / d(x, y), row-major 2x2, skipped when
+  // `jacobian` is null: dN/dx = c x with c = alpha beta / rho, and
+  //   J = I / N - (c / N^2) (x, y)^T (x, y).
+  template <typename T>
+  static void DistortWithJacobian(const T* dist, const T& x, const T& y, T* xd,
+                                  T* yd, T* jacobian) {
+    using std::sqrt;
+    const T& alpha = dist[0];
+    const T& beta = dist[1];
+    const T rho = sqrt(beta * (x * x + y * y) + T(1.0));
+    const T norm = alpha * rho + T(1.0) - alpha;
+    const T inverse = T(1.0) / norm;
+    *xd = x * inverse;
+    *yd = y * inverse;
+    if (jacobian == nullptr) return;
+    const T b = alpha * beta / rho * inverse * inverse;
+    jacobian[0] = inverse - b * x * x;
+    jacobian[1] = -b * x * y;
+    jacobian[2] = jacobian[1];
+    jacobian[3] = inverse - b * y * y;
+  }
+
+  // The closed form above, then Newton from it.
+  static bool UndistortScalar(const double* dist, const double target[2],
+                              double point[2]) {
+    if (!std::isfinite(target[0]) || !std::isfinite(target[1])) return false;
+    const double alpha = dist[0];
+    const double beta = dist[1];
+    const double r2 = target[0] * target[0] + target[1] * target[1];
+    const double under = 1.0 - (2.0 * alpha - 1.0) * beta * r2;
+    if (!(under >= 0.0)) return false;
+    const double m = (1.0 - alpha * alpha * beta * r2) /
+                     (alpha * std::sqrt(under) + 1.0 - alpha);
+    if (!(m > 0.0) || !std::isfinite(m)) return false;
+    point[0] = target[0] / m;
+    point[1] = target[1] / m;
+    return NewtonFrom(dist, target, point);
   }
 };
 

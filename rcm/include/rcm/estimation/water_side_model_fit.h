@@ -1,5 +1,7 @@
 // The water-side model: the conventional central camera (a lens model of
-// lens_models.h: pinhole, radtan or equidistant) that best reproduces a
+// lens_models.h: pinhole, radtan, equidistant, rational, ds or eucm; the
+// ds and eucm coefficients kept in their ranges by bounds on the solve)
+// that best reproduces a
 // RefractiveCamera over its image. A VIO framework that loads only such
 // models (OpenVINS, VINS-Fusion, ORB-SLAM3, ROVIO) can then use the raw
 // underwater images directly, without remapping them (rcm export).
@@ -24,7 +26,7 @@
 // over the samples at least options.fit_inset of the width (height) from
 // the left and right (top and bottom) borders. Levenberg-Marquardt from
 // K_n = (n fx, n fy, cx, cy) with zero distortion (the virtual pinhole,
-// paper eq. 9). Deterministic: there is no measurement noise, only model
+// paper eq. 9; for the EUCM alpha = 0, beta = 1, its pinhole). Deterministic: there is no measurement noise, only model
 // error, so no covariance is reported; the figures of merit are the fit
 // errors. At n = 1 with M the camera's own lens model the fit returns the
 // camera itself.

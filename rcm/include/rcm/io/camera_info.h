@@ -74,12 +74,17 @@ CameraInfo CameraInfoFromCamera(const std::string& camera_name,
 // `camera`, as FormatCameraInfo and camera_info messages write them:
 //   radtan       -> plumb_bob [k1, k2, p1, p2, 0] (ROS's k3 held at 0);
 //   equidistant  -> equidistant [k1, k2, k3, k4];
+//   rational     -> rational_polynomial [k1, k2, p1, p2, k3, k4, k5, k6];
 //   pinhole      -> plumb_bob [0, 0, 0, 0, 0] (some ROS tools reject
 //                   "none"; zero coefficients read as undistorted).
+// ROS has no double-sphere or EUCM model: for those cameras
+// CheckCameraInfoModel fails (one line) and RosDistortionOf and
+// FormatCameraInfo must not be called.
 struct RosDistortion {
   std::string model;
   std::vector<double> coefficients;
 };
+Status CheckCameraInfoModel(const Camera& camera);
 RosDistortion RosDistortionOf(const Camera& camera);
 
 // The text camera_calibration_parsers writes (keys in its order:
@@ -90,11 +95,14 @@ RosDistortion RosDistortionOf(const Camera& camera);
 // reads back exactly the numbers written. Distortion models written:
 //   radtan       -> plumb_bob [k1, k2, p1, p2, 0];
 //   equidistant  -> equidistant [k1, k2, k3, k4];
+//   rational     -> rational_polynomial [k1, k2, p1, p2, k3, k4, k5, k6]
+//                   (read back as rational);
 //   pinhole      -> plumb_bob [0, 0, 0, 0, 0], what ROS tools expect of an
 //                   undistorted camera (it reads back as radtan with zero
 //                   coefficients: the same projection).
 std::string FormatCameraInfo(const CameraInfo& info);
 // Writes atomically (WriteFileAtomically): on failure `path` is untouched.
+// Fails with CheckCameraInfoModel's message for ds and eucm cameras.
 Status WriteCameraInfo(const std::string& path, const CameraInfo& info);
 
 // The stereo rig described by the camera_info files of the left and right
