@@ -70,6 +70,11 @@ Status TargetRenderOptions::Check() const {
     message << "background = " << background << " must be in [0, 255]";
   } else if (num_threads < 1) {
     message << "num_threads = " << num_threads << " must be >= 1";
+  } else if (!board_warp.warp.allFinite() ||
+             !board_warp.origin.allFinite() ||
+             !(board_warp.extent.minCoeff() > 0.0) ||
+             !board_warp.extent.allFinite()) {
+    message << "board_warp must be finite with a positive extent";
   } else {
     return Status::Ok();
   }

@@ -125,6 +125,47 @@ TEST(MeanFramesProjection, JacobianMatchesCentralDifferences) {
       MeanFramesProjectionUncertainty(calibration, 0, {376.0, 240.0}, -1.0)));
 }
 
+TEST(MeanFramesProjection, InTheReport) {
+  // The report's statistics and map of the mean-frames figure: finite,
+  // ordered, at the distance asked for.
+  const StereoRig rig = RadTanRig();
+  const StereoCalibration calibration = NoisyCalibration(rig, 12, 0.2, 3);
+  std::vector<StereoView> views(calibration.cam0_from_target.size());
+  const ImageSize size{rig.left().width(), rig.left().height()};
+  CalibrationReportOptions options;
+  const CalibrationReport at_infinity =
+      SummarizeCalibration(calibration, views, size, size, options);
+  options.uncertainty_distance_m = 1.0;
+  const CalibrationReport at_1m =
+      SummarizeCalibration(calibration, views, size, size, options);
+  for (int c = 0; c < 2; ++c) {
+    const CalibrationReport::CameraStats& s = at_infinity.cameras[c];
+    std::printf("cam%d: mean-frames median %.4f p95 %.4f max %.4f px at "
+                "infinity, median %.4f px at 1 m; intrinsics only median "
+                "%.4f px\n",
+                c, s.projection_uncertainty_median_px,
+                s.projection_uncertainty_p95_px,
+                s.projection_uncertainty_max_px,
+                at_1m.cameras[c].projection_uncertainty_median_px,
+                s.intrinsics_only_uncertainty_median_px);
+    EXPECT_GT(s.projection_uncertainty_median_px, 0.0);
+    EXPECT_LE(s.projection_uncertainty_median_px,
+              s.projection_uncertainty_p95_px);
+    EXPECT_LE(s.projection_uncertainty_p95_px, s.projection_uncertainty_max_px);
+    EXPECT_NE(s.projection_uncertainty_median_px,
+              at_1m.cameras[c].projection_uncertainty_median_px);
+    // The same sample as the function's at the image centre's cell.
+    EXPECT_TRUE(std::isfinite(s.projection_uncertainty_max_px));
+  }
+  const cv::Mat map = DrawMeanFramesUncertainty(calibration, 1, 1.0, 0.0,
+                                                "cam1");
+  EXPECT_EQ(map.type(), CV_8UC3);
+  EXPECT_GE(map.cols, size.width);
+  options.uncertainty_distance_m = 0.0;
+  EXPECT_FALSE(options.Check().ok());
+  EXPECT_EQ(DistanceName(kInfiniteDistance), "infinity");
+}
+
 // Worst-direction standard deviation of a sample of pixels.
 double SampleWorstSigma(const std::vector<Eigen::Vector2d>& samples) {
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();

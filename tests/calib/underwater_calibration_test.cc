@@ -285,15 +285,17 @@ TEST(UnderwaterCalibration, ExactThickPortRecoversAirGap) {
     EXPECT_TRUE(result->ports[0].air_gap_estimated);
     EXPECT_TRUE(result->ports[1].air_gap_estimated);
     EXPECT_NEAR(result->ports[1].port.air_gap, 0.009, kExactTolerance);
-    // Named blocks: n, the extrinsics, then the gaps.
+    // Named blocks: n, the extrinsics, the gaps, then the board's warp
+    // (estimated by default).
     const UnderwaterCovariance& covariance = result->covariance;
-    ASSERT_EQ(covariance.blocks.size(), 4u);
+    ASSERT_EQ(covariance.blocks.size(), 5u);
     EXPECT_EQ(covariance.blocks[0].name, "n");
     EXPECT_EQ(covariance.blocks[1].name, "cam1_from_cam0");
     EXPECT_EQ(covariance.blocks[2].name, "cam0 air_gap");
     EXPECT_EQ(covariance.blocks[3].name, "cam1 air_gap");
     EXPECT_EQ(covariance.blocks[3].offset, 8);
-    EXPECT_EQ(covariance.matrix.rows(), 9);
+    EXPECT_EQ(covariance.blocks[4].name, "board_warp");
+    EXPECT_EQ(covariance.matrix.rows(), 9 + 2);
   }
 }
 
@@ -334,7 +336,8 @@ TEST(UnderwaterCalibration, ExactTiltedPortRecoversTilt) {
   EXPECT_TRUE(result->ports[1].tilt_estimated);
   ASSERT_NE(result->covariance.Find("cam1 port_tilt"), nullptr);
   EXPECT_EQ(result->covariance.Find("cam1 port_tilt")->size, 2);
-  EXPECT_EQ(result->covariance.matrix.rows(), 1 + 6 + 2 + 4);
+  // n, the extrinsics, the gaps, the tilts and the board's warp.
+  EXPECT_EQ(result->covariance.matrix.rows(), 1 + 6 + 2 + 4 + 2);
 }
 
 TEST(UnderwaterCalibration, ExactSingleCamera) {
@@ -354,7 +357,8 @@ TEST(UnderwaterCalibration, ExactSingleCamera) {
   EXPECT_EQ(result->rig.right_from_left().translation,
             dive.air.right_from_left().translation);
   EXPECT_EQ(result->num_stereo_views, 0);
-  EXPECT_EQ(result->covariance.blocks.size(), 1u);
+  // n and the board's warp (estimated by default).
+  EXPECT_EQ(result->covariance.blocks.size(), 2u);
   EXPECT_EQ(result->extrinsic_change.angle_deg, 0.0);
 }
 

@@ -209,14 +209,39 @@ TEST(CalibrateCli, FoldersToCamchainAndReport) {
   EXPECT_EQ(json["stereo_views"], pairs.Stereo());
   EXPECT_EQ(json["cross_validation"]["folds"], 4);
   EXPECT_LT(json["rms_px"].get<double>(), 0.2);
+  // The board's flatness (a flat board rendered: its bowl within a few
+  // tenths of a millimetre, 0 within 4 sigma) and both uncertainties.
+  EXPECT_TRUE(json["board_flatness"]["estimated"].get<bool>());
+  EXPECT_EQ(json["board_flatness"]["board_warp_mm"].size(), 2u);
+  EXPECT_LT(std::abs(json["board_flatness"]["bowl_mm"].get<double>()),
+            4.0 * json["board_flatness"]["bowl_sigma_mm"].get<double>());
+  EXPECT_NE(result.out.find("board flatness: bowl "), std::string::npos)
+      << result.out;
+  EXPECT_EQ(json["projection_uncertainty"]["cam0"]["distance_m"], "inf");
+  EXPECT_GT(json["projection_uncertainty"]["cam1"]["median_px"].get<double>(),
+            0.0);
+  EXPECT_GT(
+      json["intrinsics_only_uncertainty_px"]["cam0"]["median"].get<double>(),
+      0.0);
+  EXPECT_NE(result.out.find("cam0 projection uncertainty at infinity"),
+            std::string::npos)
+      << result.out;
 }
 
 TEST(CalibrateCli, JsonOnStdoutAndAnOutputFolder) {
   const std::string dir = WriteFolders(Pairs(), "pairs");
   const RunResult result =
-      Rcm(Args(dir, dir + "/calibration", {"--json", "--folds", "0"}));
+      Rcm(Args(dir, dir + "/calibration",
+               {"--json", "--folds", "0", "--flat-board",
+                "--uncertainty-distance", "1.5"}));
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const nlohmann::json json = nlohmann::json::parse(result.out);
+  EXPECT_FALSE(json["board_flatness"]["estimated"].get<bool>());
+  EXPECT_EQ(json["projection_uncertainty"]["cam0"]["distance_m"], 1.5);
+  EXPECT_EQ(Rcm(Args(dir, dir + "/calibration",
+                     {"--uncertainty-distance", "-1"}))
+                .exit_code,
+            2);
   EXPECT_EQ(json["camchain"], dir + "/calibration/camchain.yaml");
   EXPECT_FALSE(json.contains("cross_validation"));
   EXPECT_EQ(json["cam0"]["distortion_model"], "radtan");

@@ -64,7 +64,8 @@ struct TargetRenderOptions {
   uint64_t seed = 0;           // the noise depends on it and the pixel only
   int background = 160;        // gray level where the target is not, 0..255
   int num_threads = 2;         // >= 1
-  // The board's bow (header); warp 0 (the default) is the flat board.
+  // The board's bow (header; BoardWarpSurfaceOf); warp 0 (the default) is
+  // the flat board. Finite, with a positive extent.
   BoardWarpSurface board_warp;
   Status Check() const;
 };
