@@ -1,5 +1,6 @@
 #include "calibration_input.h"
 
+#include <cmath>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include "image_input_flags.h"
+#include "number_list_flag.h"
 #include "rcm/calib/corners_file.h"
 
 DEFINE_string(corners, "",
@@ -76,26 +78,20 @@ StatusOr<NamePattern> PatternFromFlag(const std::string& flag,
 }
 
 StatusOr<calib::ImageSize> ImageSizeFromFlag() {
-  const std::string& text = FLAGS_image_size;
-  const size_t comma = text.find_first_of(",x");
-  calib::ImageSize size;
-  size_t end_w = 0;
-  size_t end_h = 0;
-  try {
-    if (comma == std::string::npos) throw std::invalid_argument("no comma");
-    size.width = std::stoi(text.substr(0, comma), &end_w);
-    size.height = std::stoi(text.substr(comma + 1), &end_h);
-  } catch (const std::exception&) {
-    end_w = 0;
-  }
-  if (end_w != comma || end_h != text.size() - comma - 1 || size.width < 1 ||
-      size.height < 1 || size.width > Camera::kMaxImageSide ||
-      size.height > Camera::kMaxImageSide) {
-    return Status::Error("--image-size " + text +
+  const StatusOr<std::vector<double>> numbers =
+      ParseNumberList(FLAGS_image_size);
+  const auto side = [](double value) {
+    return value >= 1.0 && value <= Camera::kMaxImageSide &&
+           value == std::floor(value);
+  };
+  if (!numbers.ok() || numbers->size() != 2 || !side((*numbers)[0]) ||
+      !side((*numbers)[1])) {
+    return Status::Error("--image-size " + FLAGS_image_size +
                          ": expected W,H in pixels, e.g. 640,480 (each in "
                          "[1, " + std::to_string(Camera::kMaxImageSide) + "])");
   }
-  return size;
+  return calib::ImageSize{static_cast<int>((*numbers)[0]),
+                          static_cast<int>((*numbers)[1])};
 }
 
 // The size of the first image of `names` that can be read, as it is named
@@ -115,14 +111,6 @@ std::optional<calib::ImageSize> SizeOfFirstReadable(
 
 std::string Count(int n, const std::string& what) {
   return std::to_string(n) + " " + what + (n == 1 ? "" : "s");
-}
-
-void CountViews(Detections* detections) {
-  for (const StereoView& view : detections->views) {
-    detections->stereo += view.stereo() ? 1 : 0;
-    detections->left_only += view.left && !view.right ? 1 : 0;
-    detections->right_only += view.right && !view.left ? 1 : 0;
-  }
 }
 
 StatusOr<CalibrationInput> ReadCornersInput(

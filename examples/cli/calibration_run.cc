@@ -106,6 +106,15 @@ nlohmann::json BoardFlatnessJson(bool estimated, const Eigen::Vector2d& warp,
   return json;
 }
 
+void CountViews(Detections* detections) {
+  detections->stereo = detections->left_only = detections->right_only = 0;
+  for (const calib::StereoView& view : detections->views) {
+    detections->stereo += view.stereo() ? 1 : 0;
+    detections->left_only += view.left && !view.right ? 1 : 0;
+    detections->right_only += view.right && !view.left ? 1 : 0;
+  }
+}
+
 StatusOr<Detections> DetectTargets(StereoImageSource* source,
                                    const calib::CalibrationTarget& target) {
   const size_t pairs = source->NumPairs();
@@ -209,11 +218,9 @@ StatusOr<Detections> DetectTargets(StereoImageSource* source,
       detections.warnings.push_back(pair.left_name + " and " +
                                     pair.right_name + ": " + view.note);
     }
-    detections.stereo += view.stereo() ? 1 : 0;
-    detections.left_only += view.left && !view.right ? 1 : 0;
-    detections.right_only += view.right && !view.left ? 1 : 0;
     detections.views.push_back(std::move(view));
   }
+  CountViews(&detections);
   return detections;
 }
 

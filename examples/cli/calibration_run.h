@@ -67,6 +67,8 @@ struct Detections {
   int left_only = 0;
   int right_only = 0;
 };
+// Sets the stereo / left_only / right_only counts from the views.
+void CountViews(Detections* detections);
 // Fails (one line) when one camera's images differ in size.
 StatusOr<Detections> DetectTargets(StereoImageSource* source,
                                    const calib::CalibrationTarget& target);
