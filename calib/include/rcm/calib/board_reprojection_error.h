@@ -79,6 +79,27 @@ void WarpedPoint(const Eigen::Vector3d& point, const Eigen::Vector2d& basis,
   out[2] = T(point.z()) + warp[0] * basis.x() + warp[1] * basis.y();
 }
 
+// The bowed board's point in cam0: R_v X(warp) + t_v.
+template <typename T>
+void WarpedPointInCam0(const Eigen::Vector3d& point,
+                       const Eigen::Vector2d& basis, const T* warp,
+                       const T* cam0_from_target, T out[3]) {
+  T warped[3];
+  WarpedPoint(point, basis, warp, warped);
+  TransformPoint(cam0_from_target, warped, out);
+}
+
+// ... and in cam1: R_10 (R_v X(warp) + t_v) + t_10.
+template <typename T>
+void WarpedPointInCam1(const Eigen::Vector3d& point,
+                       const Eigen::Vector2d& basis, const T* warp,
+                       const T* cam0_from_target, const T* cam1_from_cam0,
+                       T out[3]) {
+  T in_cam0[3];
+  WarpedPointInCam0(point, basis, warp, cam0_from_target, in_cam0);
+  TransformPoint(cam1_from_cam0, in_cam0, out);
+}
+
 }  // namespace board_internal
 
 // A corner seen by cam0: blocks (lens, cam0_from_target).
@@ -154,11 +175,9 @@ struct Cam0WarpedBoardReprojectionError {
   template <typename T>
   bool operator()(const T* lens, const T* cam0_from_target,
                   const T* board_warp, T* residuals) const {
-    T point[3];
-    board_internal::WarpedPoint(point_in_target, warp_basis, board_warp,
-                                point);
     T point_in_cam0[3];
-    board_internal::TransformPoint(cam0_from_target, point, point_in_cam0);
+    board_internal::WarpedPointInCam0(point_in_target, warp_basis, board_warp,
+                                      cam0_from_target, point_in_cam0);
     return board_internal::ProjectCameraPoint<LensModel>(lens, point_in_cam0,
                                                          residuals, pixel);
   }
@@ -190,14 +209,10 @@ struct Cam1WarpedBoardReprojectionError {
   bool operator()(const T* lens, const T* cam0_from_target,
                   const T* cam1_from_cam0, const T* board_warp,
                   T* residuals) const {
-    T point[3];
-    board_internal::WarpedPoint(point_in_target, warp_basis, board_warp,
-                                point);
-    T point_in_cam0[3];
-    board_internal::TransformPoint(cam0_from_target, point, point_in_cam0);
     T point_in_cam1[3];
-    board_internal::TransformPoint(cam1_from_cam0, point_in_cam0,
-                                   point_in_cam1);
+    board_internal::WarpedPointInCam1(point_in_target, warp_basis, board_warp,
+                                      cam0_from_target, cam1_from_cam0,
+                                      point_in_cam1);
     return board_internal::ProjectCameraPoint<LensModel>(lens, point_in_cam1,
                                                          residuals, pixel);
   }

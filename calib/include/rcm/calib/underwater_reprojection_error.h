@@ -100,11 +100,9 @@ struct Cam0UnderwaterReprojectionError {
   bool operator()(const T* n, const T* cam0_from_target, const T* air_gap,
                   const T* port_tilt, const T* board_warp,
                   T* residuals) const {
-    T point[3];
-    board_internal::WarpedPoint(point_in_target, warp_basis, board_warp,
-                                point);
     T point_in_cam0[3];
-    board_internal::TransformPoint(cam0_from_target, point, point_in_cam0);
+    board_internal::WarpedPointInCam0(point_in_target, warp_basis, board_warp,
+                                      cam0_from_target, point_in_cam0);
     return underwater_internal::ProjectThroughPort<LensModel>(
         constants, n[0], air_gap[0], port_tilt, point_in_cam0, pixel,
         residuals);
@@ -143,14 +141,10 @@ struct Cam1UnderwaterReprojectionError {
   bool operator()(const T* n, const T* cam0_from_target,
                   const T* cam1_from_cam0, const T* air_gap, const T* port_tilt,
                   const T* board_warp, T* residuals) const {
-    T point[3];
-    board_internal::WarpedPoint(point_in_target, warp_basis, board_warp,
-                                point);
-    T point_in_cam0[3];
-    board_internal::TransformPoint(cam0_from_target, point, point_in_cam0);
     T point_in_cam1[3];
-    board_internal::TransformPoint(cam1_from_cam0, point_in_cam0,
-                                   point_in_cam1);
+    board_internal::WarpedPointInCam1(point_in_target, warp_basis, board_warp,
+                                      cam0_from_target, cam1_from_cam0,
+                                      point_in_cam1);
     return underwater_internal::ProjectThroughPort<LensModel>(
         constants, n[0], air_gap[0], port_tilt, point_in_cam1, pixel,
         residuals);
