@@ -86,17 +86,8 @@ TEST(BoardWarp, IsMrcalsCalobjectWarp) {
 // warp, the translations) and radians, as in stereo_calibration_test.cc.
 constexpr double kExactTolerance = 1e-9;
 
-// EuRoC's radtan lens twice on a 0.11 m, 0.5-degree rig.
-StereoRig RadTanRig() {
-  const Camera left = rcm::test::EurocRadtanCamera();
-  Rigid3d right_from_left;
-  right_from_left.rotation =
-      Eigen::AngleAxisd(0.5 * M_PI / 180.0,
-                        Eigen::Vector3d(0.2, 1.0, 0.1).normalized())
-          .toRotationMatrix();
-  right_from_left.translation = Eigen::Vector3d(-0.11, 0.001, 0.002);
-  return StereoRig::Create(left, left, right_from_left).value();
-}
+// EuRoC's radtan lens twice on a 0.11 m, 0.5-degree rig (752x480).
+StereoRig RadTanRig() { return rcm::test::EurocRadtanTwinRig(); }
 
 void ExpectExactBowedBoard(const StereoRig& truth, LensModelId model) {
   const std::vector<Rigid3d> poses =

@@ -29,16 +29,7 @@ CalibrationTarget Checkerboard() {
 const Eigen::Vector2d kWarp(4e-4, 3e-4);
 
 // EuRoC's radtan lens twice on a 0.11 m, 0.5-degree rig (752x480).
-StereoRig RadTanRig() {
-  const Camera left = rcm::test::EurocRadtanCamera();
-  Rigid3d right_from_left;
-  right_from_left.rotation =
-      Eigen::AngleAxisd(0.5 * M_PI / 180.0,
-                        Eigen::Vector3d(0.2, 1.0, 0.1).normalized())
-          .toRotationMatrix();
-  right_from_left.translation = Eigen::Vector3d(-0.11, 0.001, 0.002);
-  return StereoRig::Create(left, left, right_from_left).value();
-}
+StereoRig RadTanRig() { return rcm::test::EurocRadtanTwinRig(); }
 
 StereoCalibration CalibrateViews(const StereoRig& rig,
                                  const std::vector<StereoView>& views) {

@@ -15,6 +15,17 @@ Camera AlphasenseCam1() { return AlphasenseFrontCam1(); }
 
 Camera EurocRadtanCamera() { return EurocCam0(); }
 
+StereoRig EurocRadtanTwinRig() {
+  const Camera camera = EurocRadtanCamera();
+  Rigid3d right_from_left;
+  right_from_left.rotation =
+      Eigen::AngleAxisd(0.5 * M_PI / 180.0,
+                        Eigen::Vector3d(0.2, 1.0, 0.1).normalized())
+          .toRotationMatrix();
+  right_from_left.translation = Eigen::Vector3d(-0.11, 0.001, 0.002);
+  return StereoRig::Create(camera, camera, right_from_left).value();
+}
+
 Camera PinholeCamera() {
   return Camera::Create(LensModelId::kPinhole, 640, 480,
                         {400.0, 400.0, 319.5, 239.5}, {})

@@ -20,6 +20,9 @@ Camera AlphasenseCam1();
 Camera EurocRadtanCamera();
 // 640x480, f = 400, no distortion.
 Camera PinholeCamera();
+// EurocRadtanCamera twice, cam1 turned by 0.5 degrees about
+// (0.2, 1, 0.1) and 0.11 m to the right: a rig the calibrations solve.
+StereoRig EurocRadtanTwinRig();
 // 1024x1024 equidistant (Alphasense coefficients) whose image corners see
 // rays 89.5 degrees off axis.
 Camera WideEquidistantCamera();
