@@ -624,16 +624,19 @@ StereoView DetectTargetPair(const cv::Mat& left, const cv::Mat& right,
           }
         });
   }
-  if (view.note.empty()) {
-    if (!view.left && !view.right) {
-      view.note = "board found in neither image";
-    } else if (!view.right) {
-      view.note = "board found in the left image only";
-    } else if (!view.left) {
-      view.note = "board found in the right image only";
-    }
-  }
+  NoteMissingTargets(&view);
   return view;
+}
+
+void NoteMissingTargets(StereoView* view) {
+  if (!view->note.empty()) return;
+  if (!view->left && !view->right) {
+    view->note = "board found in neither image";
+  } else if (!view->right) {
+    view->note = "board found in the left image only";
+  } else if (!view->left) {
+    view->note = "board found in the right image only";
+  }
 }
 
 }  // namespace rcm::calib

@@ -12,6 +12,7 @@
 #include "image_input_flags.h"
 #include "number_list_flag.h"
 #include "rcm/calib/corners_file.h"
+#include "rcm/calib/target_detector.h"
 
 DEFINE_string(corners, "",
               "calibrate from these corners (mrcal's corners.vnl format) "
@@ -191,12 +192,8 @@ StatusOr<CalibrationInput> ReadCornersInput(
       view.note = "no left image pairs with it";
     } else if (view.right_name.empty()) {
       view.note = "no right image pairs with it";
-    } else if (!view.left && !view.right) {
-      view.note = "board found in neither image";
-    } else if (!view.right) {
-      view.note = "board found in the left image only";
-    } else if (!view.left) {
-      view.note = "board found in the right image only";
+    } else {
+      calib::NoteMissingTargets(&view);
     }
     if (!view.note.empty()) {
       detections.warnings.push_back(

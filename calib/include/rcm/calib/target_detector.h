@@ -88,6 +88,11 @@ std::optional<TargetObservation> DetectTarget(
     const cv::Mat& image, const CalibrationTarget& target,
     const TargetDetectorOptions& options = {});
 
+// When view->note is empty, sets it to which of the pair's images lacks the
+// target: "board found in neither image", "... in the left image only",
+// "... in the right image only" (nothing when both have it).
+void NoteMissingTargets(StereoView* view);
+
 // Both images of a stereo pair (left = cam0), with consistent point ids;
 // `note` says why a view is missing or was dropped. The names and
 // timestamp are left empty for the caller.
