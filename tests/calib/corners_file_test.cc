@@ -61,7 +61,9 @@ TEST(CornersFile, RoundTripKeepsEveryPixelBitForBit) {
     const TargetObservation& out = *(*read)[i].observation;
     ASSERT_EQ(out.size(), in.size());
     for (int k = 0; k < out.size(); ++k) {
-      if (k > 0) EXPECT_LT(out.point_ids[k - 1], out.point_ids[k]);
+      if (k > 0) {
+        EXPECT_LT(out.point_ids[k - 1], out.point_ids[k]);
+      }
       const int id = out.point_ids[k];
       const auto at = std::find(in.point_ids.begin(), in.point_ids.end(), id);
       ASSERT_NE(at, in.point_ids.end());
