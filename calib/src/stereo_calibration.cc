@@ -93,6 +93,32 @@ void AddResiduals(LensModelId model, const std::vector<Corner>& corners,
   }
 }
 
+// A unified model's coefficient that ended at an end of its range (the
+// solver's box, DistortionBounds) is an error, not a camera: the fit
+// wanted to go beyond what the model can represent, so the lens it found
+// is not a minimum of the corners' errors, and a covariance taken at an
+// active bound means nothing. 1e-9 is far below any coefficient's sigma
+// and far above the solver's projection onto the box, which lands on the
+// bound itself.
+Status CheckNotPinned(LensModelId model, int camera, const double* lens) {
+  constexpr double kPinned = 1e-9;
+  for (const DistortionBound& bound : DistortionBounds(model)) {
+    const double value = lens[4 + bound.index];
+    const bool at_lower = value <= bound.lower + kPinned;
+    if (!at_lower && value < bound.upper - kPinned) continue;
+    const std::string others = model == LensModelId::kEucm
+                                   ? "ds or equidistant"
+                                   : "eucm or equidistant";
+    return Status::Error(
+        "the calibration failed: cam" + std::to_string(camera) + "'s " +
+        std::string(LensModelName(model)) + " " + bound.name + " ended at " +
+        FormatDouble(at_lower ? bound.lower : bound.upper) +
+        ", the end of its range, so the model does not fit these views " +
+        "(try --model " + others + ", or views that reach the image corners)");
+  }
+  return Status::Ok();
+}
+
 // The residual of one corner at the current parameters; NaN when the
 // corner is behind its camera.
 Eigen::Vector2d Residual(LensModelId model, const Corner& corner,
@@ -345,6 +371,7 @@ StatusOr<StereoCalibration> CalibrateStereo(
   // The result.
   for (int c = 0; c < 2; ++c) {
     const double* lens = parameters.lens[c].data();
+    RCM_RETURN_IF_ERROR(CheckNotPinned(options.model, c, lens));
     const std::vector<double> distortion(lens + 4, lens + num_lens_params);
     StatusOr<Camera> camera =
         Camera::Create(options.model, sizes[c].width, sizes[c].height,

@@ -117,10 +117,10 @@ std::vector<DistortionBound> DistortionBounds(LensModelId model) {
   constexpr double kInside = 1e-6;
   switch (model) {
     case LensModelId::kDoubleSphere:
-      return {{0, -1.0 + kInside, 1.0}, {1, 0.0, 1.0}};
+      return {{0, -1.0 + kInside, 1.0, "xi"}, {1, 0.0, 1.0, "alpha"}};
     case LensModelId::kEucm:
-      return {{0, 0.0, 1.0},
-              {1, kInside, Camera::kMaxDistortionCoefficient}};
+      return {{0, 0.0, 1.0, "alpha"},
+              {1, kInside, Camera::kMaxDistortionCoefficient, "beta"}};
     default:
       return {};
   }

@@ -14,8 +14,12 @@
 //      ds xi = 0, alpha = 0.5 and eucm alpha = 0.5, beta = 1 (the same
 //      lens, (x, y) / (0.5 sqrt(r^2 + 1) + 0.5): a pinhole at the center,
 //      whose focal length the closed form gives, with moderate barrel
-//      distortion off axis). The ds and eucm coefficients are kept in
-//      their ranges (DistortionBounds) here and in the stereo adjustment.
+//      distortion off axis). The double sphere is refined from six starts,
+//      xi = -0.4 ... 0.6 at the same near-axis focal length f / (1 + xi),
+//      and the lowest cost is kept: its f and xi trade along a long curved
+//      valley in which a single start stopped far from the minimum. The ds
+//      and eucm coefficients are kept in their ranges (DistortionBounds)
+//      here and in the stereo adjustment.
 // Step 3 is what cv::calibrateCamera / cv::fisheye::calibrate do after
 // step 1, for our lens models and with a sparse solver: OpenCV's dense LM
 // costs ~175 ms (calibrateCamera) and ~250 ms (fisheye::calibrate) on 18

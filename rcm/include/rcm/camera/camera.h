@@ -38,6 +38,7 @@ struct DistortionBound {
   int index = 0;
   double lower = 0.0;
   double upper = 0.0;
+  const char* name = "";  // "xi", "alpha", "beta": for messages
 };
 std::vector<DistortionBound> DistortionBounds(LensModelId model);
 
