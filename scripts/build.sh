@@ -7,5 +7,13 @@ cd "$(dirname "$0")/.."
 ./scripts/setup.sh
 # Debian's interpreter, which has python3-numpy (a pyenv or venv python3
 # earlier on PATH may not): the Python package is built for it.
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPython3_EXECUTABLE=/usr/bin/python3 "$@"
+# Ninja (ninja-build) for a new build folder: it compiles a target's
+# objects while the libraries they link are still being built, which
+# make's per-target steps do not. An existing folder keeps its generator.
+generator=()
+if [[ ! -f build/CMakeCache.txt ]] && command -v ninja >/dev/null; then
+  generator=(-G Ninja)
+fi
+cmake -S . -B build "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \
+  -DPython3_EXECUTABLE=/usr/bin/python3 "$@"
 cmake --build build -j2

@@ -8,6 +8,7 @@ set -euo pipefail
 # Why each package is here: see README.md, section "Dependencies".
 packages=(
   build-essential cmake pkg-config
+  ninja-build          # the build tool scripts/build.sh uses (make works too)
   libeigen3-dev        # linear algebra, fixed-size math in the model
   libceres-dev         # nonlinear least squares, ceres::Jet autodiff
   libgflags-dev        # command-line flags of the rcm executable

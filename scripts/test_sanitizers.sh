@@ -12,7 +12,11 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 fuzz_seconds=${1:-10}
 ./scripts/setup.sh
-cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=Release \
+generator=()  # Ninja for a new build folder, as scripts/build.sh
+if [[ ! -f build-sanitize/CMakeCache.txt ]] && command -v ninja >/dev/null; then
+  generator=(-G Ninja)
+fi
+cmake -S . -B build-sanitize "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_CXX_FLAGS=-gline-tables-only \
   -DRCM_SANITIZE=address,undefined -DRCM_BUILD_FUZZERS=ON \
   -DRCM_BUILD_BENCHMARKS=OFF -DBUILD_SHARED_LIBS=OFF -DRCM_BUILD_PYTHON=OFF \
