@@ -1,0 +1,168 @@
+// LivePipeline: rcm as it runs on the robot, between the camera driver and
+// the VIO, free of any middleware. The ROS1 node (ros/rcm_ros_node.cc) is a
+// thin adapter over it; a ROS 2 node would be another.
+//
+// Per stereo pair, Process(left, right, stamp), on the caller's thread:
+//   1. the pair is checked: 8-bit images (gray, BGR or BGRA) of the
+//      calibration's size, and not blank (a black, saturated or covered
+//      frame: the gray standard deviation of either image below
+//      min_contrast). A refused pair is an error (one line), changes
+//      nothing and produces nothing;
+//   2. the front end (stereo_front_end.h) matches it, guided by the last
+//      pair's own estimate n_f +- max(6 sigma_f, 0.01) (as `rcm estimate`
+//      on images), or over the prior search range when there is none;
+//   3. the sliding-window estimator (sliding_window_estimator.h) takes the
+//      matches: the window's n and total sigma_n, and whether this pair
+//      confirmed a change of medium. No estimate (too few matches, n not
+//      observable, n pinned at the upper bound of [1, 2], which a stale
+//      calibration gives) is the estimate's error, never a number;
+//   4. both images are remapped to the corrected pinhole pair
+//      (virtual_pinhole_rig.h) with the maps of n_maps.
+//
+// The maps. n_maps starts at options.initial_n, whose maps Create builds.
+// When the window's n differs from n_maps by more than map_update_threshold
+// (and the pipeline is not on hold), maps for that n are built on a worker
+// thread while the pairs keep being corrected with the current ones; the
+// first pair processed after the build has finished uses the new maps
+// (LiveFrame::maps_updated). One build at a time: if n has moved on when
+// it finishes, the next pair starts another. A build costs ~50-150 ms for
+// 720x540 on one core (the benchmark), several pairs at 20 Hz, hence the
+// worker. The threshold's default, 1e-3, moves the corrected images'
+// focal length by 0.1 %, below what a metric depth of 1 % needs.
+//
+// Hold (SetHold): the maps stay at their n and no build starts; the
+// estimation keeps running and is reported. Reset(n): a new window and no
+// guide (as at start-up), and with n, maps for n (built on the worker).
+//
+// Threads: Process, Reset and SetHold are called from one thread (not
+// thread-safe); the map builds run on their own worker. The corrected
+// images of a LiveFrame are the pipeline's buffers, overwritten by the next
+// Process (no allocation per pair): copy what must outlive it.
+#ifndef RCM_LIVE_LIVE_PIPELINE_H_
+#define RCM_LIVE_LIVE_PIPELINE_H_
+
+#include <cstdint>
+#include <future>
+#include <memory>
+#include <optional>
+#include <opencv2/core.hpp>
+
+#include "rcm/camera/virtual_pinhole_rig.h"
+#include "rcm/estimation/refinement_options.h"
+#include "rcm/estimation/sliding_window_estimator.h"
+#include "rcm/frontend/stereo_front_end.h"
+#include "rcm/geometry/stereo_rig.h"
+#include "rcm/util/status.h"
+
+namespace rcm {
+
+struct LivePipelineOptions {
+  StereoFrontEndOptions front_end;
+  // The estimator's options; systematic_px defaults to the front end's
+  // floor (kFrontEndSystematicPx), as `rcm estimate` on images.
+  RefinementOptions refinement = DefaultRefinement();
+  SlidingWindowOptions window;
+  // The corrected pair: fit, rectify, output size (virtual_pinhole_rig.h).
+  // num_threads is the worker's.
+  VirtualPinholeRigOptions correction = DefaultCorrection();
+  // n of the maps before any estimate; in [1, 2]. 1: the robot starts in
+  // air.
+  double initial_n = 1.0;
+  // |n - n_maps| above which new maps are built; > 0 and finite.
+  double map_update_threshold = 1e-3;
+  // A gray standard deviation below this (either image) refuses the pair
+  // as blank; >= 0 (0 accepts every pair). 2 gray levels: a lit scene has
+  // tens, a covered or black frame its sensor noise.
+  double min_contrast = 2.0;
+
+  static RefinementOptions DefaultRefinement();
+  static VirtualPinholeRigOptions DefaultCorrection();
+  Status Check() const;
+};
+
+// What one pair gave.
+struct LiveFrame {
+  int64_t frame = 0;   // 0, 1, ... in the order of Process calls accepted
+  double stamp = 0.0;  // the caller's, unchanged
+  int64_t num_matches = 0;
+  // The window estimate after this pair, or why there is none.
+  StatusOr<SlidingWindowRefractiveIndexEstimator::Estimate> estimate =
+      Status::Error("no estimate");
+  // This pair confirmed a change of medium (the window restarted).
+  std::optional<MediumSwitch> medium_switch;
+  bool held = false;
+  // The corrected pair and its rig: the maps' n, and whether the maps
+  // changed at this pair.
+  double maps_n = 1.0;
+  bool maps_updated = false;
+  cv::Mat left_corrected;
+  cv::Mat right_corrected;
+  std::shared_ptr<const VirtualPinholeRig> corrected;
+  // Milliseconds of this pair's stages.
+  double match_ms = 0.0;
+  double estimate_ms = 0.0;
+  double remap_ms = 0.0;
+};
+
+class LivePipeline {
+ public:
+  // Builds the front end, the estimator and the maps of initial_n. Errors:
+  // options.Check(), and the rig's (no maps for it).
+  static StatusOr<std::unique_ptr<LivePipeline>> Create(
+      const StereoRig& rig, const LivePipelineOptions& options);
+  ~LivePipeline();
+  LivePipeline(const LivePipeline&) = delete;
+  LivePipeline& operator=(const LivePipeline&) = delete;
+
+  // One stereo pair (raw images, as the cameras give them). Errors: the
+  // pair is refused (1. above), or the front end failed; the pipeline is
+  // then unchanged.
+  StatusOr<LiveFrame> Process(const cv::Mat& left, const cv::Mat& right,
+                              double stamp);
+
+  // A new window and no guide; with n (in [1, 2]), maps for n are built.
+  Status Reset(std::optional<double> n = std::nullopt);
+  // On hold, a build in flight is waited for and discarded.
+  void SetHold(bool hold);
+  bool hold() const { return hold_; }
+
+  const StereoRig& rig() const { return rig_; }
+  const LivePipelineOptions& options() const { return options_; }
+  // The maps in use, and whether a build is in flight.
+  const VirtualPinholeRig& corrected() const { return *maps_; }
+  bool building() const { return pending_.valid(); }
+  // Waits for a build in flight and puts its maps in use (tests,
+  // shutdown); false when none was in flight.
+  bool WaitForMaps();
+  // Pairs refused at step 1, and map builds that failed.
+  int64_t num_refused() const { return num_refused_; }
+  int64_t num_failed_builds() const { return num_failed_builds_; }
+
+ private:
+  LivePipeline(const StereoRig& rig, const LivePipelineOptions& options,
+               StereoFrontEnd front_end,
+               SlidingWindowRefractiveIndexEstimator estimator,
+               std::shared_ptr<const VirtualPinholeRig> maps);
+  // Puts a finished build in use; true when the maps changed.
+  bool CollectBuild(bool wait);
+  void StartBuild(double n);
+
+  StereoRig rig_;
+  LivePipelineOptions options_;
+  StereoFrontEnd front_end_;
+  SlidingWindowRefractiveIndexEstimator estimator_;
+  std::shared_ptr<const VirtualPinholeRig> maps_;
+  std::future<StatusOr<VirtualPinholeRig>> pending_;
+  double pending_n_ = 0.0;
+  std::optional<RefractiveIndexInterval> guide_;
+  bool hold_ = false;
+  int64_t next_frame_ = 0;
+  int64_t num_refused_ = 0;
+  int64_t num_failed_builds_ = 0;
+  cv::Mat left_corrected_;
+  cv::Mat right_corrected_;
+};
+
+}  // namespace rcm
+
+#endif  // RCM_LIVE_LIVE_PIPELINE_H_
