@@ -80,6 +80,10 @@ Status LivePipelineOptions::Check() const {
         "the map update threshold must be positive and finite, not " +
         FormatDouble(map_update_threshold));
   }
+  if (max_matches < 0) {
+    return Status::Error("max matches must be >= 0, not " +
+                         std::to_string(max_matches));
+  }
   if (!(min_contrast >= 0.0) || !std::isfinite(min_contrast)) {
     return Status::Error("min contrast must be >= 0 and finite, not " +
                          FormatDouble(min_contrast));
@@ -217,8 +221,19 @@ StatusOr<LiveFrame> LivePipeline::Process(const cv::Mat& left,
 
   // 3. The window.
   const auto estimate_start = std::chrono::steady_clock::now();
+  const std::vector<StereoCorrespondence>* matches = &matched->matches;
+  const size_t cap = static_cast<size_t>(options_.max_matches);
+  if (cap > 0 && matches->size() > cap) {
+    subset_.clear();
+    subset_.reserve(cap);
+    for (size_t k = 0; k < cap; ++k) {
+      subset_.push_back((*matches)[k * matches->size() / cap]);
+    }
+    matches = &subset_;
+  }
+  out.num_estimated = static_cast<int64_t>(matches->size());
   SlidingWindowRefractiveIndexEstimator::WindowUpdate update =
-      estimator_.AddFrame(out.frame, matched->matches);
+      estimator_.AddFrame(out.frame, *matches);
   out.estimate_ms = Milliseconds(estimate_start);
   if (update.frame_estimate.ok()) {
     guide_ = RefractiveIndexInterval::Around(

@@ -25,9 +25,14 @@
 // thread while the pairs keep being corrected with the current ones; the
 // first pair processed after the build has finished uses the new maps
 // (LiveFrame::maps_updated). One build at a time: if n has moved on when
-// it finishes, the next pair starts another. A build costs ~50-150 ms for
-// 720x540 on one core (the benchmark), several pairs at 20 Hz, hence the
-// worker. The threshold's default, 1e-3, moves the corrected images'
+// it finishes, the next pair starts another. A build costs 47 ms for
+// 720x540 on one core (benchmarks/live_benchmark.cc), about a pair's whole
+// period at 20 Hz, hence the worker.
+//
+// Cost per 720x540 pair (live_benchmark, this project's 2-core machine):
+// the window's update of 400 matches and both remaps 17.5 ms of CPU, 35 %
+// of one core at 20 Hz; the front end's matching adds ~27 ms (on both
+// cores, 25 ms wall for the whole Process). The threshold's default, 1e-3, moves the corrected images'
 // focal length by 0.1 %, below what a metric depth of 1 % needs.
 //
 // Hold (SetHold): the maps stay at their n and no build starts; the
@@ -46,6 +51,7 @@
 #include <memory>
 #include <optional>
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "rcm/camera/virtual_pinhole_rig.h"
 #include "rcm/estimation/refinement_options.h"
@@ -70,6 +76,14 @@ struct LivePipelineOptions {
   double initial_n = 1.0;
   // |n - n_maps| above which new maps are built; > 0 and finite.
   double map_update_threshold = 1e-3;
+  // Matches of a pair the window takes at most, every k-th of the front
+  // end's (which come in image order, so the subset keeps their spread);
+  // >= 0, 0 takes all. The window's update costs ~44 us of CPU per match
+  // (the robust fit's scan and the self-calibrated rotation): the ~1200
+  // matches of a 720x540 pair take 52 ms, over the 25 ms that half a core
+  // at 20 Hz allows; 400 take a third. Their noise share of sigma_n grows
+  // by sqrt(3), under the calibration's share on a drifting rig.
+  int max_matches = 400;
   // A gray standard deviation below this (either image) refuses the pair
   // as blank; >= 0 (0 accepts every pair). 2 gray levels: a lit scene has
   // tens, a covered or black frame its sensor noise.
@@ -84,7 +98,8 @@ struct LivePipelineOptions {
 struct LiveFrame {
   int64_t frame = 0;   // 0, 1, ... in the order of Process calls accepted
   double stamp = 0.0;  // the caller's, unchanged
-  int64_t num_matches = 0;
+  int64_t num_matches = 0;    // the front end's
+  int64_t num_estimated = 0;  // of them, the window's (max_matches)
   // The window estimate after this pair, or why there is none.
   StatusOr<SlidingWindowRefractiveIndexEstimator::Estimate> estimate =
       Status::Error("no estimate");
@@ -161,6 +176,7 @@ class LivePipeline {
   int64_t num_failed_builds_ = 0;
   cv::Mat left_corrected_;
   cv::Mat right_corrected_;
+  std::vector<StereoCorrespondence> subset_;  // reused: no allocation
 };
 
 }  // namespace rcm
