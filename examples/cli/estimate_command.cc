@@ -248,11 +248,6 @@ struct ImageRun {
   std::vector<StereoCorrespondence> picture_matches;
 };
 
-// The guide of the next pair: the last pair's own estimate of n, widened
-// to 6 sigma and at least +-0.01 (a few frames' drift of a real medium).
-constexpr double kGuideSigmas = 6.0;
-constexpr double kGuideMinHalfWidth = 0.01;
-
 double Milliseconds(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(
              std::chrono::steady_clock::now() - start)
@@ -303,8 +298,7 @@ StatusOr<ImageRun> RunFrontEnd(const StereoRig& rig,
     if (own.ok()) {
       row.n = own->n;
       row.sigma_n = own->sigma_n;
-      guide = RefractiveIndexInterval::Around(own->n, own->sigma_n,
-                                              kGuideSigmas, kGuideMinHalfWidth);
+      guide = NextPairGuide(own->n, own->sigma_n);
       status += ", n = " + FormatFixed(own->n, 4) + " +- " +
                 FormatFixed(own->sigma_n, 4);
     } else {

@@ -16,6 +16,7 @@
 #include "rcm/calib/target_detector.h"
 #include "rcm/calib/target_image.h"
 #include "rcm/calib/target_renderer.h"
+#include "support/projection_error.h"
 #include "support/test_rigs.h"
 
 namespace rcm::calib {
@@ -135,24 +136,6 @@ StereoRig UnifiedRig(LensModelId model) {
       .value();
 }
 
-// The largest distance between the pixels of the estimate and of the
-// truth over the truth's image (8 px grid).
-double MaxProjectionError(const Camera& estimate, const Camera& truth) {
-  double worst = 0.0;
-  for (double v = -0.5; v <= truth.height() - 0.5; v += 8.0) {
-    for (double u = -0.5; u <= truth.width() - 0.5; u += 8.0) {
-      const std::optional<Eigen::Vector2d> ray =
-          truth.NormalizedFromImage(Eigen::Vector2d(u, v));
-      if (!ray) continue;
-      const std::optional<Eigen::Vector2d> pixel =
-          estimate.ProjectNormalized(*ray);
-      if (!pixel) return std::numeric_limits<double>::infinity();
-      worst = std::max(worst, (*pixel - Eigen::Vector2d(u, v)).norm());
-    }
-  }
-  return worst;
-}
-
 void ExpectUnifiedModelRecovered(LensModelId model) {
   const StereoRig rig = UnifiedRig(model);
   const CalibrationTarget target = MakeCheckerboardTarget(9, 6, 0.04).value();
@@ -167,7 +150,7 @@ void ExpectUnifiedModelRecovered(LensModelId model) {
     ASSERT_EQ(estimate.model(), model);
     const std::vector<double> e = estimate.Distortion();
     const std::vector<double> t = truths[c]->Distortion();
-    const double projection_error = MaxProjectionError(estimate, *truths[c]);
+    const double projection_error = rcm::test::MaxProjectionErrorPx(estimate, *truths[c], 8.0);
     std::printf(
         "cam%d %s: [%.5f, %.5f] for [%.5f, %.5f] (sigma %.1e %.1e), "
         "projection within %.3f px\n",

@@ -13,6 +13,7 @@
 
 #include "calib/synthetic_target_views.h"
 #include "support/sample_moments.h"
+#include "support/projection_error.h"
 #include "support/test_rigs.h"
 
 namespace rcm::calib {
@@ -142,25 +143,6 @@ Truth TwinTruth(const Camera& left) {
           left.model()};
 }
 
-// The largest distance between the pixels of `estimate` and `truth` over
-// the truth's image (4 px grid): how far apart two lenses are where their
-// coefficients are not identifiable one by one.
-double MaxProjectionErrorPx(const Camera& estimate, const Camera& truth) {
-  double worst = 0.0;
-  for (double v = -0.5; v <= truth.height() - 0.5; v += 4.0) {
-    for (double u = -0.5; u <= truth.width() - 0.5; u += 4.0) {
-      const std::optional<Eigen::Vector2d> ray =
-          truth.NormalizedFromImage(Eigen::Vector2d(u, v));
-      if (!ray) continue;
-      const std::optional<Eigen::Vector2d> pixel =
-          estimate.ProjectNormalized(*ray);
-      if (!pixel) return std::numeric_limits<double>::infinity();
-      worst = std::max(worst, (*pixel - Eigen::Vector2d(u, v)).norm());
-    }
-  }
-  return worst;
-}
-
 StatusOr<StereoCalibration> CalibrateExact(const Truth& truth) {
   return Calibrate(truth, ObserveStereo(truth.rig, Checkerboard(),
                                         BoardPoses(truth.rig.left(),
@@ -185,7 +167,7 @@ TEST(StereoCalibration, ExactRationalProjectsAsTheTruth) {
                                 &calibration->cam1.camera};
   const Camera* truths[2] = {&truth.rig.left(), &truth.rig.right()};
   for (int c = 0; c < 2; ++c) {
-    EXPECT_LT(MaxProjectionErrorPx(*estimates[c], *truths[c]),
+    EXPECT_LT(rcm::test::MaxProjectionErrorPx(*estimates[c], *truths[c], 4.0),
               kMaxProjectionPx)
         << "cam" << c;
   }

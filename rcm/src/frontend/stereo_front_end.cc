@@ -7,6 +7,14 @@
 #include "rcm/util/parallel_for.h"
 
 namespace rcm {
+
+RefractiveIndexInterval NextPairGuide(double n, double sigma_n) {
+  constexpr double kGuideSigmas = 6.0;
+  constexpr double kGuideMinHalfWidth = 0.01;
+  return RefractiveIndexInterval::Around(n, sigma_n, kGuideSigmas,
+                                         kGuideMinHalfWidth);
+}
+
 namespace {
 
 using Clock = std::chrono::steady_clock;

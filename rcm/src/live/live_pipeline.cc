@@ -1,5 +1,6 @@
 #include "rcm/live/live_pipeline.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
@@ -11,11 +12,6 @@
 
 namespace rcm {
 namespace {
-
-// The guide of the next pair, as `rcm estimate` on images: the last pair's
-// own estimate widened to 6 sigma and at least +-0.01.
-constexpr double kGuideSigmas = 6.0;
-constexpr double kGuideMinHalfWidth = 0.01;
 
 double Milliseconds(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(
@@ -236,9 +232,8 @@ StatusOr<LiveFrame> LivePipeline::Process(const cv::Mat& left,
       estimator_.AddFrame(out.frame, *matches);
   out.estimate_ms = Milliseconds(estimate_start);
   if (update.frame_estimate.ok()) {
-    guide_ = RefractiveIndexInterval::Around(
-        update.frame_estimate->n, update.frame_estimate->sigma_n,
-        kGuideSigmas, kGuideMinHalfWidth);
+    guide_ = NextPairGuide(update.frame_estimate->n,
+                           update.frame_estimate->sigma_n);
   } else {
     guide_.reset();
   }

@@ -48,6 +48,12 @@ namespace rcm {
 // field covers that.
 inline constexpr double kFrontEndSystematicPx = 0.03;
 
+// The guide of a sequence's next pair (Match's `guide`): the last pair's
+// own estimate of n, widened to 6 sigma and at least +-0.01 (a few frames'
+// drift of a real medium). `rcm estimate` on images and the live pipeline
+// both guide with it.
+RefractiveIndexInterval NextPairGuide(double n, double sigma_n);
+
 struct StereoFrontEndOptions {
   ClaheOptions clahe;
   FeatureOptions features;
