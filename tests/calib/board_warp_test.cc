@@ -35,11 +35,10 @@ CalibrationTarget Checkerboard() {
 // at the centre (the 0.74 mm measured on a printed 9x6 board).
 const Eigen::Vector2d kWarp(4e-4, 3e-4);
 
-StatusOr<StereoCalibration> Calibrate(const StereoRig& rig, LensModelId model,
-                                      const std::vector<StereoView>& views,
-                                      bool estimate_warp,
-                                      const CalibrationTarget& target =
-                                          Checkerboard()) {
+StatusOr<StereoCalibration> Calibrate(
+    const StereoRig& rig, LensModelId model,
+    const std::vector<StereoView>& views, bool estimate_warp,
+    const CalibrationTarget& target = Checkerboard()) {
   StereoCalibrationOptions options;
   options.model = model;
   options.estimate_board_warp = estimate_warp;
@@ -58,8 +57,8 @@ TEST(BoardWarp, IsMrcalsCalobjectWarp) {
     for (int i = 0; i < 9; ++i) {
       const double xr = i / 8.0;
       const double yr = j / 5.0;
-      const double z = kWarp.x() * 4.0 * xr * (1.0 - xr) +
-                       kWarp.y() * 4.0 * yr * (1.0 - yr);
+      const double z =
+          kWarp.x() * 4.0 * xr * (1.0 - xr) + kWarp.y() * 4.0 * yr * (1.0 - yr);
       EXPECT_NEAR(points[j * 9 + i].z(), z, 1e-18) << i << " " << j;
       EXPECT_EQ(points[j * 9 + i].x(), 0.04 * i);
     }
@@ -113,11 +112,11 @@ void ExpectExactBowedBoard(const StereoRig& truth, LensModelId model) {
              truth.right_from_left().translation)
                 .norm(),
             kExactTolerance);
-  EXPECT_LT((calibration->cam1_from_cam0.rotation -
-             truth.right_from_left().rotation)
-                .cwiseAbs()
-                .maxCoeff(),
-            kExactTolerance);
+  EXPECT_LT(
+      (calibration->cam1_from_cam0.rotation - truth.right_from_left().rotation)
+          .cwiseAbs()
+          .maxCoeff(),
+      kExactTolerance);
   EXPECT_LT(calibration->rms_px, kExactTolerance);
   EXPECT_EQ(calibration->num_parameters,
             2 * truth.left().num_params() + 6 + 6 * 18 + 2);
@@ -257,9 +256,9 @@ RenderedViews RenderBowedBoard(const StereoRig& rig,
   render.noise_sigma = 2.0;
   render.blur_sigma_px = 0.5;
   render.board_warp = BoardWarpSurfaceOf(target, warp);
-  const std::vector<Rigid3d> poses = BoardPoses(
-      rig.left(), target, num_poses, /*seed=*/3, min_depth, max_depth,
-      max_tilt_deg);
+  const std::vector<Rigid3d> poses =
+      BoardPoses(rig.left(), target, num_poses, /*seed=*/3, min_depth,
+                 max_depth, max_tilt_deg);
   RenderedViews out;
   for (size_t v = 0; v < poses.size(); ++v) {
     const Rigid3d pose[2] = {poses[v], rig.right_from_left() * poses[v]};
@@ -304,9 +303,10 @@ TEST(BoardWarpOnRenders, BowRecoveredAndFocalLengthsUnbiased) {
       RenderBowedBoard(rig, target, warp, 20, 0.3, 0.55, 40.0);
   const double bowed_median = Median(rendered.bowed_errors_px);
   const double flat_median = Median(rendered.flat_errors_px);
-  std::printf("detected corners vs the bowed board's projections: median "
-              "%.4f px; vs the flat board's: median %.4f px (%zu corners)\n",
-              bowed_median, flat_median, rendered.bowed_errors_px.size());
+  std::printf(
+      "detected corners vs the bowed board's projections: median "
+      "%.4f px; vs the flat board's: median %.4f px (%zu corners)\n",
+      bowed_median, flat_median, rendered.bowed_errors_px.size());
   // The renderer draws the bow: the detections follow the bowed corners
   // (the detector's own error on renders, 0.03 px median, docs/
   // calibrate.md), not the flat ones (a 1 mm bowl seen at 0.3-0.55 m
@@ -324,39 +324,42 @@ TEST(BoardWarpOnRenders, BowRecoveredAndFocalLengthsUnbiased) {
       Calibrate(rig, LensModelId::kEquidistant, flat_board.views, true).value();
   const StereoCalibration flat =
       Calibrate(rig, LensModelId::kEquidistant, rendered.views, false).value();
-  const double bowl_z = (bowed.BoardBowl() - warp.sum()) / bowed.BoardBowlSigma();
-  std::printf("bowl %.4f +- %.4f mm (truth %.4f): %.2f sigma; warp x %.4f +- "
-              "%.4f, y %.4f +- %.4f mm; rms %.4f px (flat fit %.4f px)\n",
-              1e3 * bowed.BoardBowl(), 1e3 * bowed.BoardBowlSigma(),
-              1e3 * warp.sum(), bowl_z, 1e3 * bowed.board_warp.x(),
-              1e3 * bowed.board_warp_sigma.x(), 1e3 * bowed.board_warp.y(),
-              1e3 * bowed.board_warp_sigma.y(), bowed.rms_px, flat.rms_px);
+  const double bowl_z =
+      (bowed.BoardBowl() - warp.sum()) / bowed.BoardBowlSigma();
+  std::printf(
+      "bowl %.4f +- %.4f mm (truth %.4f): %.2f sigma; warp x %.4f +- "
+      "%.4f, y %.4f +- %.4f mm; rms %.4f px (flat fit %.4f px)\n",
+      1e3 * bowed.BoardBowl(), 1e3 * bowed.BoardBowlSigma(), 1e3 * warp.sum(),
+      bowl_z, 1e3 * bowed.board_warp.x(), 1e3 * bowed.board_warp_sigma.x(),
+      1e3 * bowed.board_warp.y(), 1e3 * bowed.board_warp_sigma.y(),
+      bowed.rms_px, flat.rms_px);
   const double flat_bowl_z = on_flat.BoardBowl() / on_flat.BoardBowlSigma();
   const double difference = bowed.BoardBowl() - on_flat.BoardBowl();
-  const double difference_sigma = std::hypot(bowed.BoardBowlSigma(),
-                                             on_flat.BoardBowlSigma());
+  const double difference_sigma =
+      std::hypot(bowed.BoardBowlSigma(), on_flat.BoardBowlSigma());
   const double difference_z = (difference - warp.sum()) / difference_sigma;
-  std::printf("flat board rendered the same way: bowl %.4f +- %.4f mm "
-              "(%.2f sigma); bowed - flat %.4f +- %.4f mm (%.2f sigma from "
-              "the truth)\n",
-              1e3 * on_flat.BoardBowl(), 1e3 * on_flat.BoardBowlSigma(),
-              flat_bowl_z, 1e3 * difference, 1e3 * difference_sigma,
-              difference_z);
-  // The detector's systematic corner errors on these renders (0.03 px
-  // median) read as a bowl of +0.05 mm on the flat board too, about 2 of
-  // its sigmas (0.025 mm at 2 gray levels of noise over 20 views): the
-  // absolute bowl is within 3 sigma of the truth, and its difference from
-  // the flat board's (the bias cancels: same poses, same noise) within 2
-  // sigma, a 95 % band if the sigma is honest (MonteCarloWarpSigmaIsHonest).
-  constexpr double kMaxBowlSigmas = 3.0;
+  std::printf(
+      "flat board rendered the same way: bowl %.4f +- %.4f mm "
+      "(%.2f sigma); bowed - flat %.4f +- %.4f mm (%.2f sigma from "
+      "the truth)\n",
+      1e3 * on_flat.BoardBowl(), 1e3 * on_flat.BoardBowlSigma(), flat_bowl_z,
+      1e3 * difference, 1e3 * difference_sigma, difference_z);
+  // The bowl within 2 sigma of the truth, a 95 % band if the sigma is
+  // honest (MonteCarloWarpSigmaIsHonest), on the bowed board and (at 0) on
+  // the flat one; so is their difference (same poses, same noise). Before
+  // the detector dropped the corners whose refinement is not a fixed point
+  // of the junction (target_detector.cc, kSbRefineMaxMovePx), SB's corners
+  // 0.5-1.3 px off on the small squares of the tilted views read as a
+  // bowl of +0.05 mm on the flat board (2.0 sigma) and 1.053 mm here (2.2).
+  constexpr double kMaxBowlSigmas = 2.0;
   constexpr double kMaxDifferenceSigmas = 2.0;
   EXPECT_LT(std::abs(bowl_z), kMaxBowlSigmas);
   EXPECT_LT(std::abs(flat_bowl_z), kMaxBowlSigmas);
   EXPECT_LT(std::abs(difference_z), kMaxDifferenceSigmas);
   for (int i = 0; i < 2; ++i) {
-    EXPECT_LT(std::abs(bowed.board_warp[i] - warp[i]) /
-                  bowed.board_warp_sigma[i],
-              kMaxBowlSigmas)
+    EXPECT_LT(
+        std::abs(bowed.board_warp[i] - warp[i]) / bowed.board_warp_sigma[i],
+        kMaxBowlSigmas)
         << i;
   }
   // The focal lengths: within 1.5 sigma of the truth with the warp; the
@@ -372,11 +375,11 @@ TEST(BoardWarpOnRenders, BowRecoveredAndFocalLengthsUnbiased) {
           (with.camera.params()[i] - truth.params()[i]) / with.sigma[i];
       const double z_without =
           (without.camera.params()[i] - truth.params()[i]) / without.sigma[i];
-      std::printf("cam%d f%c: with the warp %+.3f px (%+.2f sigma), flat "
-                  "%+.3f px (%+.2f sigma)\n",
-                  c, i == 0 ? 'x' : 'y',
-                  with.camera.params()[i] - truth.params()[i], z_with,
-                  without.camera.params()[i] - truth.params()[i], z_without);
+      std::printf(
+          "cam%d f%c: with the warp %+.3f px (%+.2f sigma), flat "
+          "%+.3f px (%+.2f sigma)\n",
+          c, i == 0 ? 'x' : 'y', with.camera.params()[i] - truth.params()[i],
+          z_with, without.camera.params()[i] - truth.params()[i], z_without);
       EXPECT_LT(std::abs(z_with), kMaxFocalSigmas) << "cam" << c << " " << i;
       EXPECT_GT(std::abs(z_without), kMinFlatBiasSigmas)
           << "cam" << c << " " << i;

@@ -58,6 +58,32 @@ const std::vector<StereoView>& SampleViews() {
 
 constexpr ImageSize kSize{640, 480};
 
+// The views with only the corners both cameras kept (the detector drops a
+// corner whose refinement it cannot trust, target_detector.cc), in id
+// order: cv::stereoCalibrate needs the same points in both images.
+std::vector<StereoView> CommonCorners(const std::vector<StereoView>& views) {
+  std::vector<StereoView> out;
+  for (const StereoView& view : views) {
+    if (!view.stereo()) continue;
+    StereoView common = view;
+    common.left->point_ids.clear();
+    common.left->pixels.clear();
+    common.right->point_ids.clear();
+    common.right->pixels.clear();
+    for (int i = 0; i < view.left->size(); ++i) {
+      for (int j = 0; j < view.right->size(); ++j) {
+        if (view.right->point_ids[j] != view.left->point_ids[i]) continue;
+        common.left->point_ids.push_back(view.left->point_ids[i]);
+        common.left->pixels.push_back(view.left->pixels[i]);
+        common.right->point_ids.push_back(view.right->point_ids[j]);
+        common.right->pixels.push_back(view.right->pixels[j]);
+      }
+    }
+    out.push_back(std::move(common));
+  }
+  return out;
+}
+
 // cv::stereoCalibrate on the corners of the stereo views, the same
 // 4-coefficient model (k3 fixed to 0), each camera started from
 // cv::calibrateCamera: OpenCV's own best effort.
@@ -71,7 +97,7 @@ double OpenCvStereoRms(const std::vector<StereoView>& views) {
     image[0].emplace_back();
     image[1].emplace_back();
     for (int k = 0; k < view.left->size(); ++k) {
-      // The chessboard detector reports every corner, in id order.
+      // CommonCorners: the same corners, in id order.
       EXPECT_EQ(view.left->point_ids[k], view.right->point_ids[k]);
       const Eigen::Vector3d& x = points[view.left->point_ids[k]];
       object.back().emplace_back(x.x(), x.y(), x.z());
@@ -102,18 +128,36 @@ double OpenCvStereoRms(const std::vector<StereoView>& views) {
 }
 
 TEST(OpenCvSampleStereo, EveryPairIsDetectedConsistently) {
+  // Every pair in both images. The detector drops the corners whose
+  // refinement it cannot trust (target_detector.cc: 37 of the 1404, all on
+  // the pattern's border where the paper's edge cuts the outer squares):
+  // at most 6 of an image's 54 and 4 % of all.
+  constexpr int kMinCornersPerImage = 48;
+  constexpr double kMaxDroppedFraction = 0.04;
   const std::vector<StereoView>& views = SampleViews();
   ASSERT_EQ(views.size(), 13u);
+  int kept = 0;
   for (const StereoView& view : views) {
     ASSERT_TRUE(view.stereo()) << view.left_name << ": " << view.note;
-    EXPECT_EQ(view.left->size(), 54);
-    EXPECT_EQ(view.right->size(), 54);
+    EXPECT_GE(view.left->size(), kMinCornersPerImage) << view.left_name;
+    EXPECT_GE(view.right->size(), kMinCornersPerImage) << view.right_name;
+    for (const TargetObservation* seen : {&*view.left, &*view.right}) {
+      kept += seen->size();
+      for (int k = 0; k < seen->size(); ++k) {
+        ASSERT_LT(seen->point_ids[k], 54);
+        if (k > 0) EXPECT_LT(seen->point_ids[k - 1], seen->point_ids[k]);
+      }
+    }
   }
+  const int total = 13 * 2 * 54;
+  std::printf("%d of %d corners kept\n", kept, total);
+  EXPECT_GE(kept, (1.0 - kMaxDroppedFraction) * total);
 }
 
 TEST(OpenCvSampleStereo, RmsNoWorseThanStereoCalibrate) {
-  // OpenCV assumes a flat board: so does the fit compared with it.
-  const std::vector<StereoView>& views = SampleViews();
+  // OpenCV assumes a flat board: so does the fit compared with it. Both
+  // on the corners both cameras kept.
+  const std::vector<StereoView> views = CommonCorners(SampleViews());
   StereoCalibrationOptions flat;
   flat.estimate_board_warp = false;
   const StatusOr<StereoCalibration> calibration =
