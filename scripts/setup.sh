@@ -24,6 +24,10 @@ packages=(
   librosbag-storage-dev libsensor-msgs-dev  # ROS1 bags: rcm estimate/undistort --bag
   pluginlib-dev libclass-loader-dev librcpputils-dev librcutils-dev \
     libament-index-cpp-dev  # ROS 2 headers that rosbag's headers include
+  libroscpp-dev libimage-transport-dev libcv-bridge-dev libmessage-filters-dev \
+    libdiagnostic-updater-dev libstd-srvs-dev  # the ROS1 node rcm_ros_node (ros/)
+  ros-std-msgs ros-std-srvs python3-gencpp python3-genpy  # its message and service, generated as catkin would
+  ros-core python3-sensor-msgs python3-std-srvs  # roscore, rosbag play, rostopic: the node's test
   clang-14 libclang-rt-14-dev  # sanitizer build and libFuzzer (test_sanitizers.sh)
   llvm-14              # llvm-symbolizer: source lines in sanitizer reports
   pybind11-dev python3-dev python3-numpy  # the Python package (python/)
