@@ -40,13 +40,16 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <future>
 #include <limits>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "rcm/camera/virtual_pinhole_remap.h"
 #include "rcm/camera/virtual_pinhole_rig.h"
@@ -69,6 +72,10 @@ struct StereoPair {
   ImageConstPtr left;
   ImageConstPtr right;
 };
+
+// Images the other camera must give after a camera's last one before that
+// camera counts as stopped.
+constexpr int64_t kMinImagesOfTheOther = 3;
 
 struct NodeOptions {
   std::string calib;
@@ -206,10 +213,14 @@ class RcmRosNode {
   void OnLeft(const ImageConstPtr&) {
     last_left_ = Now();
     ++num_left_;
+    ++left_at_last_right_;
+    right_at_last_left_ = 0;
   }
   void OnRight(const ImageConstPtr&) {
     last_right_ = Now();
     ++num_right_;
+    ++right_at_last_left_;
+    left_at_last_right_ = 0;
   }
 
   void OnPair(const ImageConstPtr& left, const ImageConstPtr& right) {
@@ -254,15 +265,18 @@ class RcmRosNode {
                          std::to_string(options_.sync_tolerance) +
                          " s); nothing published");
     }
+    // A camera stopped: silent for stale_after while the other gave at
+    // least kMinImagesOfTheOther images since its last (not a pause of
+    // both, where one resumes a moment before the other).
     if (left > 0.0 && now - left > stale && right > 0.0 &&
-        now - right < stale) {
+        now - right < stale && right_at_last_left_ >= kMinImagesOfTheOther) {
       warnings_.Warn("left",
                      "rcm_ros_node: the left camera stopped (no image "
                      "for " +
                          Seconds(now - left) + "); nothing published");
     }
     if (right > 0.0 && now - right > stale && left > 0.0 &&
-        now - left < stale) {
+        now - left < stale && left_at_last_right_ >= kMinImagesOfTheOther) {
       warnings_.Warn("right",
                      "rcm_ros_node: the right camera stopped (no "
                      "image for " +
@@ -298,7 +312,6 @@ class RcmRosNode {
       std::lock_guard<std::mutex> lock(command_mutex_);
       commands_.push_back(std::move(task));
     }
-    slot_wake_.Put(true);
     if (done.wait_for(std::chrono::seconds(5)) != std::future_status::ready) {
       return Status::Error("the worker did not answer within 5 s");
     }
@@ -320,7 +333,6 @@ class RcmRosNode {
       RunCommands();
       std::optional<StereoPair> pair =
           slot_.Take(std::chrono::milliseconds(50));
-      slot_wake_.Take(std::chrono::milliseconds(0));
       RunCommands();
       if (!pair) continue;
       Process(*pair);
@@ -340,7 +352,6 @@ class RcmRosNode {
   }
 
   void Process(const StereoPair& pair) {
-    const std::string& enc_left = pair.left->encoding;
     cv::Mat images[2];
     for (int c = 0; c < 2; ++c) {
       const sensor_msgs::Image& message = c == 0 ? *pair.left : *pair.right;
@@ -359,12 +370,11 @@ class RcmRosNode {
       }
       images[c] = std::move(image).value();
     }
-    (void)enc_left;
     const double stamp = pair.left->header.stamp.toSec();
     StatusOr<LiveFrame> result =
         pipeline_->Process(images[0], images[1], stamp);
     if (!result.ok()) {
-      pipeline_refused_ = pipeline_->num_refused();
+      ++pipeline_refused_;
       SetState(false, "bad input");
       warnings_.Warn("refused", "rcm_ros_node: pair at " +
                                     std::to_string(stamp) +
@@ -466,7 +476,6 @@ class RcmRosNode {
   ros::WallTimer watchdog_;
 
   LatestSlot<StereoPair> slot_;
-  LatestSlot<bool> slot_wake_;
   std::mutex command_mutex_;
   std::vector<std::packaged_task<Status()>> commands_;
   std::thread worker_;
@@ -477,6 +486,9 @@ class RcmRosNode {
   std::atomic<double> last_pair_{0.0};
   std::atomic<int64_t> num_left_{0};
   std::atomic<int64_t> num_right_{0};
+  // Images of one camera since the other's last image.
+  std::atomic<int64_t> left_at_last_right_{0};
+  std::atomic<int64_t> right_at_last_left_{0};
   std::atomic<int64_t> num_pairs_{0};
   std::atomic<int64_t> num_processed_{0};
   std::atomic<int64_t> pipeline_refused_{0};

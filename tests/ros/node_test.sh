@@ -5,7 +5,15 @@
 # Checks: a bad ~calib is one line and exit 1; every played pair gives one
 # ~refractive_index message whose named fields rostopic echo shows; both
 # medium switches are flagged within 3 pairs of the truth's; n in each
-# medium after its switch within 5e-3 of the truth. Everything it started
+# medium after its switch within 5e-3 of the truth. Then bad input, each a
+# bag of its own: 16-bit images (an encoding the node refuses), images of
+# half the calibration's size, black frames, pairs that never sync (the
+# right stamps 0.3 s late), a camera that stops (left images only): for
+# each a throttled warning (~warn_period 2 s: at most 4 for 6 s of it),
+# nothing published from that data, and the node keeps running. Last a
+# flood (the bag at 10x, 40 pairs/s, faster than the node works): whole
+# pairs are dropped and counted on /diagnostics (received = processed +
+# dropped, within the one in flight), and the node still publishes. Everything it started
 # is stopped on exit, also when a check fails, and the whole run is bounded
 # by `timeout` in CMake (ctest's TIMEOUT).
 #
@@ -60,9 +68,10 @@ set -e
 echo "bad ~calib: $out"
 
 "$node" __name:=rcm __ns:=/stereo _calib:="$work/sim/camchain.yaml" \
-  >"$work/node.log" 2>&1 &
+  _warn_period:=2.0 >"$work/node.log" 2>&1 &
 pids+=($!)
-rostopic echo -p /stereo/rcm/refractive_index >"$work/index.csv" 2>&1 &
+rostopic echo -p /stereo/rcm/refractive_index >"$work/index.csv" \
+  2>"$work/echo.err" &
 pids+=($!)
 # The node is up when its topic is advertised.
 for _ in $(seq 1 50); do
@@ -72,10 +81,48 @@ done
 sleep 1
 rosbag play -q "$work/sim.bag" >/dev/null 2>&1 || fail "rosbag play failed"
 sleep 2
+node_pid=${pids[1]}
 
-"$python" - "$work/index.csv" <<'PY' || { cat "$work/node.log" >&2; fail "see above"; }
+# Bad input, each from its own stamps on (the pairing needs them to grow).
+t0=1100
+for bad in mono16 small black offset left-only; do
+  args=(--bad "$bad")
+  [[ $bad == offset ]] && args=(--right-offset 0.3)
+  "$python" "$(dirname "$0")/write_stereo_bag.py" "$work/sim" \
+    "$work/$bad.bag" --rate 4 --t0 $t0 "${args[@]}" >/dev/null
+  rosbag play -q "$work/$bad.bag" >/dev/null 2>&1 || fail "rosbag play $bad failed"
+  sleep 1.5
+  kill -0 "$node_pid" 2>/dev/null || fail "the node died on $bad input"
+  t0=$((t0 + 100))
+done
+
+# ~hold: the services answer, and the flood's messages say held.
+timeout 10 rosservice call /stereo/rcm/hold "data: true" >"$work/hold.txt" 2>&1 ||
+  fail "~hold did not answer: $(cat "$work/hold.txt")"
+grep -q "success: True" "$work/hold.txt" || fail "~hold failed: $(cat "$work/hold.txt")"
+
+# The flood: the sequence at 10x.
+"$python" "$(dirname "$0")/write_stereo_bag.py" "$work/sim" "$work/flood.bag" \
+  --rate 4 --t0 1700 >/dev/null
+rosbag play -q -r 10 "$work/flood.bag" >/dev/null 2>&1 || fail "rosbag play (flood) failed"
+sleep 2
+timeout 10 rostopic echo -n 1 /diagnostics >"$work/diagnostics.txt" 2>&1 ||
+  fail "no /diagnostics"
+kill -0 "$node_pid" 2>/dev/null || fail "the node died in the flood"
+# ~reset with a start value: a new window, maps for n = 1.333 built.
+timeout 10 rosservice call /stereo/rcm/reset "n: 1.333" >"$work/reset.txt" 2>&1 ||
+  fail "~reset did not answer: $(cat "$work/reset.txt")"
+grep -q "success: True" "$work/reset.txt" || fail "~reset failed: $(cat "$work/reset.txt")"
+timeout 10 rosservice call /stereo/rcm/reset "n: 7" >"$work/reset_bad.txt" 2>&1 || true
+grep -q "success: False" "$work/reset_bad.txt" ||
+  fail "~reset to n = 7 did not fail: $(cat "$work/reset_bad.txt")"
+echo "node_test: ~hold, ~reset answered; ~reset to n = 7: $(grep message "$work/reset_bad.txt")"
+
+"$python" - "$work/index.csv" "$work/node.log" "$work/diagnostics.txt" <<'PY' || { cat "$work/node.log" >&2; fail "see above"; }
 import csv, math, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
+all_rows = rows
+rows = [r for r in rows if int(r["field.header.stamp"]) < 1050 * 10**9]
 truth = [1.0] * 6 + [1.333] * 10 + [1.0] * 6
 stamps = [round(1000.0 + k / 4.0, 3) for k in range(len(truth))]
 by_stamp = {round(int(r["field.header.stamp"]) * 1e-9, 3): r for r in rows}
@@ -104,5 +151,59 @@ for k, s in enumerate(stamps):
 if worst > 5e-3:
     sys.exit("n off by %.4f, more than 5e-3" % worst)
 print("node_test: n within %.4f of the truth" % worst)
+
+# Bad input: nothing published from it, one throttled warning per cause.
+published = {}
+for r in all_rows:
+    phase = int(r["field.header.stamp"]) // (100 * 10**9)
+    published[phase] = published.get(phase, 0) + 1
+log = open(sys.argv[2]).read().splitlines()
+causes = [("mono16", 11, "refused: "), ("small", 12, "refused: "),
+          ("black", 13, "refused: "), ("offset", 14, "none pair"),
+          ("left-only", 15, "camera stopped")]
+for name, phase, text in causes:
+    if published.get(phase, 0):
+        sys.exit("%s input: %d messages published" % (name, published[phase]))
+warnings = [line for line in log if text in line and "WARN" in line]
+for name, phase, text in causes:
+    print("node_test: %-9s input: nothing published" % name)
+for text in sorted(set(c[2] for c in causes)):
+    lines = [line for line in log if text in line]
+    # "refused: " is three causes' (encoding, size, blank), "camera
+    # stopped" two (left, right).
+    per_cause = {"refused: ": 3, "camera stopped": 2}.get(text, 1)
+    print("node_test: %d warnings '%s'" % (len(lines), text.strip()))
+    if not lines:
+        sys.exit("no warning '%s'" % text)
+    if len(lines) > 4 * per_cause:
+        sys.exit("%d warnings '%s': not throttled" % (len(lines), text))
+for line in log:
+    if "refused: " in line:
+        print("node_test:   " + line.strip()[:160])
+        break
+
+# The flood: drops counted, the node still publishing.
+flood = published.get(17, 0)
+diag = open(sys.argv[3]).read()
+def value(key):
+    at = diag.index("key: \"%s\"" % key)
+    return int(diag[at:].split("value: \"", 1)[1].split("\"", 1)[0])
+received = value("pairs received")
+processed = value("pairs processed")
+dropped = value("pairs dropped (worker busy)")
+refused = value("pairs refused (bad input)")
+print("node_test: flood: %d messages for 24 pairs; diagnostics: received %d, "
+      "processed %d, dropped %d, refused %d" % (flood, received, processed,
+                                                dropped, refused))
+if flood < 2:
+    sys.exit("the node published %d messages in the flood" % flood)
+held = [r["field.held"] for r in all_rows
+        if int(r["field.header.stamp"]) // (100 * 10**9) == 17]
+if not all(h in ("1", "True") for h in held):
+    sys.exit("flood messages after ~hold not held: %s" % held)
+if dropped < 1:
+    sys.exit("no pair dropped in a flood of 40 pairs/s")
+if not 0 <= received - (processed + dropped + refused) <= 1:
+    sys.exit("received %d != processed + dropped + refused" % received)
 PY
 echo "node_test: passed"
