@@ -1,7 +1,5 @@
 #include "rcm/calib/calibration_report.h"
 
-#include "rcm/calib/projection_uncertainty.h"
-
 #include <ceres/jet.h>
 #include <glog/logging.h>
 
@@ -13,6 +11,7 @@
 #include <optional>
 #include <utility>
 
+#include "rcm/calib/projection_uncertainty.h"
 #include "rcm/io/atomic_file.h"
 #include "rcm/io/image_file.h"
 #include "rcm/io/number_format.h"
@@ -130,8 +129,8 @@ cv::Mat UncertaintySamples(const CameraCalibration& calibration,
 // everywhere without the full covariance).
 cv::Mat MeanFramesSamples(const StereoCalibration& calibration, int camera,
                           double distance) {
-  const Camera& c = camera == 0 ? calibration.cam0.camera
-                                : calibration.cam1.camera;
+  const Camera& c =
+      camera == 0 ? calibration.cam0.camera : calibration.cam1.camera;
   return SampleOverImage({c.width(), c.height()},
                          [&](const Eigen::Vector2d& pixel) {
                            return MeanFramesProjectionUncertainty(
@@ -476,6 +475,9 @@ CalibrationReport SummarizeCalibration(
 
   // Warnings, in plain words.
   std::vector<std::string>& warnings = report.warnings;
+  if (!calibration.full_covariance_note.empty()) {
+    warnings.push_back(calibration.full_covariance_note);
+  }
   if (report.num_views_used < options.min_views) {
     warnings.push_back("only " + std::to_string(report.num_views_used) +
                        " views used (" + std::to_string(options.min_views) +
@@ -502,8 +504,7 @@ CalibrationReport SummarizeCalibration(
   }
   for (int c = 0; c < 2; ++c) {
     const CalibrationReport::CameraStats& stats = report.cameras[c];
-    if (stats.intrinsics_only_uncertainty_p95_px >
-        options.max_uncertainty_px) {
+    if (stats.intrinsics_only_uncertainty_p95_px > options.max_uncertainty_px) {
       warnings.push_back(
           CameraName(c) + ": intrinsics-only projection uncertainty " +
           Fixed(stats.intrinsics_only_uncertainty_p95_px, 2) +
@@ -833,8 +834,7 @@ namespace {
 // ..."), `legend` is the legend's first words.
 cv::Mat DrawUncertaintyMap(const cv::Mat& samples, const ImageSize& size,
                            double max_px, const std::string& camera_name,
-                           const std::string& what,
-                           const std::string& legend) {
+                           const std::string& what, const std::string& legend) {
   CHECK(Finite(max_px) && max_px >= 0.0) << max_px;
   CheckSize(size);
   const std::vector<double> values = Values(samples);
@@ -995,16 +995,16 @@ cv::Mat DrawUncertaintyMap(const cv::Mat& samples, const ImageSize& size,
                   ", max " + Fixed(largest, 3) + " px",
               cv::Point2d(layout.margin, layout.title_baseline), kTitleFont,
               kInk, layout.TextWidth());
-  figure.Text(
-      legend + "; log scale" +
-          std::string(
-              values.size() > 0 &&
-                      std::any_of(values.begin(), values.end(),
-                                  [](double value) { return !Finite(value); })
-                  ? "; gray: no ray"
-                  : ""),
-      cv::Point2d(layout.margin, layout.legend_baseline), kTextFont, kInk,
-      layout.TextWidth());
+  figure.Text(legend + "; log scale" +
+                  std::string(values.size() > 0 &&
+                                      std::any_of(values.begin(), values.end(),
+                                                  [](double value) {
+                                                    return !Finite(value);
+                                                  })
+                                  ? "; gray: no ray"
+                                  : ""),
+              cv::Point2d(layout.margin, layout.legend_baseline), kTextFont,
+              kInk, layout.TextWidth());
   return figure.Finish();
 }
 
@@ -1215,9 +1215,8 @@ Status WriteCalibrationReport(const std::string& directory,
     }));
     if (calibration.full_covariance.size() > 0) {
       RCM_RETURN_IF_ERROR(write_png("projection_uncertainty" + suffix, [&] {
-        return DrawMeanFramesUncertainty(calibration, c,
-                                         options.uncertainty_distance_m, 0.0,
-                                         CameraName(c));
+        return DrawMeanFramesUncertainty(
+            calibration, c, options.uncertainty_distance_m, 0.0, CameraName(c));
       }));
     }
   }

@@ -5,7 +5,6 @@
 #include <glog/logging.h>
 
 #include <Eigen/Cholesky>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -133,14 +132,13 @@ Eigen::Vector2d Residual(LensModelId model, const Corner& corner,
   RCM_LENS_MODEL_SWITCH(
       model,
       if (corner.camera == 0) {
-        ok = Cam0WarpedBoardReprojectionError<LensModel>(point, basis,
-                                                         corner.pixel)(
-            lens, pose, warp, residual.data());
+        ok = Cam0WarpedBoardReprojectionError<LensModel>(
+            point, basis, corner.pixel)(lens, pose, warp, residual.data());
       } else {
-        ok = Cam1WarpedBoardReprojectionError<LensModel>(point, basis,
-                                                         corner.pixel)(
-            lens, pose, parameters.cam1_from_cam0.data(), warp,
-            residual.data());
+        ok = Cam1WarpedBoardReprojectionError<LensModel>(
+            point, basis, corner.pixel)(lens, pose,
+                                        parameters.cam1_from_cam0.data(), warp,
+                                        residual.data());
       } break;)
   if (!ok) residual.setConstant(std::numeric_limits<double>::quiet_NaN());
   return residual;
@@ -203,10 +201,24 @@ bool ComputeFullCovariance(const std::vector<bool>& view_used,
   const Eigen::VectorXd scale = diagonal.cwiseSqrt().cwiseInverse();
   const Eigen::MatrixXd scaled =
       scale.asDiagonal() * information * scale.asDiagonal();
+  Eigen::MatrixXd inverse;
   const Eigen::LLT<Eigen::MatrixXd> llt(scaled);
-  if (llt.info() != Eigen::Success) return false;
-  const Eigen::MatrixXd inverse =
-      llt.solve(Eigen::MatrixXd::Identity(total, total));
+  if (llt.info() == Eigen::Success) {
+    inverse = llt.solve(Eigen::MatrixXd::Identity(total, total));
+  } else {
+    // Too ill-conditioned for the plain factorization in double precision
+    // (the rational model's k1..k6 on views that do not reach the image
+    // corners: its numerator and denominator nearly share a factor). The
+    // pivoted LDL^T factors it when every pivot is positive; the
+    // near-degenerate directions then get the large variances the data
+    // leave them, and they do not move a projection.
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(scaled);
+    if (ldlt.info() != Eigen::Success || !ldlt.isPositive() ||
+        !(ldlt.vectorD().minCoeff() > 0.0)) {
+      return false;
+    }
+    inverse = ldlt.solve(Eigen::MatrixXd::Identity(total, total));
+  }
   layout.matrix = variance * scale.asDiagonal() * inverse * scale.asDiagonal();
   if (!layout.matrix.allFinite()) return false;
   values->resize(total);
@@ -362,9 +374,8 @@ StatusOr<StereoCalibration> CalibrateStereo(
        options.min_outlier_threshold_px, options.max_outlier_rounds},
       solver_options,
       [&](double huber_px, ceres::Problem* problem) {
-        AddResiduals(options.model, corners, board,
-                     options.estimate_board_warp, huber_px, &parameters,
-                     problem);
+        AddResiduals(options.model, corners, board, options.estimate_board_warp,
+                     huber_px, &parameters, problem);
       },
       residual, &corners, &problem));
 
@@ -460,14 +471,22 @@ StatusOr<StereoCalibration> CalibrateStereo(
         result.cam1_from_cam0.translation / result.baseline;
     result.baseline_sigma = std::sqrt(direction.dot(
         result.extrinsics_covariance.bottomRightCorner<3, 3>() * direction));
+    // The joint covariance of every unknown, board poses included, is
+    // only for mrcal's projection uncertainty: when it cannot be factored
+    // the calibration stands (its lens covariance is above) and the
+    // report says the uncertainty is not available.
     if (!ComputeFullCovariance(view_used, num_lens_params,
                                options.estimate_board_warp, variance,
                                &parameters, &problem, &result.full_covariance,
                                &result.full_parameters)) {
-      return Status::Error(
-          "the calibration is degenerate: the covariance of its board poses "
-          "cannot be computed (add views with the target tilted and near the "
-          "image corners)");
+      result.full_covariance = FullCovariance{};
+      result.full_parameters.resize(0);
+      result.full_covariance_note =
+          "the covariance of all unknowns together (board poses included) "
+          "is numerically singular, so the projection uncertainty through "
+          "the board poses is not available (the lens model has more "
+          "freedom than these views constrain: try fewer coefficients, or "
+          "views that reach the image corners)";
     }
   }
   return result;

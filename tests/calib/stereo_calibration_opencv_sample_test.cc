@@ -145,7 +145,9 @@ TEST(OpenCvSampleStereo, EveryPairIsDetectedConsistently) {
       kept += seen->size();
       for (int k = 0; k < seen->size(); ++k) {
         ASSERT_LT(seen->point_ids[k], 54);
-        if (k > 0) EXPECT_LT(seen->point_ids[k - 1], seen->point_ids[k]);
+        if (k > 0) {
+          EXPECT_LT(seen->point_ids[k - 1], seen->point_ids[k]);
+        }
       }
     }
   }

@@ -176,6 +176,9 @@ struct StereoCalibration {
   // compute_covariance), and the solution in its layout (the poses and
   // extrinsics as the angle-axis vectors the solver held).
   FullCovariance full_covariance;
+  // Why full_covariance is empty although compute_covariance was on (it
+  // could not be factored); empty otherwise.
+  std::string full_covariance_note;
   Eigen::VectorXd full_parameters;
   // Every corner of every used view, inliers and outliers.
   std::vector<CornerResidual> corners;
