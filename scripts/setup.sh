@@ -24,10 +24,6 @@ packages=(
   librosbag-storage-dev libsensor-msgs-dev  # ROS1 bags: rcm estimate/undistort --bag
   pluginlib-dev libclass-loader-dev librcpputils-dev librcutils-dev \
     libament-index-cpp-dev  # ROS 2 headers that rosbag's headers include
-  libroscpp-dev libimage-transport-dev libcv-bridge-dev libmessage-filters-dev \
-    libdiagnostic-updater-dev libstd-srvs-dev  # the ROS1 node rcm_ros_node (ros/)
-  ros-std-msgs ros-std-srvs python3-gencpp python3-genpy  # its message and service, generated as catkin would
-  ros-core python3-sensor-msgs python3-std-srvs  # roscore, rosbag play, rostopic: the node's test
   clang-14 libclang-rt-14-dev  # sanitizer build and libFuzzer (test_sanitizers.sh)
   llvm-14              # llvm-symbolizer: source lines in sanitizer reports
   pybind11-dev python3-dev python3-numpy  # the Python package (python/)
@@ -35,6 +31,15 @@ packages=(
   python3-opencv       # cv2.remap with rcm's maps, in the Python tests and docs
   mrcal                # mrcal-calibrate-cameras: the peer the air calibration is tested against
 )
+
+# The ROS1 node (ros/) and its test need more; they are not installed here
+# yet: with them installed, the sanitizer pass's bag test under
+# LeakSanitizer crashed in LSan's tracer 2 of 3 times (README, "On the
+# robot"). Install them by hand to build and test the node:
+#   apt-get install libroscpp-dev libimage-transport-dev libcv-bridge-dev \
+#     libmessage-filters-dev libdiagnostic-updater-dev libstd-srvs-dev \
+#     ros-std-msgs ros-std-srvs python3-gencpp python3-genpy ros-core \
+#     python3-sensor-msgs python3-std-srvs
 
 missing=()
 for p in "${packages[@]}"; do
