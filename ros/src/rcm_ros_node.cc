@@ -212,13 +212,11 @@ class RcmRosNode {
   // --- ROS callbacks (spinner thread) --------------------------------------
   void OnLeft(const ImageConstPtr&) {
     last_left_ = Now();
-    ++num_left_;
     ++left_at_last_right_;
     right_at_last_left_ = 0;
   }
   void OnRight(const ImageConstPtr&) {
     last_right_ = Now();
-    ++num_right_;
     ++right_at_last_left_;
     left_at_last_right_ = 0;
   }
@@ -286,10 +284,9 @@ class RcmRosNode {
 
   void Diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
     std::lock_guard<std::mutex> lock(state_mutex_);
-    const char* level_text = state_.c_str();
     status.summary(state_ok_ ? diagnostic_msgs::DiagnosticStatus::OK
                              : diagnostic_msgs::DiagnosticStatus::WARN,
-                   level_text);
+                   state_);
     status.add("pairs received", static_cast<int64_t>(num_pairs_));
     status.add("pairs processed", num_processed_);
     status.add("pairs dropped (worker busy)", slot_.num_dropped());
@@ -484,8 +481,6 @@ class RcmRosNode {
   std::atomic<double> last_left_{0.0};
   std::atomic<double> last_right_{0.0};
   std::atomic<double> last_pair_{0.0};
-  std::atomic<int64_t> num_left_{0};
-  std::atomic<int64_t> num_right_{0};
   // Images of one camera since the other's last image.
   std::atomic<int64_t> left_at_last_right_{0};
   std::atomic<int64_t> right_at_last_left_{0};

@@ -167,6 +167,17 @@ std::optional<MrcalSolution> MrcalCalibrate(
   return solution;
 }
 
+// rcm's board warp [mm] and its sigma (x, y), from the JSON summary.
+struct RcmWarp {
+  std::vector<double> mm;
+  std::vector<double> sigma_mm;
+};
+RcmWarp RcmWarpOf(const nlohmann::json& rcm) {
+  const nlohmann::json& flatness = rcm["board_flatness"];
+  return {flatness["board_warp_mm"].get<std::vector<double>>(),
+          flatness["board_warp_sigma_mm"].get<std::vector<double>>()};
+}
+
 std::vector<double> RcmIntrinsics(const nlohmann::json& camera) {
   std::vector<double> values = camera["intrinsics"].get<std::vector<double>>();
   for (const double d : camera["distortion_coeffs"]) values.push_back(d);
@@ -236,12 +247,8 @@ TEST(MrcalPeer, BoardFlatnessGivesMrcalsFocalLengthsAndBowl) {
     }
   }
   ExpectSameIntrinsics(rcm, *mrcal);
-  const nlohmann::json& flatness = rcm["board_flatness"];
-  ASSERT_TRUE(flatness["estimated"].get<bool>());
-  const std::vector<double> warp_mm =
-      flatness["board_warp_mm"].get<std::vector<double>>();
-  const std::vector<double> sigma_mm =
-      flatness["board_warp_sigma_mm"].get<std::vector<double>>();
+  ASSERT_TRUE(rcm["board_flatness"]["estimated"].get<bool>());
+  const auto [warp_mm, sigma_mm] = RcmWarpOf(rcm);
   ASSERT_EQ(warp_mm.size(), 2u);
   ASSERT_EQ(sigma_mm.size(), 2u);
   for (int i = 0; i < 2; ++i) {
@@ -283,11 +290,9 @@ TEST(MrcalPeer, MrcalsDefaultsGiveTheSameFocalLengthsAndBowl) {
           << "cam" << c << (i == 0 ? " fx" : " fy");
     }
   }
-  const nlohmann::json& flatness = rcm["board_flatness"];
-  const std::vector<double> warp_mm =
-      flatness["board_warp_mm"].get<std::vector<double>>();
-  const std::vector<double> sigma_mm =
-      flatness["board_warp_sigma_mm"].get<std::vector<double>>();
+  const auto [warp_mm, sigma_mm] = RcmWarpOf(rcm);
+  ASSERT_EQ(warp_mm.size(), 2u);
+  ASSERT_EQ(sigma_mm.size(), 2u);
   for (int i = 0; i < 2; ++i) {
     const double theirs_mm = 1e3 * (*mrcal->warp)[i];
     std::printf("warp %c: rcm %.4f +- %.4f, mrcal (defaults) %.4f mm\n",
