@@ -26,7 +26,18 @@ cmake -S . -B build-sanitize "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \
 cmake --build build-sanitize -j2
 
 # Reports abort the process (no recovery), with a symbolized stack.
-export ASAN_OPTIONS=detect_leaks=1:strict_string_checks=1
+# intercept_tls_get_addr=0: up to LLVM 16 the runtime's __tls_get_addr
+# interceptor takes a dynamic TLS block that happens to start 16 bytes into
+# a page for glibc 2.19's header and reads the two words before it as the
+# block's range; LeakSanitizer's tracer then dies at exit ("Tracer caught
+# signal 11", exit 1, no leak reported). The bag test (the TLS of Debian's
+# ROS libraries) met it in 2 of 3 runs on one machine and in CI; whether a
+# block lands there depends on the heap's layout, so it did not reproduce
+# in 18 runs on another. The flag follows from that mechanism (fixed
+# upstream in LLVM 17), not from a run that showed the crash gone. Without
+# the interceptor the leak check still scans every thread's stack and
+# static TLS.
+export ASAN_OPTIONS=detect_leaks=1:strict_string_checks=1:intercept_tls_get_addr=0
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 if [[ -x /usr/lib/llvm-14/bin/llvm-symbolizer ]]; then
   export ASAN_SYMBOLIZER_PATH=/usr/lib/llvm-14/bin/llvm-symbolizer
