@@ -30,16 +30,20 @@ packages=(
   python3-pytest       # its tests
   python3-opencv       # cv2.remap with rcm's maps, in the Python tests and docs
   mrcal                # mrcal-calibrate-cameras: the peer the air calibration is tested against
+  # The ROS1 node rcm_ros_node (ros/): the client library, image transport,
+  # OpenCV bridge, stamp pairing, diagnostics, its service types and the
+  # generators of its own message and service (gencpp, genpy)
+  libroscpp-dev libimage-transport-dev libcv-bridge-dev libmessage-filters-dev \
+    libdiagnostic-updater-dev libstd-srvs-dev ros-std-msgs ros-std-srvs \
+    python3-gencpp python3-genpy
+  # ... and its test (tests/ros/node_test.sh): roscore, rostopic, rosservice,
+  # rosbag record/play and their Python messages; Debian's stereo_image_proc
+  # (its node, nodelet plugin and the nodelet package it loads) on the
+  # node's rectified output
+  ros-core python3-sensor-msgs python3-std-srvs python3-diagnostic-msgs \
+    python3-stereo-msgs ros-stereo-image-proc libstereo-image-proc-dev \
+    libnodeletlib-tools
 )
-
-# The ROS1 node (ros/) and its test need more; they are not installed here
-# yet: with them installed, the sanitizer pass's bag test under
-# LeakSanitizer crashed in LSan's tracer 2 of 3 times (README, "On the
-# robot"). Install them by hand to build and test the node:
-#   apt-get install libroscpp-dev libimage-transport-dev libcv-bridge-dev \
-#     libmessage-filters-dev libdiagnostic-updater-dev libstd-srvs-dev \
-#     ros-std-msgs ros-std-srvs python3-gencpp python3-genpy ros-core \
-#     python3-sensor-msgs python3-std-srvs
 
 missing=()
 for p in "${packages[@]}"; do

@@ -145,6 +145,12 @@ nlohmann::json SimulationFlagsJson(const Simulation& simulation) {
             {"glass_thickness", port.glass_thickness},
             {"glass_index", port.glass_index},
             {"normal", {port.normal.x(), port.normal.y(), port.normal.z()}}}},
+          // The pool, world frame of truth.csv: [0, length] x [0, width] x
+          // [0, depth] meters (TankScene), for checks of depth against it.
+          {"tank",
+           {{"length", options.scene.length},
+            {"width", options.scene.width},
+            {"depth", options.scene.depth}}},
           {"frame_rate", options.trajectory.frame_rate},
           {"image_noise", FLAGS_image_noise},
           {"supersampling", FLAGS_supersampling},

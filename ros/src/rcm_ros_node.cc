@@ -9,6 +9,8 @@
 //   publishes   ~refractive_index                 rcm_ros/RefractiveIndex
 //               ~left/image_rect, ~right/image_rect  the corrected pair,
 //               ~left/camera_info, ~right/camera_info  stamped as the input
+//                 (rectified: both in the left's frame_id, as
+//                 stereo_image_proc expects)
 //               /diagnostics                      rate, drops, state
 //   services    ~reset (rcm_ros/Reset), ~hold (std_srvs/SetBool)
 //
@@ -439,10 +441,16 @@ class RcmRosNode {
     sensor_msgs::CameraInfo* infos[2] = {&left_info_, &right_info_};
     image_transport::CameraPublisher* pubs[2] = {&left_pub_, &right_pub_};
     for (int c = 0; c < 2; ++c) {
+      std_msgs::Header header = inputs[c]->header;
+      // A rectified pair is one camera model in ROS (image_geometry's
+      // StereoCameraModel, stereo_image_proc): both images in the left
+      // rectified frame, the baseline in the right's P.
+      if (options_.pipeline.correction.rectify) {
+        header.frame_id = inputs[0]->header.frame_id;
+      }
       sensor_msgs::ImagePtr image =
-          cv_bridge::CvImage(inputs[c]->header, encoding, *images[c])
-              .toImageMsg();
-      infos[c]->header = inputs[c]->header;
+          cv_bridge::CvImage(header, encoding, *images[c]).toImageMsg();
+      infos[c]->header = header;
       pubs[c]->publish(*image, *infos[c]);
     }
   }

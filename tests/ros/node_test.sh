@@ -5,7 +5,10 @@
 # Checks: a bad ~calib is one line and exit 1; every played pair gives one
 # ~refractive_index message whose named fields rostopic echo shows; both
 # medium switches are flagged within 3 pairs of the truth's; n in each
-# medium after its switch within 5e-3 of the truth. Then bad input, each a
+# medium after its switch within 2e-3 of the truth; Debian's
+# stereo_image_proc on the node's rectified pair gives the pool's metric
+# depth within 1 % in the water (check_depth.py), and more than 20 % off
+# when n is held at 1 (~reset to 1 under ~hold). Then bad input, each a
 # bag of its own: 16-bit images (an encoding the node refuses), images of
 # half the calibration's size, black frames, pairs that never sync (the
 # right stamps 0.3 s late), a camera that stops (left images only): for
@@ -39,6 +42,17 @@ cleanup() {
 }
 trap cleanup EXIT
 fail() { echo "node_test: FAILED: $*" >&2; exit 1; }
+# rosbag record closes its bag on SIGINT: its Python front end returns at
+# once, the recorder it started renames BAG.active to BAG when done.
+stop_recorder() {
+  kill -INT "$1"
+  wait "$1" 2>/dev/null || true
+  for _ in $(seq 1 50); do
+    [[ -f $2 ]] && return 0
+    sleep 0.1
+  done
+  fail "rosbag record wrote no $2"
+}
 
 export ROS_MASTER_URI=http://127.0.0.1:$port ROS_HOSTNAME=127.0.0.1
 export ROS_HOME=$work/ros_home ROS_LOG_DIR=$work/ros_log
@@ -67,9 +81,23 @@ set -e
 [[ $(printf '%s\n' "$out" | grep -c .) -eq 1 ]] || fail "a missing ~calib printed more than one line: $out"
 echo "bad ~calib: $out"
 
+# ~max_matches 0: the window takes every match of a pair (about 1200, not
+# the real-time default's 400), the accuracy the 2e-3 below needs; at 400
+# the worst pair here is 2.2e-3 off, within its sigma_n (README).
 "$node" __name:=rcm __ns:=/stereo _calib:="$work/sim/camchain.yaml" \
-  _warn_period:=2.0 >"$work/node.log" 2>&1 &
+  _warn_period:=2.0 _max_matches:=0 >"$work/node.log" 2>&1 &
 pids+=($!)
+node_pid=$!
+# Debian's stereo_image_proc on the node's rectified pair, as a VIO's
+# stereo front end would see it; its disparities are recorded.
+stereo_image_proc=/usr/lib/stereo_image_proc/stereo_image_proc
+[[ -x $stereo_image_proc ]] || stereo_image_proc=$(command -v stereo_image_proc || true)
+[[ -n $stereo_image_proc ]] || fail "stereo_image_proc is not installed (scripts/setup.sh)"
+"$stereo_image_proc" __name:=stereo_image_proc __ns:=/stereo/rcm \
+  left/image_raw:=left/image_rect right/image_raw:=right/image_rect \
+  >"$work/stereo_image_proc.log" 2>&1 &
+pids+=($!)
+depth_topics=(/stereo/rcm/disparity /stereo/rcm/left/camera_info)
 rostopic echo -p /stereo/rcm/refractive_index >"$work/index.csv" \
   2>"$work/echo.err" &
 pids+=($!)
@@ -78,10 +106,21 @@ for _ in $(seq 1 50); do
   rostopic list 2>/dev/null | grep -q /stereo/rcm/refractive_index && break
   sleep 0.2
 done
+rosbag record -q -O "$work/depth.bag" "${depth_topics[@]}" \
+  >"$work/record.log" 2>&1 &
+recorder=$!
+pids+=($recorder)
 sleep 1
 rosbag play -q "$work/sim.bag" >/dev/null 2>&1 || fail "rosbag play failed"
 sleep 2
-node_pid=${pids[1]}
+stop_recorder "$recorder" "$work/depth.bag"
+kill -0 "${pids[2]}" 2>/dev/null ||
+  fail "stereo_image_proc died: $(tail -3 "$work/stereo_image_proc.log")"
+# Water after the switch (flagged by pair 8 at the latest, checked below):
+# stereo_image_proc's metric depth within 1 % of the pool's.
+"$python" "$(dirname "$0")/check_depth.py" "$work/depth.bag" "$work/sim" \
+  --t0 1000 --rate 4 --first 0 --frames 9:16 --within 0.01 --label "n estimated: " ||
+  fail "depth of stereo_image_proc on the corrected pair"
 
 # Bad input, each from its own stamps on (the pairing needs them to grow).
 t0=1100
@@ -107,7 +146,7 @@ grep -q "success: True" "$work/hold.txt" || fail "~hold failed: $(cat "$work/hol
 rosbag play -q -r 10 "$work/flood.bag" >/dev/null 2>&1 || fail "rosbag play (flood) failed"
 sleep 2
 timeout 10 rostopic echo -n 1 /diagnostics >"$work/diagnostics.txt" 2>&1 ||
-  fail "no /diagnostics"
+  fail "no /diagnostics: $(tail -5 "$work/diagnostics.txt")"
 kill -0 "$node_pid" 2>/dev/null || fail "the node died in the flood"
 # ~reset with a start value: a new window, maps for n = 1.333 built.
 timeout 10 rosservice call /stereo/rcm/reset "n: 1.333" >"$work/reset.txt" 2>&1 ||
@@ -117,6 +156,24 @@ timeout 10 rosservice call /stereo/rcm/reset "n: 7" >"$work/reset_bad.txt" 2>&1 
 grep -q "success: False" "$work/reset_bad.txt" ||
   fail "~reset to n = 7 did not fail: $(cat "$work/reset_bad.txt")"
 echo "node_test: ~hold, ~reset answered; ~reset to n = 7: $(grep message "$work/reset_bad.txt")"
+
+# Ignoring the water: n held at 1 (~reset to 1, ~hold still on), the water
+# pairs again; stereo_image_proc's depth is then off by more than 20 %.
+timeout 10 rosservice call /stereo/rcm/reset "n: 1.0" >"$work/reset_air.txt" 2>&1 ||
+  fail "~reset to n = 1 did not answer: $(cat "$work/reset_air.txt")"
+"$python" "$(dirname "$0")/write_stereo_bag.py" "$work/sim" "$work/water.bag" \
+  --rate 4 --t0 1900 --frames 8:16 >/dev/null
+rosbag record -q -O "$work/depth_n1.bag" "${depth_topics[@]}" \
+  >"$work/record_n1.log" 2>&1 &
+recorder=$!
+pids+=($recorder)
+sleep 1
+rosbag play -q "$work/water.bag" >/dev/null 2>&1 || fail "rosbag play (water at n = 1) failed"
+sleep 2
+stop_recorder "$recorder" "$work/depth_n1.bag"
+"$python" "$(dirname "$0")/check_depth.py" "$work/depth_n1.bag" "$work/sim" \
+  --t0 1900 --rate 4 --first 8 --frames 8:16 --off-by-more-than 0.2 \
+  --label "n held at 1: " || fail "depth with n = 1 not off by more than 20 %"
 
 "$python" - "$work/index.csv" "$work/node.log" "$work/diagnostics.txt" <<'PY' || { cat "$work/node.log" >&2; fail "see above"; }
 import csv, math, sys
@@ -148,8 +205,8 @@ for k, s in enumerate(stamps):
     n = float(r["field.n"])
     worst = max(worst, abs(n - truth[k]))
     print("node_test: pair %2d n %.5f +- %.5f (truth %.3f)" % (k, n, float(r["field.sigma_n"]), truth[k]))
-if worst > 5e-3:
-    sys.exit("n off by %.4f, more than 5e-3" % worst)
+if worst > 2e-3:
+    sys.exit("n off by %.4f, more than 2e-3" % worst)
 print("node_test: n within %.4f of the truth" % worst)
 
 # Bad input: nothing published from it, one throttled warning per cause.

@@ -6,10 +6,12 @@ t0 + k / rate [s], k = 0, 1, ...
 
 usage: write_stereo_bag.py SIM_DIR OUT.bag [--rate HZ] [--right-offset S]
                            [--bad mono16|small|black|left-only] [--t0 S]
+                           [--frames FIRST:END]
 --right-offset shifts the right stamps (pairs that never sync); --bad
 writes bad input instead: 16-bit images (an encoding the node refuses),
 images of half the calibration's size, black frames, or left images only
-(a camera that stopped).
+(a camera that stopped). --frames writes the frames FIRST, ..., END - 1
+only, the first of them at t0.
 """
 import numpy as np
 import argparse
@@ -42,8 +44,12 @@ def main():
     parser.add_argument("--right-offset", type=float, default=0.0)
     parser.add_argument("--bad", choices=["mono16", "small", "black", "left-only"])
     parser.add_argument("--t0", type=float, default=1000.0)
+    parser.add_argument("--frames", default=None)
     args = parser.parse_args()
     names = sorted(os.listdir(os.path.join(args.sim_dir, "left")))
+    if args.frames:
+        first, end = (int(v) for v in args.frames.split(":"))
+        names = names[first:end]
     if not names:
         sys.exit("write_stereo_bag.py: no images in %s/left" % args.sim_dir)
     t0 = args.t0
