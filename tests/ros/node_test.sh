@@ -16,7 +16,9 @@
 # nothing published from that data, and the node keeps running. Last a
 # flood (the bag at 10x, 40 pairs/s, faster than the node works): whole
 # pairs are dropped and counted on /diagnostics (received = processed +
-# dropped, within the one in flight), and the node still publishes. Everything it started
+# dropped, within the one in flight), and the node still publishes. A stale
+# calibration (a narrow rig turned 0.15 and 0.3 deg): an honest, wide
+# sigma_n, then no estimate at all (valid: false, one warning). Everything it started
 # is stopped on exit, also when a check fails, and the whole run is bounded
 # by `timeout` in CMake (ctest's TIMEOUT).
 #
@@ -174,6 +176,68 @@ stop_recorder "$recorder" "$work/depth_n1.bag"
 "$python" "$(dirname "$0")/check_depth.py" "$work/depth_n1.bag" "$work/sim" \
   --t0 1900 --rate 4 --first 8 --frames 8:16 --off-by-more-than 0.2 \
   --label "n held at 1: " || fail "depth with n = 1 not off by more than 20 %"
+
+# A stale calibration: a narrow rig (rcm simulate --rig narrow, 6 pairs in
+# water) whose cam1 turned about x since its camchain, each drift seen by a
+# node of its own (/stale_K). The live window holds cam1's rotation and
+# carries the calibration's uncertainty in sigma_n: at 0.15 deg n must be
+# within 3 sigma_n of the truth with a sigma_n over 5x the fresh rig's
+# (never a precise-looking wrong number); at 0.3 deg the matching band
+# misses the turned rig and every message must be valid: false with n NaN,
+# with a throttled warning, the node still running.
+k=0
+for drift in -0.15 -0.3; do
+  k=$((k + 1))
+  "$rcm" simulate --out "$work/stale_$k" --rig narrow --media water:6 \
+    --extrinsic-drift "$drift,0,0" >/dev/null
+  "$python" "$(dirname "$0")/write_stereo_bag.py" "$work/stale_$k" \
+    "$work/stale_$k.bag" --rate 4 >/dev/null
+  "$node" __name:=rcm __ns:=/stale_$k _calib:="$work/stale_$k/camchain.yaml" \
+    _warn_period:=2.0 >"$work/stale_$k.log" 2>&1 &
+  pids+=($!)
+  stale_pid=$!
+  rostopic echo -p /stale_$k/rcm/refractive_index >"$work/stale_$k.csv" 2>/dev/null &
+  pids+=($!)
+  for _ in $(seq 1 50); do
+    rostopic list 2>/dev/null | grep -q /stale_$k/rcm/refractive_index && break
+    sleep 0.2
+  done
+  sleep 1
+  rosbag play -q "$work/stale_$k.bag" /stereo/left/image_raw:=/stale_$k/left/image_raw \
+    /stereo/right/image_raw:=/stale_$k/right/image_raw >/dev/null 2>&1 ||
+    fail "rosbag play (stale calibration, $drift deg) failed"
+  sleep 1.5
+  kill -0 "$stale_pid" 2>/dev/null || fail "the node died on a stale calibration ($drift deg)"
+  "$python" - "$work/stale_$k.csv" "$work/stale_$k.log" "$drift" <<'PY' || fail "stale calibration ($drift deg)"
+import csv, math, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+log = open(sys.argv[2]).read().splitlines()
+drift = float(sys.argv[3])
+if len(rows) < 4:
+    sys.exit("%d messages for 6 pairs" % len(rows))
+valid = [r for r in rows if r["field.valid"] in ("1", "True")]
+if abs(drift) < 0.2:
+    if len(valid) != len(rows):
+        sys.exit("a 0.15 deg turn gave no estimate: %s" % rows[-1]["field.status"])
+    for r in rows:
+        n, sigma = float(r["field.n"]), float(r["field.sigma_n"])
+        print("node_test: stale %.2f deg: n %.5f +- %.5f (truth 1.333, %.1f sigma)"
+              % (drift, n, sigma, abs(n - 1.333) / sigma))
+        if abs(n - 1.333) > 3 * sigma or sigma < 5 * 1.5e-3:
+            sys.exit("n %.5f +- %.5f: not an honest sigma for a stale rig" % (n, sigma))
+else:
+    if valid:
+        sys.exit("a 0.3 deg turn published n = %s" % valid[0]["field.n"])
+    if not all(math.isnan(float(r["field.n"])) for r in rows):
+        sys.exit("a message without an estimate carries a number")
+    warnings = [l for l in log if "no estimate of n" in l and "WARN" in l]
+    print("node_test: stale %.2f deg: %d messages valid: false (%s), %d warnings"
+          % (drift, len(rows), rows[-1]["field.status"][:60], len(warnings)))
+    if not 1 <= len(warnings) <= 2:
+        sys.exit("%d warnings 'no estimate of n' for 1.5 s of pairs, not one "
+                 "throttled one" % len(warnings))
+PY
+done
 
 "$python" - "$work/index.csv" "$work/node.log" "$work/diagnostics.txt" <<'PY' || { cat "$work/node.log" >&2; fail "see above"; }
 import csv, math, sys
