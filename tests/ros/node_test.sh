@@ -12,7 +12,7 @@
 # bag of its own: 16-bit images (an encoding the node refuses), images of
 # half the calibration's size, black frames, pairs that never sync (the
 # right stamps 0.3 s late), a camera that stops (left images only): for
-# each a throttled warning (~warn_period 2 s: at most 4 for 6 s of it),
+# each a throttled warning (~warn_period 2 s: at most 4 for the 3 s of it),
 # nothing published from that data, and the node keeps running. Last a
 # flood (the bag at 10x, 40 pairs/s, faster than the node works): whole
 # pairs are dropped and counted on /diagnostics (received = processed +
@@ -130,7 +130,7 @@ for bad in mono16 small black offset left-only; do
   args=(--bad "$bad")
   [[ $bad == offset ]] && args=(--right-offset 0.3)
   "$python" "$(dirname "$0")/write_stereo_bag.py" "$work/sim" \
-    "$work/$bad.bag" --rate 4 --t0 $t0 "${args[@]}" >/dev/null
+    "$work/$bad.bag" --rate 4 --t0 $t0 --frames 0:12 "${args[@]}" >/dev/null
   rosbag play -q "$work/$bad.bag" >/dev/null 2>&1 || fail "rosbag play $bad failed"
   sleep 1.5
   kill -0 "$node_pid" 2>/dev/null || fail "the node died on $bad input"
