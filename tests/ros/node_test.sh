@@ -44,16 +44,24 @@ cleanup() {
 }
 trap cleanup EXIT
 fail() { echo "node_test: FAILED: $*" >&2; exit 1; }
-# rosbag record closes its bag on SIGINT: its Python front end returns at
-# once, the recorder it started renames BAG.active to BAG when done.
-stop_recorder() {
-  kill -INT "$1"
-  wait "$1" 2>/dev/null || true
+# Plays BAG while rosbag record writes the depth topics (depth_topics,
+# below) to OUT. rosbag record closes its bag on SIGINT: its Python front
+# end returns at once, the recorder it started renames OUT.active to OUT
+# when done.
+play_recording_depth() {
+  rosbag record -q -O "$2" "${depth_topics[@]}" >"$2.log" 2>&1 &
+  local recorder=$!
+  pids+=($recorder)
+  sleep 1
+  rosbag play -q "$1" >/dev/null 2>&1 || fail "rosbag play $1 failed"
+  sleep 2
+  kill -INT "$recorder"
+  wait "$recorder" 2>/dev/null || true
   for _ in $(seq 1 50); do
     [[ -f $2 ]] && return 0
     sleep 0.1
   done
-  fail "rosbag record wrote no $2"
+  fail "rosbag record wrote no $2: $(cat "$2.log")"
 }
 
 export ROS_MASTER_URI=http://127.0.0.1:$port ROS_HOSTNAME=127.0.0.1
@@ -108,14 +116,7 @@ for _ in $(seq 1 50); do
   rostopic list 2>/dev/null | grep -q /stereo/rcm/refractive_index && break
   sleep 0.2
 done
-rosbag record -q -O "$work/depth.bag" "${depth_topics[@]}" \
-  >"$work/record.log" 2>&1 &
-recorder=$!
-pids+=($recorder)
-sleep 1
-rosbag play -q "$work/sim.bag" >/dev/null 2>&1 || fail "rosbag play failed"
-sleep 2
-stop_recorder "$recorder" "$work/depth.bag"
+play_recording_depth "$work/sim.bag" "$work/depth.bag"
 kill -0 "${pids[2]}" 2>/dev/null ||
   fail "stereo_image_proc died: $(tail -3 "$work/stereo_image_proc.log")"
 # Water after the switch (flagged by pair 8 at the latest, checked below):
@@ -165,14 +166,7 @@ timeout 10 rosservice call /stereo/rcm/reset "n: 1.0" >"$work/reset_air.txt" 2>&
   fail "~reset to n = 1 did not answer: $(cat "$work/reset_air.txt")"
 "$python" "$(dirname "$0")/write_stereo_bag.py" "$work/sim" "$work/water.bag" \
   --rate 4 --t0 1900 --frames 8:16 >/dev/null
-rosbag record -q -O "$work/depth_n1.bag" "${depth_topics[@]}" \
-  >"$work/record_n1.log" 2>&1 &
-recorder=$!
-pids+=($recorder)
-sleep 1
-rosbag play -q "$work/water.bag" >/dev/null 2>&1 || fail "rosbag play (water at n = 1) failed"
-sleep 2
-stop_recorder "$recorder" "$work/depth_n1.bag"
+play_recording_depth "$work/water.bag" "$work/depth_n1.bag"
 "$python" "$(dirname "$0")/check_depth.py" "$work/depth_n1.bag" "$work/sim" \
   --t0 1900 --rate 4 --first 8 --frames 8:16 --off-by-more-than 0.2 \
   --label "n held at 1: " || fail "depth with n = 1 not off by more than 20 %"
