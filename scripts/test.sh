@@ -15,11 +15,12 @@ step() {
   "$@"
   echo "test.sh: $* took $((SECONDS - begin)) s ($((SECONDS - start)) s in all)"
 }
-# Each test suite as 6 ctest entries, its gtest shards (tests/CMakeLists.txt,
-# RCM_TEST_SHARDS): a test binary's start is longer than most tests. For one
-# ctest entry per test (ctest -R NAME), configure build/ with
-# -DRCM_TEST_SHARDS=0.
-step ./scripts/build.sh -DRCM_TEST_SHARDS=6
+# Each test suite as 6 ctest entries, its gtest shards, in both passes
+# (tests/CMakeLists.txt, RCM_TEST_SHARDS; test_sanitizers.sh reads it from
+# here): a test binary's start is longer than most tests. For one ctest
+# entry per test (ctest -R NAME), configure build/ with -DRCM_TEST_SHARDS=0.
+export RCM_TEST_SHARDS=6
+step ./scripts/build.sh -DRCM_TEST_SHARDS="$RCM_TEST_SHARDS"
 step ctest --test-dir build --output-on-failure -j2
 step ./scripts/test_install.sh
 step ./scripts/test_sanitizers.sh

@@ -11,9 +11,10 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 fuzz_seconds=${1:-5}
-# Processes per test suite: enough that the two jobs stay busy to the end
-# (the largest suite, cli_tests, is ~40 % of the pass).
-shards=6
+# Processes per test suite (scripts/test.sh sets it for both passes):
+# enough that the two jobs stay busy to the end (the largest suite,
+# cli_tests, is ~40 % of the pass).
+shards=${RCM_TEST_SHARDS:-6}
 ./scripts/setup.sh
 generator=()  # Ninja for a new build folder, as scripts/build.sh
 if [[ ! -f build-sanitize/CMakeCache.txt ]] && command -v ninja >/dev/null; then

@@ -44,6 +44,13 @@ cleanup() {
 }
 trap cleanup EXIT
 fail() { echo "node_test: FAILED: $*" >&2; exit 1; }
+# A node is up when its topic is advertised (waits at most 10 s).
+wait_for_topic() {
+  for _ in $(seq 1 50); do
+    rostopic list 2>/dev/null | grep -q "$1" && return 0
+    sleep 0.2
+  done
+}
 # Plays BAG while rosbag record writes the depth topics (depth_topics,
 # below) to OUT. rosbag record closes its bag on SIGINT: its Python front
 # end returns at once, the recorder it started renames OUT.active to OUT
@@ -107,17 +114,14 @@ stereo_image_proc=/usr/lib/stereo_image_proc/stereo_image_proc
   left/image_raw:=left/image_rect right/image_raw:=right/image_rect \
   >"$work/stereo_image_proc.log" 2>&1 &
 pids+=($!)
+stereo_image_proc_pid=$!
 depth_topics=(/stereo/rcm/disparity /stereo/rcm/left/camera_info)
 rostopic echo -p /stereo/rcm/refractive_index >"$work/index.csv" \
   2>"$work/echo.err" &
 pids+=($!)
-# The node is up when its topic is advertised.
-for _ in $(seq 1 50); do
-  rostopic list 2>/dev/null | grep -q /stereo/rcm/refractive_index && break
-  sleep 0.2
-done
+wait_for_topic /stereo/rcm/refractive_index
 play_recording_depth "$work/sim.bag" "$work/depth.bag"
-kill -0 "${pids[2]}" 2>/dev/null ||
+kill -0 "$stereo_image_proc_pid" 2>/dev/null ||
   fail "stereo_image_proc died: $(tail -3 "$work/stereo_image_proc.log")"
 # Water after the switch (flagged by pair 8 at the latest, checked below):
 # stereo_image_proc's metric depth within 1 % of the pool's.
@@ -192,10 +196,7 @@ for drift in -0.15 -0.3; do
   stale_pid=$!
   rostopic echo -p /stale_$k/rcm/refractive_index >"$work/stale_$k.csv" 2>/dev/null &
   pids+=($!)
-  for _ in $(seq 1 50); do
-    rostopic list 2>/dev/null | grep -q /stale_$k/rcm/refractive_index && break
-    sleep 0.2
-  done
+  wait_for_topic /stale_$k/rcm/refractive_index
   sleep 1
   rosbag play -q "$work/stale_$k.bag" /stereo/left/image_raw:=/stale_$k/left/image_raw \
     /stereo/right/image_raw:=/stale_$k/right/image_raw >/dev/null 2>&1 ||
