@@ -521,6 +521,63 @@ TEST(LensModels, UnifiedModelsUndistortFailsBeyondNinetyDegrees) {
                                        nan, 0.0, &x, &y));
 }
 
+// A denominator with a pole inside the image (k4..k6 of the fuzz finding,
+// small tangential terms): near the pole the distorted radius grows without
+// bound, so a pixel's distorted radius rd exceeds the pole's radius R and
+// Newton from the distorted point starts beyond the pole. Undistortion must
+// still return the preimage on the principal branch, the normalized point
+// that was distorted, not only some point that reprojects. The map expands
+// towards the pole (d rd / dr >= 1), so the round trip in normalized units
+// is at most the undistortion tolerance, 1e-14 (1 + rd); 1e-12 leaves room.
+TEST(RationalLens, UndistortsPixelsBeyondThePoleRadius) {
+  const double dist[8] = {0.0, 0.0, 0.002, -0.001, 0.0,
+                          -0.046722412109375, -0.046860399433210742,
+                          -0.12499997294894172};
+  const Camera camera =
+      Camera::Create(LensModelId::kRational, 3175, 2893,
+                     {3922.83, 2386.91, 0.0, -92.34},
+                     std::vector<double>(dist, dist + 8))
+          .value();
+  const double pole = camera.MaxInvertibleRadius();
+  ASSERT_NEAR(pole, 1.3506, 1e-3);
+  constexpr double kNormalizedTolerance = 1e-12;
+  int beyond_pole = 0;
+  double worst = 0.0;
+  for (double fraction = 0.05; fraction < 0.999; fraction += 0.0125) {
+    for (int k = 0; k < 24; ++k) {
+      const double angle = 2.0 * M_PI * k / 24.0;
+      const Eigen::Vector2d x =
+          fraction * pole * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+      if (!camera.LensInvertibleAt(x)) continue;
+      double xd, yd;
+      RationalLens::Distort(dist, x.x(), x.y(), &xd, &yd);
+      if (std::hypot(xd, yd) > pole) ++beyond_pole;
+      Eigen::Vector2d back;
+      ASSERT_TRUE(RationalLens::Undistort(dist, xd, yd, &back.x(), &back.y()))
+          << "r " << x.norm() << " rd " << std::hypot(xd, yd);
+      worst = std::max(worst, (back - x).norm());
+    }
+  }
+  EXPECT_GT(beyond_pole, 24) << "the case the test is for was not reached";
+  EXPECT_LT(worst, kNormalizedTolerance);
+}
+
+// A fold: with only k1 = -0.5 the radial part r (1 - r^2 / 2) rises to
+// sqrt(2/3) * 2/3 = 0.5443 at r = sqrt(2/3) and falls after it. A distorted
+// radius beyond that maximum has no preimage on the principal branch and is
+// refused (Newton from it would land past the fold); one just below it is
+// found on the branch.
+TEST(RationalLens, UndistortRefusesRadiiBeyondTheFold) {
+  const double dist[8] = {-0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+  const double fold = std::sqrt(2.0 / 3.0);
+  const double highest = fold * (1.0 - 0.5 * fold * fold);
+  double x, y;
+  EXPECT_FALSE(RationalLens::Undistort(dist, 0.0, 1.01 * highest, &x, &y));
+  ASSERT_TRUE(RationalLens::Undistort(dist, 0.0, 0.99 * highest, &x, &y));
+  EXPECT_LT(std::hypot(x, y), fold);
+  EXPECT_NEAR(y * (1.0 - 0.5 * y * y), 0.99 * highest, 1e-14);
+}
+
 TEST(LensModels, FoldsOfTheNewModels) {
   // Rational with only k1 is radtan's r (1 + k1 r^2): fold at
   // r^2 = -1 / (3 k1).

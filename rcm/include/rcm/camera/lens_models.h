@@ -551,6 +551,69 @@ struct RationalLens : public BaseLens<RationalLens> {
     // d/dr [r n / q] = ((n + 2 s n') q - 2 s n q') / q^2.
     return q > 0.0 && (n + 2.0 * s * dn) * q - 2.0 * s * n * dq > 0.0;
   }
+
+  // The double-precision solve behind Undistort. Newton from the distorted
+  // point is kept when it converges where the lens is rising
+  // (RadiallyIncreasing). Otherwise it started past the principal branch:
+  // a denominator q with negative k4..k6 has a pole at radius R, and a
+  // pixel whose distorted radius rd exceeds R has its preimage below R,
+  // while Newton from rd sits beyond the pole (found by fuzz_camera_model:
+  // k4, k5, k6 = -0.047, -0.047, -0.125, R = 1.351, rd = 1.37). Then
+  // Newton restarts from (xd, yd) * r / rd, where r solves the radial part
+  // alone, r n(r^2) / q(r^2) = rd, on the branch rising from the axis
+  // (RadialInverse); the tangential terms move it by about p1, p2.
+  static bool UndistortScalar(const double* dist, const double target[2],
+                              double point[2]) {
+    if (!std::isfinite(target[0]) || !std::isfinite(target[1])) return false;
+    point[0] = target[0];
+    point[1] = target[1];
+    if (NewtonFrom(dist, target, point) &&
+        RadiallyIncreasing(dist, std::hypot(point[0], point[1]))) {
+      return true;
+    }
+    const double rd = std::hypot(target[0], target[1]);
+    const double r = RadialInverse(dist, rd);
+    if (!std::isfinite(r)) return false;
+    const double scale = rd > 0.0 ? r / rd : 1.0;
+    point[0] = target[0] * scale;
+    point[1] = target[1] * scale;
+    return NewtonFrom(dist, target, point) &&
+           RadiallyIncreasing(dist, std::hypot(point[0], point[1]));
+  }
+
+  // The radius r on the principal branch with r n(r^2) / q(r^2) = rd, or
+  // NaN when the branch ends (a fold or a pole, RadiallyIncreasing false)
+  // below rd. The same scan as Camera::MaxInvertibleRadius, coarser
+  // (steps of pi/1024 in the angle off axis), brackets the root; 60
+  // bisections then place it to the last bit.
+  static double RadialInverse(const double* dist, double rd) {
+    constexpr double kHalfPi = 1.5707963267948966;
+    constexpr int kScanSteps = 512;
+    const auto radial = [dist](double r) {
+      double n, q, dn, dq;
+      RadialParts(dist, r * r, &n, &q, &dn, &dq);
+      return r * n / q;
+    };
+    double low = 0.0;
+    for (int k = 1; k < kScanSteps; ++k) {
+      double high = std::tan(kHalfPi * k / kScanSteps);
+      if (!RadiallyIncreasing(dist, high)) break;
+      if (radial(high) < rd) {
+        low = high;
+        continue;
+      }
+      for (int it = 0; it < 60; ++it) {
+        const double middle = 0.5 * (low + high);
+        if (radial(middle) < rd) {
+          low = middle;
+        } else {
+          high = middle;
+        }
+      }
+      return 0.5 * (low + high);
+    }
+    return std::numeric_limits<double>::quiet_NaN();
+  }
 };
 
 // Double sphere (Usenko, Demmel, Cremers, "The Double Sphere Camera
