@@ -10,7 +10,7 @@ namespace rcm {
 Status FlatPort::Check() const {
   constexpr double kMaxIndex = 2.0;
   std::ostringstream message;
-  const double norm = normal.norm();
+  const double norm = normal.stableNorm();  // No underflow of tiny normals.
   if (!std::isfinite(air_gap) || air_gap < 0.0 || air_gap > kMaxAirGap) {
     message << "port air_gap = " << air_gap << " m is outside [0, "
             << kMaxAirGap << "]";

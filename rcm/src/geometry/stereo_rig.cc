@@ -31,7 +31,9 @@ StatusOr<StereoRig> StereoRig::WithPorts(const FlatPort& left,
   rig.ports_ = Ports{left, right};
   // Unit normals (as a camchain stores them) are kept bit for bit.
   for (FlatPort* port : {&rig.ports_->left, &rig.ports_->right}) {
-    if (std::abs(port->normal.norm() - 1.0) > 1e-12) port->normal.normalize();
+    if (std::abs(port->normal.norm() - 1.0) > 1e-12) {
+      port->normal.stableNormalize();
+    }
   }
   return rig;
 }

@@ -89,7 +89,7 @@ StatusOr<FlatPort> ReadPort(const YamlReader& reader, const YAML::Node& node,
     return reader.Error(node, field, status.message());
   }
   // A unit normal read back from a file rcm wrote stays bit-exact.
-  if (std::abs(port.normal.norm() - 1.0) > 1e-12) port.normal.normalize();
+  if (std::abs(port.normal.norm() - 1.0) > 1e-12) port.normal.stableNormalize();
   return port;
 }
 
