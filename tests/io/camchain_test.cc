@@ -547,6 +547,13 @@ TEST(Camchain, RejectsBadPortBlocks) {
               HasSubstr("cam0.port: missing key 'air_gap'"));
   EXPECT_THAT(with_port("{air_gap: 0.01, glass_thickness: 0.0, gap_mm: 8}"),
               HasSubstr("cam0.port.gap_mm: unknown key"));
+  // A key with a line break and a NUL (a double-quoted YAML key; found by
+  // fuzz_calibration_yaml) is named escaped, on one line.
+  const std::string control = with_port(
+      "{air_gap: 0.01, glass_thickness: 0.0, \"glass\\nthi\\0ckness\": 1}");
+  EXPECT_THAT(control,
+              HasSubstr("cam0.port.glass\\x0athi\\x00ckness: unknown key"));
+  EXPECT_EQ(control.find('\n'), std::string::npos) << control;
   EXPECT_THAT(with_port("{air_gap: -0.01, glass_thickness: 0.0}"),
               HasSubstr("port air_gap = -0.01 m is outside [0, 0.5]"));
   EXPECT_THAT(with_port("{air_gap: 8, glass_thickness: 0.0}"),

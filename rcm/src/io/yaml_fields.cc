@@ -178,14 +178,14 @@ Status YamlReader::Error(const YAML::Node& at, std::string_view field,
     const YAML::Mark mark = at.Mark();
     if (!mark.is_null()) text += ":" + std::to_string(mark.line + 1);
   }
-  if (!field.empty()) text.append(": ").append(field);
+  if (!field.empty()) text.append(": ").append(EscapeControlCharacters(field));
   return Status::Error(text.append(": ").append(message));
 }
 
 Status YamlReader::Error(std::string_view field,
                          std::string_view message) const {
   std::string text = source_name_;
-  if (!field.empty()) text.append(": ").append(field);
+  if (!field.empty()) text.append(": ").append(EscapeControlCharacters(field));
   return Status::Error(text.append(": ").append(message));
 }
 

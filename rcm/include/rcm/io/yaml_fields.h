@@ -144,7 +144,8 @@ class YamlReader {
   // --- Errors.
 
   // "SOURCE:LINE: FIELD: MESSAGE" with the line of `at` (left out when it
-  // has none).
+  // has none). FIELD is built from the file's own keys, so its control
+  // characters are escaped (\x0a): the message stays one line.
   Status Error(const YAML::Node& at, std::string_view field,
                std::string_view message) const;
   // "SOURCE: FIELD: MESSAGE", for a problem that no node stands for.
