@@ -10,11 +10,15 @@
 namespace rcm::calib {
 namespace {
 
-// The quantities of a calibration, in ParameterSpread order.
+// The quantities of a calibration, in ParameterSpread order: the board's
+// bowl last when the warp is estimated.
 std::vector<double> Quantities(const StereoCalibration& c) {
-  return {c.cam0.camera.fx(), c.cam0.camera.fy(), c.cam0.camera.cx(),
-          c.cam0.camera.cy(), c.cam1.camera.fx(), c.cam1.camera.fy(),
-          c.cam1.camera.cx(), c.cam1.camera.cy(), c.baseline};
+  std::vector<double> quantities = {
+      c.cam0.camera.fx(), c.cam0.camera.fy(), c.cam0.camera.cx(),
+      c.cam0.camera.cy(), c.cam1.camera.fx(), c.cam1.camera.fy(),
+      c.cam1.camera.cx(), c.cam1.camera.cy(), c.baseline};
+  if (c.board_warp_estimated) quantities.push_back(c.BoardBowl());
+  return quantities;
 }
 
 }  // namespace
@@ -93,17 +97,20 @@ StatusOr<CrossValidation> CrossValidateStereo(
                          " of " + std::to_string(groups) +
                          " leave-out calibrations succeeded");
   }
-  const char* names[9] = {"cam0 fx", "cam0 fy", "cam0 cx", "cam0 cy", "cam1 fx",
-                          "cam1 fy", "cam1 cx", "cam1 cy", "baseline"};
-  const double reported[9] = {
+  const char* names[10] = {"cam0 fx", "cam0 fy", "cam0 cx", "cam0 cy",
+                           "cam1 fx", "cam1 fy", "cam1 cx", "cam1 cy",
+                           "baseline", "board bowl"};
+  const double reported[10] = {
       full.cam0.sigma[0], full.cam0.sigma[1], full.cam0.sigma[2],
       full.cam0.sigma[3], full.cam1.sigma[0], full.cam1.sigma[1],
-      full.cam1.sigma[2], full.cam1.sigma[3], full.baseline_sigma};
+      full.cam1.sigma[2], full.cam1.sigma[3], full.baseline_sigma,
+      full.BoardBowlSigma()};
   const std::vector<double> full_values = Quantities(full);
-  for (int q = 0; q < 9; ++q) {
+  const int num_quantities = static_cast<int>(full_values.size());
+  for (int q = 0; q < num_quantities; ++q) {
     ParameterSpread spread;
     spread.name = names[q];
-    spread.unit = q == 8 ? "m" : "px";
+    spread.unit = q >= 8 ? "m" : "px";
     spread.full = full_values[q];
     spread.reported_sigma = reported[q];
     double mean = 0.0;

@@ -55,7 +55,7 @@ DEFINE_bool(flat_board, false,
 DEFINE_string(uncertainty_distance, "inf",
               "distance [m] of the projection uncertainty in the report "
               "(mrcal's mean-frames method through the board poses); inf: "
-              "at infinity");
+              "at infinity; not with --underwater");
 DEFINE_int32(min_corners, 6,
              "fewest corners of a view in one image for it to be used");
 
@@ -198,6 +198,14 @@ int RunCalibrate() {
                  "air calibration's (--air)");
       return kExitUsage;
     }
+    if (!gflags::GetCommandLineFlagInfoOrDie("uncertainty_distance")
+             .is_default) {
+      PrintError(command,
+                 "--uncertainty-distance does not go with --underwater: the "
+                 "underwater report gives n's and the extrinsics' sigmas, "
+                 "not a projection uncertainty (the lenses are --air's)");
+      return kExitUsage;
+    }
     UnderwaterRunOptions underwater;
     underwater.huber_px = FLAGS_huber;
     underwater.outlier_sigmas = FLAGS_outlier_sigmas;
@@ -272,6 +280,14 @@ int RunCalibrate() {
   report_options.uncertainty_distance_m = uncertainty_distance;
   calib::CalibrationReport report = calib::SummarizeCalibration(
       *calibration, views, sizes[0], sizes[1], report_options);
+  // The leave-out sigma of a quantity of the table (ParameterSpread::name).
+  auto jackknife = [&](const std::string& name) -> std::optional<double> {
+    if (!cross_validation) return std::nullopt;
+    for (const calib::ParameterSpread& p : cross_validation->parameters) {
+      if (p.name == name) return p.jackknife_sigma;
+    }
+    return std::nullopt;
+  };
   if (cross_validation) {
     for (const calib::ParameterSpread& p : cross_validation->parameters) {
       // The covariance assumes independent corner noise; a leave-out
@@ -279,8 +295,11 @@ int RunCalibrate() {
       if (p.jackknife_sigma > 2.0 * p.reported_sigma) {
         report.warnings.push_back(
             p.name + ": the leave-out spread (sigma " +
-            FormatFixed(p.jackknife_sigma, p.unit == "m" ? 6 : 3) + " " +
-            p.unit + ") is " +
+            (p.name == "board bowl"
+                 ? FormatFixed(1e3 * p.jackknife_sigma, 3) + " mm"
+                 : FormatFixed(p.jackknife_sigma, p.unit == "m" ? 6 : 3) +
+                       " " + p.unit) +
+            ") is " +
             FormatFixed(p.jackknife_sigma / p.reported_sigma, 1) +
             "x the covariance's; corner errors are correlated within views "
             "(board flatness, blur, lens model): trust the leave-out figure");
@@ -345,7 +364,7 @@ int RunCalibrate() {
                                                    sigma6[5]};
   json["board_flatness"] = BoardFlatnessJson(
       calibration->board_warp_estimated, calibration->board_warp,
-      calibration->board_warp_covariance);
+      calibration->board_warp_covariance, jackknife("board bowl"));
   for (int c = 0; c < 2; ++c) {
     const calib::CalibrationReport::CameraStats& s = report.cameras[c];
     json["coverage"]["cam" + std::to_string(c)] = s.coverage;
@@ -407,13 +426,6 @@ int RunCalibrate() {
     std::cout << json.dump(2) << std::endl;
     return kExitOk;
   }
-  auto jackknife = [&](const std::string& name) -> std::optional<double> {
-    if (!cross_validation) return std::nullopt;
-    for (const calib::ParameterSpread& p : cross_validation->parameters) {
-      if (p.name == name) return p.jackknife_sigma;
-    }
-    return std::nullopt;
-  };
   std::printf("%d views used (%d stereo), %d corners, %d outliers\n",
               calibration->num_views_used, calibration->num_stereo_views,
               calibration->num_inliers + calibration->num_outliers,
@@ -468,7 +480,8 @@ int RunCalibrate() {
   }
   std::printf("%s\n", BoardFlatnessText(calibration->board_warp_estimated,
                                          calibration->board_warp,
-                                         calibration->board_warp_covariance)
+                                         calibration->board_warp_covariance,
+                                         jackknife("board bowl"))
                            .c_str());
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)

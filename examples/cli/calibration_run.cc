@@ -82,12 +82,14 @@ std::string WithSigma(double value, double sigma, int digits,
 }
 
 std::string BoardFlatnessText(bool estimated, const Eigen::Vector2d& warp,
-                              const Eigen::Matrix2d& covariance) {
+                              const Eigen::Matrix2d& covariance,
+                              std::optional<double> bowl_leave_out_sigma) {
   if (!estimated) return "board flatness: assumed flat (--flat-board)";
   const Eigen::Vector2d sigma = covariance.diagonal().cwiseSqrt();
+  if (bowl_leave_out_sigma) *bowl_leave_out_sigma *= 1e3;
   return "board flatness: bowl " +
          WithSigma(1e3 * warp.sum(), 1e3 * std::sqrt(covariance.sum()), 2,
-                   std::nullopt) +
+                   bowl_leave_out_sigma) +
          " mm at the centre (x " +
          WithSigma(1e3 * warp.x(), 1e3 * sigma.x(), 2, std::nullopt) +
          ", y " + WithSigma(1e3 * warp.y(), 1e3 * sigma.y(), 2, std::nullopt) +
@@ -95,7 +97,8 @@ std::string BoardFlatnessText(bool estimated, const Eigen::Vector2d& warp,
 }
 
 nlohmann::json BoardFlatnessJson(bool estimated, const Eigen::Vector2d& warp,
-                                 const Eigen::Matrix2d& covariance) {
+                                 const Eigen::Matrix2d& covariance,
+                                 std::optional<double> bowl_leave_out_sigma) {
   nlohmann::json json = {{"estimated", estimated}};
   if (!estimated) return json;
   const Eigen::Vector2d sigma = covariance.diagonal().cwiseSqrt();
@@ -103,6 +106,9 @@ nlohmann::json BoardFlatnessJson(bool estimated, const Eigen::Vector2d& warp,
   json["board_warp_sigma_mm"] = {1e3 * sigma.x(), 1e3 * sigma.y()};
   json["bowl_mm"] = 1e3 * warp.sum();
   json["bowl_sigma_mm"] = 1e3 * std::sqrt(covariance.sum());
+  if (bowl_leave_out_sigma) {
+    json["bowl_leave_out_sigma_mm"] = 1e3 * *bowl_leave_out_sigma;
+  }
   return json;
 }
 

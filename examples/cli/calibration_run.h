@@ -42,15 +42,22 @@ std::string WithSigma(double value, double sigma, int digits,
 // The board's flatness as rcm calibrate prints it: "board flatness: bowl
 // 0.74 +- 0.05 mm at the centre (x 0.40 +- 0.03, y 0.34 +- 0.03 mm)", or
 // "board flatness: assumed flat (--flat-board)" when not estimated. warp
-// [m], covariance [m^2] (board_warp.h).
-std::string BoardFlatnessText(bool estimated, const Eigen::Vector2d& warp,
-                              const Eigen::Matrix2d& covariance);
+// [m], covariance [m^2] (board_warp.h); the bowl's leave-out sigma [m],
+// when the folds ran, in parentheses after its covariance sigma as the
+// other quantities' ("0.74 +- 0.05 (0.21) mm").
+std::string BoardFlatnessText(
+    bool estimated, const Eigen::Vector2d& warp,
+    const Eigen::Matrix2d& covariance,
+    std::optional<double> bowl_leave_out_sigma = std::nullopt);
 
 // Its JSON: {"estimated", "board_warp_mm": [x, y], "board_warp_sigma_mm":
-// [sx, sy], "bowl_mm", "bowl_sigma_mm"} (the bowl at the centre is
-// warp_x + warp_y); {"estimated": false} when not estimated.
-nlohmann::json BoardFlatnessJson(bool estimated, const Eigen::Vector2d& warp,
-                                 const Eigen::Matrix2d& covariance);
+// [sx, sy], "bowl_mm", "bowl_sigma_mm"[, "bowl_leave_out_sigma_mm"]} (the
+// bowl at the centre is warp_x + warp_y); {"estimated": false} when not
+// estimated.
+nlohmann::json BoardFlatnessJson(
+    bool estimated, const Eigen::Vector2d& warp,
+    const Eigen::Matrix2d& covariance,
+    std::optional<double> bowl_leave_out_sigma = std::nullopt);
 
 // The detection pass over every pair (a progress bar on a terminal). Its
 // warnings wait until the pass is over, so that a run that fails says one

@@ -217,6 +217,28 @@ TEST(CalibrateCli, FoldersToCamchainAndReport) {
             4.0 * json["board_flatness"]["bowl_sigma_mm"].get<double>());
   EXPECT_NE(result.out.find("board flatness: bowl "), std::string::npos)
       << result.out;
+  // The bowl's leave-out sigma: the folds' row, in the JSON's board
+  // flatness (mm) and in the text's parentheses.
+  const nlohmann::json& bowl_row =
+      json["cross_validation"]["parameters"]["board bowl"];
+  ASSERT_TRUE(bowl_row.is_object()) << json["cross_validation"].dump();
+  EXPECT_GT(bowl_row["jackknife_sigma"].get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(
+      json["board_flatness"]["bowl_leave_out_sigma_mm"].get<double>(),
+      1e3 * bowl_row["jackknife_sigma"].get<double>());
+  EXPECT_DOUBLE_EQ(1e3 * bowl_row["full"].get<double>(),
+                   json["board_flatness"]["bowl_mm"].get<double>());
+  char leave_out[32];
+  std::snprintf(
+      leave_out, sizeof(leave_out), " (%.2f) mm at the centre",
+      json["board_flatness"]["bowl_leave_out_sigma_mm"].get<double>());
+  const size_t flatness = result.out.find("board flatness: bowl ");
+  ASSERT_NE(flatness, std::string::npos) << result.out;
+  EXPECT_NE(result.out.substr(flatness, result.out.find('\n', flatness) -
+                                            flatness)
+                .find(leave_out),
+            std::string::npos)
+      << result.out;
   EXPECT_EQ(json["projection_uncertainty"]["cam0"]["distance_m"], "inf");
   EXPECT_GT(json["projection_uncertainty"]["cam1"]["median_px"].get<double>(),
             0.0);
@@ -244,6 +266,7 @@ TEST(CalibrateCli, JsonOnStdoutAndAnOutputFolder) {
             2);
   EXPECT_EQ(json["camchain"], dir + "/calibration/camchain.yaml");
   EXPECT_FALSE(json.contains("cross_validation"));
+  EXPECT_FALSE(json["board_flatness"].contains("bowl_leave_out_sigma_mm"));
   EXPECT_EQ(json["cam0"]["distortion_model"], "radtan");
   EXPECT_EQ(json["cam0"]["sigma"].size(), 8u);
   ExpectCloseToTruth(dir + "/calibration/camchain.yaml");

@@ -373,6 +373,11 @@ TEST(UnderwaterCli, FlagsThatNeedUnderwater) {
                 "--right r --out " +
                 water + " " + Board(0.03))),
       water, "--model does not go with --underwater", 2);
+  ExpectRefused(
+      Rcm(Words("calibrate --underwater --uncertainty-distance 2 --air a.yaml "
+                "--left l --right r --out " +
+                water + " " + Board(0.03))),
+      water, "--uncertainty-distance does not go with --underwater", 2);
 }
 
 }  // namespace

@@ -34,7 +34,7 @@ struct CrossValidationOptions {
 
 // One calibrated quantity across the folds.
 struct ParameterSpread {
-  std::string name;   // "cam0 fx", ..., "baseline"
+  std::string name;   // "cam0 fx", ..., "baseline", "board bowl"
   std::string unit;   // "px", "m"
   double full = 0.0;  // the all-views estimate
   double min = 0.0;   // over the folds
@@ -46,7 +46,10 @@ struct ParameterSpread {
 struct CrossValidation {
   int folds = 0;         // calibrations run
   int failed_folds = 0;  // of which failed (too few views left); skipped
-  // cam0 fx, fy, cx, cy, cam1 fx, fy, cx, cy, baseline.
+  // cam0 fx, fy, cx, cy, cam1 fx, fy, cx, cy, baseline, and the board's
+  // bowl (StereoCalibration::BoardBowl) when the full calibration
+  // estimated the warp: a bow that differs from view to view (a hand-held
+  // board) shows as a leave-out spread well above its covariance sigma.
   std::vector<ParameterSpread> parameters;
 };
 
