@@ -8,7 +8,10 @@
 # $RCM_FUZZ_BUILD_DIR (default build-sanitize, which scripts/
 # test_sanitizers.sh makes). Each target starts from its seed corpus in
 # fuzz/corpus/ (read only; new inputs go to a temporary folder) with its
-# dictionary, when it has one. A finding (crash, sanitizer report, violated
+# dictionary, when it has one. RCM_FUZZ_SEED, when set, is libFuzzer's
+# -seed (CI's short run sets it: the same inputs in the same order on every
+# run, so that a red CI is a change's, not a draw's; the long run leaves it
+# unset, a new draw each time). A finding (crash, sanitizer report, violated
 # property, leak, timeout) leaves the reproducer in fuzz-findings/ and makes
 # the script exit 1; otherwise it prints each target's executions.
 set -euo pipefail
@@ -36,6 +39,7 @@ run_one() {
   local args=(-max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048
               -print_final_stats=1 -artifact_prefix="fuzz-findings/$target-")
   [[ -f fuzz/$name.dict ]] && args+=(-dict="fuzz/$name.dict")
+  [[ -n ${RCM_FUZZ_SEED:-} ]] && args+=(-seed="$RCM_FUZZ_SEED")
   mkdir -p "$work/$name"
   local seeds=()
   [[ -d fuzz/corpus/$name ]] && seeds+=("fuzz/corpus/$name")
