@@ -12,6 +12,7 @@
 #include "rcm/estimation/batch_refinement.h"
 #include "rcm/estimation/closed_form.h"
 #include "rcm/estimation/generalized_epipolar_error.h"
+#include "rcm/estimation/locus_cost_function.h"
 #include "rcm/estimation/online_estimator.h"
 #include "rcm/estimation/paper_online_estimator.h"
 #include "rcm/estimation/prepared_correspondence.h"
@@ -107,6 +108,24 @@ void BM_SampsonResidual(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_SampsonResidual);
+
+// A frame's matches into the locus cost function on one thread: each match
+// at the 577 nodes, r and dr/dn vectorized over the matches
+// (sampson_residual_batch.h); per match, against 577 x BM_SampsonResidual's
+// Jet twin.
+void BM_LocusCostFunctionAddMatches(benchmark::State& state) {
+  const StereoRig rig = AlphasenseFrontUnrectifiedRig();
+  const std::vector<PreparedCorrespondence> matches =
+      PrepareCorrespondences(rig, Matches(rig)).prepared;
+  const Eigen::Matrix3d essential = EssentialMatrix(rig.right_from_left());
+  for (auto _ : state) {
+    LocusCostFunction cost;
+    benchmark::DoNotOptimize(cost.AddMatches(essential, matches, 1));
+  }
+  state.SetItemsProcessed(state.iterations() *
+                          static_cast<int64_t>(matches.size()));
+}
+BENCHMARK(BM_LocusCostFunctionAddMatches)->Unit(benchmark::kMillisecond);
 
 // The thick-port residual (generalized epipolar constraint, Sampson-
 // normalized by central differences: nine evaluations of both rays),

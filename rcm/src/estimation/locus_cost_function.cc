@@ -1,6 +1,5 @@
 #include "rcm/estimation/locus_cost_function.h"
 
-#include <ceres/jet.h>
 #include <glog/logging.h>
 
 #include <algorithm>
@@ -9,7 +8,7 @@
 #include <limits>
 #include <memory>
 
-#include "rcm/estimation/sampson_coplanarity_error.h"
+#include "rcm/estimation/sampson_residual_batch.h"
 #include "rcm/util/golden_section.h"
 #include "rcm/util/parallel_for.h"
 
@@ -89,32 +88,33 @@ int64_t LocusCostFunction::AddMatches(
     std::vector<int64_t>* rejected) {
   CHECK_GE(num_threads, 1);
   if (rejected != nullptr) rejected->clear();
-  using Jet = ceres::Jet<double, 1>;
   const auto& nodes = Nodes();
   const int64_t count = static_cast<int64_t>(matches.size());
   if (count == 0) return 0;
 
+  // r and dr/dn of all matches at one node at a time, vectorized
+  // (sampson_residual_batch.h); each node's sums in the matches' order.
+  const SampsonResidualBatch batch(essential, matches);
   Values cost{}, cost_derivative{}, information{};
   std::unique_ptr<std::atomic<bool>[]> invalid(new std::atomic<bool>[count] {});
   std::atomic<bool> any_invalid(false);
   ParallelFor(kNumNodes, num_threads,
               std::max<int64_t>(1, kMinEvaluationsPerThread / count),
               [&](int64_t begin, int64_t end) {
+                SampsonResidualBatch::Workspace workspace;
+                Eigen::ArrayXd r, dr;
                 for (int64_t k = begin; k < end; ++k) {
-                  const Jet n(nodes[k], 0);
+                  batch.Evaluate(nodes[k], &workspace, &r, &dr);
                   double c = 0.0, d = 0.0, g = 0.0;
                   for (int64_t i = 0; i < count; ++i) {
-                    Jet r;
-                    if (!SampsonCoplanarityResidual<Jet>(essential, matches[i],
-                                                         n, nullptr, &r) ||
-                        !std::isfinite(r.a) || !std::isfinite(r.v[0])) {
+                    if (!std::isfinite(r[i]) || !std::isfinite(dr[i])) {
                       invalid[i].store(true, std::memory_order_relaxed);
                       any_invalid.store(true, std::memory_order_relaxed);
                       continue;
                     }
-                    c += r.a * r.a;
-                    d += 2.0 * r.a * r.v[0];
-                    g += r.v[0] * r.v[0];
+                    c += r[i] * r[i];
+                    d += 2.0 * r[i] * dr[i];
+                    g += dr[i] * dr[i];
                   }
                   cost[k] = c;
                   cost_derivative[k] = d;
