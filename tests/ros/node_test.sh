@@ -98,11 +98,8 @@ set -e
 [[ $(printf '%s\n' "$out" | grep -c .) -eq 1 ]] || fail "a missing ~calib printed more than one line: $out"
 echo "bad ~calib: $out"
 
-# ~max_matches 0: the window takes every match of a pair (about 1200, not
-# the real-time default's 400), the accuracy the 2e-3 below needs; at 400
-# the worst pair here is 2.2e-3 off, within its sigma_n (README).
 "$node" __name:=rcm __ns:=/stereo _calib:="$work/sim/camchain.yaml" \
-  _warn_period:=2.0 _max_matches:=0 >"$work/node.log" 2>&1 &
+  _warn_period:=2.0 >"$work/node.log" 2>&1 &
 pids+=($!)
 node_pid=$!
 # Debian's stereo_image_proc on the node's rectified pair, as a VIO's

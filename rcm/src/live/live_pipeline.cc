@@ -47,6 +47,12 @@ double Contrast(const cv::Mat& image) {
 RefinementOptions LivePipelineOptions::DefaultRefinement() {
   RefinementOptions options;
   options.systematic_px = kFrontEndSystematicPx;
+  // The window on the caller's thread alone: the budget is CPU time, and a
+  // second thread adds more CPU than it saves in wall time (live_benchmark:
+  // window + remaps of ~1200 matches 17.4 ms of CPU on one thread, 18.4-21.6
+  // ms on two); the other core has the front end's second thread and the
+  // map worker.
+  options.num_threads = 1;
   return options;
 }
 

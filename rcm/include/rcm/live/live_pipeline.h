@@ -25,14 +25,15 @@
 // thread while the pairs keep being corrected with the current ones; the
 // first pair processed after the build has finished uses the new maps
 // (LiveFrame::maps_updated). One build at a time: if n has moved on when
-// it finishes, the next pair starts another. A build costs 47 ms for
-// 720x540 on one core (benchmarks/live_benchmark.cc), about a pair's whole
+// it finishes, the next pair starts another. A build costs 47-77 ms (over
+// this machine's runs) for 720x540 on one core (benchmarks/live_benchmark.cc), about a pair's whole
 // period at 20 Hz, hence the worker.
 //
 // Cost per 720x540 pair (live_benchmark, this project's 2-core machine):
-// the window's update of 400 matches and both remaps 17.5 ms of CPU, 35 %
-// of one core at 20 Hz; the front end's matching adds ~27 ms (on both
-// cores, 25 ms wall for the whole Process). The threshold's default, 1e-3, moves the corrected images'
+// the window's update of all ~1200 matches and both remaps 17.4-19.6 ms
+// of CPU, 35-39 % of one core at 20 Hz; the front end's matching
+// adds ~31-35 ms (on both cores; 35-39 ms wall for the whole
+// Process). The map threshold's default, 1e-3, moves the corrected images'
 // focal length by 0.1 %, below what a metric depth of 1 % needs.
 //
 // Hold (SetHold): the maps stay at their n and no build starts; the
@@ -78,12 +79,13 @@ struct LivePipelineOptions {
   double map_update_threshold = 1e-3;
   // Matches of a pair the window takes at most, every k-th of the front
   // end's (which come in image order, so the subset keeps their spread);
-  // >= 0, 0 takes all. The window's update costs ~44 us of CPU per match
-  // (the robust fit's scan and the self-calibrated rotation): the ~1200
-  // matches of a 720x540 pair take 52 ms, over the 25 ms that half a core
-  // at 20 Hz allows; 400 take a third. Their noise share of sigma_n grows
-  // by sqrt(3), under the calibration's share on a drifting rig.
-  int max_matches = 400;
+  // >= 0, 0 takes all. The window's update costs ~12 us of CPU per
+  // match (the locus cost function's 577 nodes, sampson_residual_batch.h,
+  // the robust fit's scan and the self-calibrated rotation): the ~1200
+  // matches a 720x540 pair gives take ~14-15 ms, and the cap bounds a
+  // richer scene's up to the front end's 2000 features within the 25 ms
+  // that half a core at 20 Hz allows.
+  int max_matches = 1500;
   // A gray standard deviation below this (either image) refuses the pair
   // as blank; >= 0 (0 accepts every pair). 2 gray levels: a lit scene has
   // tens, a covered or black frame its sensor noise.
