@@ -229,6 +229,17 @@ TEST(OpenCvSampleStereo, RationalRmsAtOrBelowRadTan) {
   EXPECT_LE(rational->rms_px, radtan->rms_px + 1e-6);
 }
 
+// The folds of the sample pairs' calibration `full` (made with `options`).
+CrossValidation CrossValidateSample(const StereoCalibration& full,
+                                    const StereoCalibrationOptions& options,
+                                    int folds) {
+  CrossValidationOptions cross_validation_options;
+  cross_validation_options.folds = folds;
+  return CrossValidateStereo(SampleBoard(), SampleViews(), kSize, kSize, full,
+                             options, cross_validation_options)
+      .value();
+}
+
 TEST(OpenCvSampleStereo, LeaveOneOutIsStable) {
   // Leave-one-pair-out cross-validation: 13 calibrations of 12 pairs.
   // Stable means every leave-one-out estimate is within 0.5 % of the focal
@@ -242,16 +253,9 @@ TEST(OpenCvSampleStereo, LeaveOneOutIsStable) {
   // 1 mm bowl BoardWarpOnRenders recovers, a third of the 0.74 mm the
   // issue measured on a real printed board (measured here: 0.10 mm).
   constexpr double kMaxBowlRange = 0.25e-3;
-  const std::vector<StereoView>& views = SampleViews();
-  const StereoCalibrationOptions options;
   const StereoCalibration full =
-      CalibrateStereo(SampleBoard(), views, kSize, kSize, options).value();
-  CrossValidationOptions cross_validation_options;
-  cross_validation_options.folds = 13;
-  const CrossValidation cross_validation =
-      CrossValidateStereo(SampleBoard(), views, kSize, kSize, full, options,
-                          cross_validation_options)
-          .value();
+      CalibrateStereo(SampleBoard(), SampleViews(), kSize, kSize).value();
+  const CrossValidation cross_validation = CrossValidateSample(full, {}, 13);
   EXPECT_EQ(cross_validation.folds, 13);
   EXPECT_EQ(cross_validation.failed_folds, 0);
   // Nine quantities, and the board's bowl (the warp is estimated by
@@ -287,15 +291,11 @@ TEST(OpenCvSampleStereo, LeaveOneOutIsStable) {
 TEST(CrossValidation, FlatBoardHasNoBowlRow) {
   StereoCalibrationOptions options;
   options.estimate_board_warp = false;
-  const std::vector<StereoView>& views = SampleViews();
   const StereoCalibration full =
-      CalibrateStereo(SampleBoard(), views, kSize, kSize, options).value();
-  CrossValidationOptions cross_validation_options;
-  cross_validation_options.folds = 3;
-  const CrossValidation cross_validation =
-      CrossValidateStereo(SampleBoard(), views, kSize, kSize, full, options,
-                          cross_validation_options)
+      CalibrateStereo(SampleBoard(), SampleViews(), kSize, kSize, options)
           .value();
+  const CrossValidation cross_validation =
+      CrossValidateSample(full, options, 3);
   ASSERT_EQ(cross_validation.parameters.size(), 9u);
   EXPECT_EQ(cross_validation.parameters.back().name, "baseline");
 }

@@ -58,15 +58,6 @@ DirectSums SumDirectly(const Eigen::Matrix3d& essential,
   return sums;
 }
 
-std::vector<PreparedCorrespondence> NoisyMatches(const StereoRig& rig, double n,
-                                                 int count, double sigma_px,
-                                                 uint64_t seed) {
-  std::vector<StereoCorrespondence> data =
-      test::ExactMatches(rig, n, count, seed);
-  AddPixelNoise(sigma_px, seed + 100, &data);
-  return PrepareCorrespondences(rig, data).prepared;
-}
-
 // Largest ray angle in air, degrees, over both images of the matches.
 double MaxRayAngleDegrees(const std::vector<PreparedCorrespondence>& matches) {
   double max_r = 0.0;
@@ -166,7 +157,7 @@ TEST(LocusCostFunction, NodesAreGradedChebyshevPointsOnUnitInterval) {
 TEST(LocusCostFunction, InterpolantMatchesDirectSumsOnDatasetRig) {
   const StereoRig rig = test::AlphasenseRealisticRig();
   const std::vector<PreparedCorrespondence> matches =
-      NoisyMatches(rig, 1.333, 300, 0.5, 11);
+      test::NoisyPreparedMatches(rig, 1.333, 300, 0.5, 11);
   const double worst =
       WorstInterpolationError(EssentialMatrix(rig.right_from_left()), matches);
   std::cout << "worst relative error on the Alphasense rig: " << worst
@@ -180,7 +171,7 @@ TEST(LocusCostFunction, InterpolantMatchesDirectSumsOnWidestFisheye) {
   // touches n = 1. Uniform pixels rarely reach the corners: keep 300
   // matches of a large sample plus its 50 widest.
   std::vector<PreparedCorrespondence> sample =
-      NoisyMatches(rig, 1.1, 20000, 0.5, 12);
+      test::NoisyPreparedMatches(rig, 1.1, 20000, 0.5, 12);
   std::vector<PreparedCorrespondence> matches(sample.begin(),
                                               sample.begin() + 300);
   std::partial_sort(
@@ -200,9 +191,9 @@ TEST(LocusCostFunction, AddAndSubtractCombineSetsOfMatches) {
   const StereoRig rig = test::AlphasenseRealisticRig();
   const Eigen::Matrix3d essential = EssentialMatrix(rig.right_from_left());
   const std::vector<PreparedCorrespondence> first =
-      NoisyMatches(rig, 1.333, 100, 0.5, 21);
+      test::NoisyPreparedMatches(rig, 1.333, 100, 0.5, 21);
   const std::vector<PreparedCorrespondence> second =
-      NoisyMatches(rig, 1.333, 50, 0.5, 22);
+      test::NoisyPreparedMatches(rig, 1.333, 50, 0.5, 22);
   std::vector<PreparedCorrespondence> both = first;
   both.insert(both.end(), second.begin(), second.end());
 
@@ -237,7 +228,7 @@ TEST(LocusCostFunction, ResultDoesNotDependOnThreads) {
   const Eigen::Matrix3d essential = EssentialMatrix(rig.right_from_left());
   // Enough matches for AddMatches to use both threads.
   const std::vector<PreparedCorrespondence> matches =
-      NoisyMatches(rig, 1.333, 500, 0.5, 31);
+      test::NoisyPreparedMatches(rig, 1.333, 500, 0.5, 31);
   LocusCostFunction one, two;
   one.AddMatches(essential, matches, 1);
   two.AddMatches(essential, matches, 2);
@@ -253,7 +244,7 @@ TEST(LocusCostFunction, MinimizerEqualsBruteForceOnDirectSums) {
   const Eigen::Matrix3d essential = EssentialMatrix(rig.right_from_left());
   for (const double n_true : {1.05, 1.333, 1.6}) {
     const std::vector<PreparedCorrespondence> matches =
-        NoisyMatches(rig, n_true, 200, 0.5, 41);
+        test::NoisyPreparedMatches(rig, n_true, 200, 0.5, 41);
     LocusCostFunction function;
     function.AddMatches(essential, matches);
     const LocusCostFunction::Minimum minimum = function.Minimize();
@@ -278,7 +269,7 @@ TEST(LocusCostFunction, MinimumOnTheLowerBoundIsTheBound) {
   int checked = 0;
   for (uint64_t seed = 50; seed < 60 && checked == 0; ++seed) {
     const std::vector<PreparedCorrespondence> matches =
-        NoisyMatches(rig, 1.0, 200, 0.5, seed);
+        test::NoisyPreparedMatches(rig, 1.0, 200, 0.5, seed);
     if (!(SumDirectly(essential, matches, 1.0).cost_derivative > 0.0)) {
       continue;
     }

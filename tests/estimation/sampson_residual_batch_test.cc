@@ -30,15 +30,6 @@ using Jet = ceres::Jet<double, 1>;
 constexpr double kRelativeTolerance = 1e-12;
 constexpr double kAbsoluteTolerancePx = 1e-12;
 
-std::vector<PreparedCorrespondence> NoisyMatches(const StereoRig& rig, double n,
-                                                 int count, double sigma_px,
-                                                 uint64_t seed) {
-  std::vector<StereoCorrespondence> data =
-      test::ExactMatches(rig, n, count, seed);
-  AddPixelNoise(sigma_px, seed + 100, &data);
-  return PrepareCorrespondences(rig, data).prepared;
-}
-
 // Every node of the locus cost function, and n at 1, just above it and at 2.
 std::vector<double> TestIndices() {
   const auto& nodes = LocusCostFunction::Nodes();
@@ -81,7 +72,7 @@ double WorstAgainstJet(const Eigen::Matrix3d& essential,
 TEST(SampsonResidualBatch, MatchesTheJetFormOnDatasetRig) {
   const StereoRig rig = test::AlphasenseRealisticRig();
   const double worst = WorstAgainstJet(EssentialMatrix(rig.right_from_left()),
-                                       NoisyMatches(rig, 1.333, 300, 0.5, 3));
+                                       test::NoisyPreparedMatches(rig, 1.333, 300, 0.5, 3));
   std::printf("worst error against the Jet form: %.3g of the tolerance\n",
               worst);
   EXPECT_LE(worst, 1.0);
@@ -93,7 +84,7 @@ TEST(SampsonResidualBatch, MatchesTheJetFormOnEveryTestCamera) {
   for (const Camera& camera : test::AllTestCameras()) {
     const StereoRig rig = test::IdealRig(camera, camera, 0.2);
     const double worst = WorstAgainstJet(EssentialMatrix(rig.right_from_left()),
-                                         NoisyMatches(rig, 1.1, 200, 0.5, 5));
+                                         test::NoisyPreparedMatches(rig, 1.1, 200, 0.5, 5));
     EXPECT_LE(worst, 1.0) << camera.width() << "x" << camera.height();
   }
 }

@@ -106,6 +106,15 @@ std::vector<StereoCorrespondence> ExactMatches(const StereoRig& rig, double n,
   return SampleStereoCorrespondences(rig, options).value();
 }
 
+std::vector<PreparedCorrespondence> NoisyPreparedMatches(const StereoRig& rig,
+                                                         double n, int count,
+                                                         double sigma_px,
+                                                         uint64_t seed) {
+  std::vector<StereoCorrespondence> data = ExactMatches(rig, n, count, seed);
+  AddPixelNoise(sigma_px, seed + 100, &data);
+  return PrepareCorrespondences(rig, data).prepared;
+}
+
 std::vector<StereoCorrespondence> ExactMatchesOnAxis(bool on_row, int count) {
   const StereoRig rig = test::AlphasenseIdealRig();
   const RefractiveCamera left =

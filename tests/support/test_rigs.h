@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "rcm/camera/camera.h"
+#include "rcm/estimation/prepared_correspondence.h"
 #include "rcm/geometry/stereo_correspondence.h"
 #include "rcm/geometry/stereo_rig.h"
 
@@ -56,6 +57,12 @@ StereoRig NarrowRadtanRig();
 // depths 0.6-6 m (rcm/sim/stereo_sampler.h).
 std::vector<StereoCorrespondence> ExactMatches(const StereoRig& rig, double n,
                                                int count, uint64_t seed = 1);
+// ExactMatches with Gaussian pixel noise of sigma_px (seed + 100), prepared
+// for the estimators (prepared_correspondence.h; the unusable dropped).
+std::vector<PreparedCorrespondence> NoisyPreparedMatches(const StereoRig& rig,
+                                                         double n, int count,
+                                                         double sigma_px,
+                                                         uint64_t seed);
 
 // `count` exact matches (n = 1.333, depths 0.6-6 m) of AlphasenseIdealRig()
 // whose left pixels lie on one image axis: normalized y = 0 (`on_row`,
