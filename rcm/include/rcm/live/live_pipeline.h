@@ -32,8 +32,8 @@
 // Cost per 720x540 pair (live_benchmark, this project's 2-core machine):
 // the window's update of all ~1200 matches and both remaps 17.4-19.6 ms
 // of CPU, 35-39 % of one core at 20 Hz; the front end's matching
-// adds ~31-35 ms (on both cores; 35-39 ms wall for the whole
-// Process). The map threshold's default, 1e-3, moves the corrected images'
+// adds ~31-38 ms (on both cores; 35-43 ms wall for the whole Process,
+// 23-28 pairs a second). The map threshold's default, 1e-3, moves the corrected images'
 // focal length by 0.1 %, below what a metric depth of 1 % needs.
 //
 // Hold (SetHold): the maps stay at their n and no build starts; the
