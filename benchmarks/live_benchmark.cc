@@ -15,7 +15,6 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
-#include <limits>
 #include <memory>
 #include <vector>
 
@@ -74,14 +73,10 @@ void BM_LiveEstimateAndRemap(benchmark::State& state) {
     const std::vector<StereoCorrespondence> all =
         front_end.Match(frame.left, frame.right).value().matches;
     // The pipeline's subset (LivePipelineOptions::max_matches, here the
-    // benchmark's second argument; 0 takes all).
-    const size_t cap = state.range(1) > 0 ? static_cast<size_t>(state.range(1))
-                                          : std::numeric_limits<size_t>::max();
+    // benchmark's second argument).
     std::vector<StereoCorrespondence> subset;
-    for (size_t k = 0; k < std::min(cap, all.size()); ++k) {
-      subset.push_back(all[k * all.size() / std::min(cap, all.size())]);
-    }
-    matches.push_back(subset);
+    matches.push_back(SpreadSubset(all, static_cast<int>(state.range(1)),
+                                   &subset));
   }
   const LivePipelineOptions options = WaterStart();
   SlidingWindowRefractiveIndexEstimator window =

@@ -10,14 +10,34 @@
 namespace rcm::calib {
 namespace {
 
+// A quantity of the table: its name, unit, value and covariance sigma.
+struct Quantity {
+  const char* name;
+  const char* unit;
+  double value;
+  double sigma;
+};
+
 // The quantities of a calibration, in ParameterSpread order: the board's
 // bowl last when the warp is estimated.
-std::vector<double> Quantities(const StereoCalibration& c) {
-  std::vector<double> quantities = {
-      c.cam0.camera.fx(), c.cam0.camera.fy(), c.cam0.camera.cx(),
-      c.cam0.camera.cy(), c.cam1.camera.fx(), c.cam1.camera.fy(),
-      c.cam1.camera.cx(), c.cam1.camera.cy(), c.baseline};
-  if (c.board_warp_estimated) quantities.push_back(c.BoardBowl());
+std::vector<Quantity> Quantities(const StereoCalibration& c) {
+  static const char* const kNames[2][4] = {
+      {"cam0 fx", "cam0 fy", "cam0 cx", "cam0 cy"},
+      {"cam1 fx", "cam1 fy", "cam1 cx", "cam1 cy"}};
+  std::vector<Quantity> quantities;
+  for (int camera = 0; camera < 2; ++camera) {
+    const CameraCalibration& cc = camera == 0 ? c.cam0 : c.cam1;
+    const double values[4] = {cc.camera.fx(), cc.camera.fy(), cc.camera.cx(),
+                              cc.camera.cy()};
+    for (int i = 0; i < 4; ++i) {
+      quantities.push_back({kNames[camera][i], "px", values[i], cc.sigma[i]});
+    }
+  }
+  quantities.push_back({"baseline", "m", c.baseline, c.baseline_sigma});
+  if (c.board_warp_estimated) {
+    quantities.push_back(
+        {"board bowl", "m", c.BoardBowl(), c.BoardBowlSigma()});
+  }
   return quantities;
 }
 
@@ -49,7 +69,7 @@ StatusOr<CrossValidation> CrossValidateStereo(
   StereoCalibrationOptions fold_options = calibration_options;
   fold_options.compute_covariance = false;
   fold_options.num_threads = 1;
-  std::vector<std::optional<std::vector<double>>> fold_estimates(groups);
+  std::vector<std::optional<std::vector<Quantity>>> fold_estimates(groups);
   std::mutex mutex;
   int next = 0;
   int done = 0;
@@ -81,10 +101,10 @@ StatusOr<CrossValidation> CrossValidateStereo(
     work();
     for (std::thread& thread : threads) thread.join();
   }
-  std::vector<std::vector<double>> estimates;
+  std::vector<std::vector<Quantity>> estimates;
   CrossValidation result;
   result.folds = groups;
-  for (std::optional<std::vector<double>>& estimate : fold_estimates) {
+  for (std::optional<std::vector<Quantity>>& estimate : fold_estimates) {
     if (estimate) {
       estimates.push_back(std::move(*estimate));
     } else {
@@ -97,33 +117,25 @@ StatusOr<CrossValidation> CrossValidateStereo(
                          " of " + std::to_string(groups) +
                          " leave-out calibrations succeeded");
   }
-  const char* names[10] = {"cam0 fx", "cam0 fy", "cam0 cx", "cam0 cy",
-                           "cam1 fx", "cam1 fy", "cam1 cx", "cam1 cy",
-                           "baseline", "board bowl"};
-  const double reported[10] = {
-      full.cam0.sigma[0], full.cam0.sigma[1], full.cam0.sigma[2],
-      full.cam0.sigma[3], full.cam1.sigma[0], full.cam1.sigma[1],
-      full.cam1.sigma[2], full.cam1.sigma[3], full.baseline_sigma,
-      full.BoardBowlSigma()};
-  const std::vector<double> full_values = Quantities(full);
+  const std::vector<Quantity> full_values = Quantities(full);
   const int num_quantities = static_cast<int>(full_values.size());
   for (int q = 0; q < num_quantities; ++q) {
     ParameterSpread spread;
-    spread.name = names[q];
-    spread.unit = q >= 8 ? "m" : "px";
-    spread.full = full_values[q];
-    spread.reported_sigma = reported[q];
+    spread.name = full_values[q].name;
+    spread.unit = full_values[q].unit;
+    spread.full = full_values[q].value;
+    spread.reported_sigma = full_values[q].sigma;
     double mean = 0.0;
-    spread.min = spread.max = estimates[0][q];
-    for (const std::vector<double>& e : estimates) {
-      mean += e[q];
-      spread.min = std::min(spread.min, e[q]);
-      spread.max = std::max(spread.max, e[q]);
+    spread.min = spread.max = estimates[0][q].value;
+    for (const std::vector<Quantity>& e : estimates) {
+      mean += e[q].value;
+      spread.min = std::min(spread.min, e[q].value);
+      spread.max = std::max(spread.max, e[q].value);
     }
     mean /= g;
     double sum = 0.0;
-    for (const std::vector<double>& e : estimates) {
-      sum += (e[q] - mean) * (e[q] - mean);
+    for (const std::vector<Quantity>& e : estimates) {
+      sum += (e[q].value - mean) * (e[q].value - mean);
     }
     spread.jackknife_sigma = std::sqrt((g - 1.0) / g * sum);
     result.parameters.push_back(spread);

@@ -86,10 +86,12 @@ std::string BoardFlatnessText(bool estimated, const Eigen::Vector2d& warp,
                               std::optional<double> bowl_leave_out_sigma) {
   if (!estimated) return "board flatness: assumed flat (--flat-board)";
   const Eigen::Vector2d sigma = covariance.diagonal().cwiseSqrt();
-  if (bowl_leave_out_sigma) *bowl_leave_out_sigma *= 1e3;
+  const std::optional<double> leave_out_mm =
+      bowl_leave_out_sigma ? std::optional<double>(1e3 * *bowl_leave_out_sigma)
+                           : std::nullopt;
   return "board flatness: bowl " +
          WithSigma(1e3 * warp.sum(), 1e3 * std::sqrt(covariance.sum()), 2,
-                   bowl_leave_out_sigma) +
+                   leave_out_mm) +
          " mm at the centre (x " +
          WithSigma(1e3 * warp.x(), 1e3 * sigma.x(), 2, std::nullopt) +
          ", y " + WithSigma(1e3 * warp.y(), 1e3 * sigma.y(), 2, std::nullopt) +

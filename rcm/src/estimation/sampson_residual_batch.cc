@@ -12,6 +12,10 @@ SampsonResidualBatch::SampsonResidualBatch(
     a->resize(count);
   }
   const Eigen::Matrix3d& e = essential;
+  // (a, b) . J[:, column]: a row vector on d(x, y)/du (column 0) or /dv (1).
+  const auto along = [](int column, double a, double b, const double* j) {
+    return a * j[column] + b * j[2 + column];
+  };
   for (Eigen::Index i = 0; i < count; ++i) {
     const PreparedCorrespondence& match = matches[i];
     const double xl = match.left_normalized[0];
@@ -32,19 +36,19 @@ SampsonResidualBatch::SampsonResidualBatch(
     a2_[i] = e(2, 0) * xl + e(2, 1) * yl;
     a3_[i] = e(2, 2);
     // The left pixel: (E^T b_r)_{0,1} . J_l[:, u] and (x_l, y_l) . J_l[:, u].
-    lu0_[i] = er0 * jl[0] + er1 * jl[2];
-    lu1_[i] = e(2, 0) * jl[0] + e(2, 1) * jl[2];
-    wul_[i] = xl * jl[0] + yl * jl[2];
-    lv0_[i] = er0 * jl[1] + er1 * jl[3];
-    lv1_[i] = e(2, 0) * jl[1] + e(2, 1) * jl[3];
-    wvl_[i] = xl * jl[1] + yl * jl[3];
+    lu0_[i] = along(0, er0, er1, jl);
+    lu1_[i] = along(0, e(2, 0), e(2, 1), jl);
+    wul_[i] = along(0, xl, yl, jl);
+    lv0_[i] = along(1, er0, er1, jl);
+    lv1_[i] = along(1, e(2, 0), e(2, 1), jl);
+    wvl_[i] = along(1, xl, yl, jl);
     // The right pixel: (E b_l)_{0,1} . J_r[:, u] and (x_r, y_r) . J_r[:, u].
-    ru0_[i] = el0 * jr[0] + el1 * jr[2];
-    ru1_[i] = e(0, 2) * jr[0] + e(1, 2) * jr[2];
-    wur_[i] = xr * jr[0] + yr * jr[2];
-    rv0_[i] = el0 * jr[1] + el1 * jr[3];
-    rv1_[i] = e(0, 2) * jr[1] + e(1, 2) * jr[3];
-    wvr_[i] = xr * jr[1] + yr * jr[3];
+    ru0_[i] = along(0, el0, el1, jr);
+    ru1_[i] = along(0, e(0, 2), e(1, 2), jr);
+    wur_[i] = along(0, xr, yr, jr);
+    rv0_[i] = along(1, el0, el1, jr);
+    rv1_[i] = along(1, e(0, 2), e(1, 2), jr);
+    wvr_[i] = along(1, xr, yr, jr);
   }
 }
 
@@ -72,17 +76,18 @@ void SampsonResidualBatch::Evaluate(double n, Workspace* w,
   w->tr = w->fr * w->sr;
   w->dtl = a3_ * w->dmr * w->sl + w->fl * w->dsl;
   w->dtr = a3_ * w->dml * w->sr + w->fr * w->dsr;
-  // |de/dp|^2 and S = sum (de/dp_k) d(de/dp_k)/dn, one pixel coordinate at
-  // a time (each a fused loop).
-  w->g2 = (lu0_ + lu1_ * w->mr + w->tl * wul_).square() +
-          (lv0_ + lv1_ * w->mr + w->tl * wvl_).square() +
-          (ru0_ + ru1_ * w->ml + w->tr * wur_).square() +
-          (rv0_ + rv1_ * w->ml + w->tr * wvr_).square();
-  w->s =
-      (lu0_ + lu1_ * w->mr + w->tl * wul_) * (lu1_ * w->dmr + w->dtl * wul_) +
-      (lv0_ + lv1_ * w->mr + w->tl * wvl_) * (lv1_ * w->dmr + w->dtl * wvl_) +
-      (ru0_ + ru1_ * w->ml + w->tr * wur_) * (ru1_ * w->dml + w->dtr * wur_) +
-      (rv0_ + rv1_ * w->ml + w->tr * wvr_) * (rv1_ * w->dml + w->dtr * wvr_);
+  // de/dp for the four pixel coordinates, then |de/dp|^2 and
+  // S = sum (de/dp_k) d(de/dp_k)/dn.
+  w->gul = lu0_ + lu1_ * w->mr + w->tl * wul_;
+  w->gvl = lv0_ + lv1_ * w->mr + w->tl * wvl_;
+  w->gur = ru0_ + ru1_ * w->ml + w->tr * wur_;
+  w->gvr = rv0_ + rv1_ * w->ml + w->tr * wvr_;
+  w->g2 = w->gul.square() + w->gvl.square() + w->gur.square() +
+          w->gvr.square();
+  w->s = w->gul * (lu1_ * w->dmr + w->dtl * wul_) +
+         w->gvl * (lv1_ * w->dmr + w->dtl * wvl_) +
+         w->gur * (ru1_ * w->dml + w->dtr * wur_) +
+         w->gvr * (rv1_ * w->dml + w->dtr * wvr_);
   // 1 / |de/dp| in g2; then r = e / |de/dp| and dr/dn.
   w->g2 = w->g2.rsqrt();
   *residual = (a0_ + a1_ * w->ml + w->fr * w->mr) * w->g2;

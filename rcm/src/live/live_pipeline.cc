@@ -44,6 +44,18 @@ double Contrast(const cv::Mat& image) {
 
 }  // namespace
 
+const std::vector<StereoCorrespondence>& SpreadSubset(
+    const std::vector<StereoCorrespondence>& all, int cap,
+    std::vector<StereoCorrespondence>* subset) {
+  const size_t size = all.size();
+  if (cap <= 0 || size <= static_cast<size_t>(cap)) return all;
+  const size_t count = static_cast<size_t>(cap);
+  subset->clear();
+  subset->reserve(count);
+  for (size_t k = 0; k < count; ++k) subset->push_back(all[k * size / count]);
+  return *subset;
+}
+
 RefinementOptions LivePipelineOptions::DefaultRefinement() {
   RefinementOptions options;
   options.systematic_px = kFrontEndSystematicPx;
@@ -223,19 +235,11 @@ StatusOr<LiveFrame> LivePipeline::Process(const cv::Mat& left,
 
   // 3. The window.
   const auto estimate_start = std::chrono::steady_clock::now();
-  const std::vector<StereoCorrespondence>* matches = &matched->matches;
-  const size_t cap = static_cast<size_t>(options_.max_matches);
-  if (cap > 0 && matches->size() > cap) {
-    subset_.clear();
-    subset_.reserve(cap);
-    for (size_t k = 0; k < cap; ++k) {
-      subset_.push_back((*matches)[k * matches->size() / cap]);
-    }
-    matches = &subset_;
-  }
-  out.num_estimated = static_cast<int64_t>(matches->size());
+  const std::vector<StereoCorrespondence>& matches =
+      SpreadSubset(matched->matches, options_.max_matches, &subset_);
+  out.num_estimated = static_cast<int64_t>(matches.size());
   SlidingWindowRefractiveIndexEstimator::WindowUpdate update =
-      estimator_.AddFrame(out.frame, *matches);
+      estimator_.AddFrame(out.frame, matches);
   out.estimate_ms = Milliseconds(estimate_start);
   if (update.frame_estimate.ok()) {
     guide_ = NextPairGuide(update.frame_estimate->n,

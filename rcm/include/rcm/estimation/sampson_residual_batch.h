@@ -57,7 +57,7 @@ class SampsonResidualBatch {
   // without allocation after.
   struct Workspace {
     Eigen::ArrayXd ml, mr, iml, imr, dml, dmr, sl, sr, dsl, dsr, fl, fr, tl, tr,
-        dtl, dtr, g2, s;
+        dtl, dtr, gul, gvl, gur, gvr, g2, s;
   };
 
   // r_i(n) and dr_i/dn at n in [1, 2] for every match i into `residual`

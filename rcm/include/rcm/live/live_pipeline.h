@@ -121,6 +121,14 @@ struct LiveFrame {
   double remap_ms = 0.0;
 };
 
+// The matches the window takes of `all` (LivePipelineOptions::max_matches,
+// `cap`): all of them when cap is 0 or not below their number, else every
+// (size / cap)-th, which keeps the front end's spread over the image; the
+// subset is written into `subset` (its capacity reused).
+const std::vector<StereoCorrespondence>& SpreadSubset(
+    const std::vector<StereoCorrespondence>& all, int cap,
+    std::vector<StereoCorrespondence>* subset);
+
 class LivePipeline {
  public:
   // Builds the front end, the estimator and the maps of initial_n. Errors:
