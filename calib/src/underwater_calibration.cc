@@ -17,6 +17,7 @@
 #include "rcm/calib/calibration_initialization.h"
 #include "rcm/calib/underwater_reprojection_error.h"
 #include "rcm/camera/refractive_model.h"
+#include "rcm/geometry/calibration_uncertainty.h"
 #include "rcm/io/number_format.h"
 
 namespace rcm::calib {
@@ -333,6 +334,87 @@ Eigen::VectorXd JackknifeSigma(const std::vector<Eigen::VectorXd>& samples) {
 }
 
 std::string CameraName(int c) { return "cam" + std::to_string(c); }
+
+// One refit of sigma_n_lenses (header): camera `camera`'s lens moved by
+// `delta` = sqrt(l_i) e_i.
+struct LensPerturbation {
+  int camera = 0;
+  Eigen::VectorXd delta;
+};
+
+// The perturbations of the used cameras' lens covariances: the eigenpairs
+// whose variance exceeds 1e-12 of the largest (the rest is rounding, or a
+// parameter the air calibration held).
+std::vector<LensPerturbation> LensPerturbations(
+    const StereoRig& air_rig, const std::array<bool, 2>& camera_used) {
+  std::vector<LensPerturbation> steps;
+  const std::optional<CalibrationUncertainty>& uncertainty =
+      air_rig.calibration_uncertainty();
+  if (!uncertainty) return steps;
+  const Camera* cameras[2] = {&air_rig.left(), &air_rig.right()};
+  const Eigen::MatrixXd* covariances[2] = {
+      &uncertainty->left_lens_covariance, &uncertainty->right_lens_covariance};
+  for (int c = 0; c < 2; ++c) {
+    const Eigen::MatrixXd& covariance = *covariances[c];
+    const int size = cameras[c]->num_params();
+    if (!camera_used[c] || covariance.rows() != size ||
+        covariance.cols() != size || !covariance.allFinite()) {
+      continue;
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(
+        0.5 * (covariance + covariance.transpose()));
+    const double largest = eigen.eigenvalues().maxCoeff();
+    if (!(largest > 0.0)) continue;
+    for (int i = 0; i < size; ++i) {
+      const double variance = eigen.eigenvalues()[i];
+      if (!(variance > 1e-12 * largest)) continue;
+      steps.push_back({c, std::sqrt(variance) * eigen.eigenvectors().col(i)});
+    }
+  }
+  return steps;
+}
+
+// The held-out errors of the views of group `group` (UnderwaterLeaveOut):
+// the parameters of `replicate` held, each view's pose fitted to its inlier
+// corners, from the full solution's pose.
+void HeldOutErrors(const Model& model, const std::vector<Corner>& corners,
+                   const std::vector<int>& group_of, int group,
+                   const Parameters& replicate,
+                   const ceres::Solver::Options& solver_options,
+                   UnderwaterLeaveOut* leave_out) {
+  std::vector<Corner> held_out;
+  for (const Corner& corner : corners) {
+    if (group_of[corner.view] == group && corner.inlier) {
+      held_out.push_back(corner);
+    }
+  }
+  if (held_out.empty()) return;
+  Parameters held = replicate;
+  ceres::Problem problem;
+  AddResiduals(model, held_out, FreeParameters{}, /*huber_px=*/0.0, &held,
+               &problem);
+  problem.SetParameterBlockConstant(&held.n);
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, &problem, &summary);
+  if (!summary.IsSolutionUsable()) return;
+  std::vector<double> ssr(held.cam0_from_target.size(), 0.0);
+  std::vector<int> count(held.cam0_from_target.size(), 0);
+  std::vector<bool> bad(held.cam0_from_target.size(), false);
+  for (const Corner& corner : held_out) {
+    const Eigen::Vector2d e = Residual(model, corner, held);
+    if (!e.allFinite()) {
+      bad[corner.view] = true;
+      continue;
+    }
+    ssr[corner.view] += e.squaredNorm();
+    ++count[corner.view];
+  }
+  for (size_t v = 0; v < ssr.size(); ++v) {
+    if (count[v] == 0 || bad[v]) continue;
+    leave_out->held_out_ssr[v] = ssr[v];
+    leave_out->held_out_corners[v] = count[v];
+  }
+}
 
 }  // namespace
 
@@ -757,6 +839,15 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     }
   }
 
+  // The refits below (leave-out replicates, lens perturbations) start at
+  // the solution; an air gap that ended on its lower bound 0 stays there
+  // (the active set of the solution: Ceres' projected steps would take
+  // 50-70 iterations to confirm it, against 4 for the free unknowns).
+  FreeParameters refit_free = free;
+  for (int c = 0; c < 2; ++c) {
+    refit_free.air_gap[c] &= parameters.air_gap[c] > kOnBound;
+  }
+
   // Leave views out (header): each replicate re-solves the inliers' least
   // squares without its views, from the full solution.
   std::vector<int> used_views;
@@ -764,7 +855,14 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     if (view_used[v]) used_views.push_back(v);
   }
   const int groups = std::min(options.folds, num_views_used);
-  const int total_steps = 1 + (groups >= 2 ? groups : 0);
+  // The lens refits (header, sigma_n_lenses): one per eigenpair of each
+  // used camera's air lens covariance that carries variance.
+  std::vector<LensPerturbation> lens_steps;
+  if (options.propagate_lens_covariance) {
+    lens_steps = LensPerturbations(air_rig, camera_used);
+  }
+  const int total_steps = 1 + (groups >= 2 ? groups : 0) +
+                          static_cast<int>(lens_steps.size());
   if (progress) progress(1, total_steps);
   if (options.folds > 0 && groups < 2) {
     result.notes.push_back("leave-out: fewer than 2 views to leave out");
@@ -776,6 +874,9 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     }
     UnderwaterLeaveOut leave_out;
     leave_out.folds = groups;
+    leave_out.held_out_ssr.assign(num_views,
+                                  std::numeric_limits<double>::quiet_NaN());
+    leave_out.held_out_corners.assign(num_views, 0);
     std::vector<Eigen::VectorXd> samples;
     std::vector<Eigen::VectorXd> changes;
     const Eigen::Matrix3d reference = water_extrinsics.rotation;
@@ -798,7 +899,7 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
       }
       Parameters replicate = parameters;
       ceres::Problem fold_problem;
-      AddResiduals(model, kept, free, /*huber_px=*/0.0, &replicate,
+      AddResiduals(model, kept, refit_free, /*huber_px=*/0.0, &replicate,
                    &fold_problem);
       ceres::Solver::Summary summary;
       if (observable && !kept.empty()) {
@@ -810,6 +911,8 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
           replicate.n >= kMaxIndex - kOnBound) {
         ++leave_out.failed_folds;
       } else {
+        HeldOutErrors(model, corners, group_of, k, replicate, solver_options,
+                      &leave_out);
         samples.push_back(ParameterVector(free, replicate, reference));
         if (free.extrinsics) {
           changes.push_back(ReportedChange(ChangeFromAir(
@@ -833,6 +936,42 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
       result.notes.push_back("leave-out: only " +
                              std::to_string(samples.size()) + " of " +
                              std::to_string(groups) + " replicates succeeded");
+    }
+  }
+
+  // The air lenses' share (header): the final least squares again with
+  // each lens perturbation, from the solution.
+  if (!lens_steps.empty()) {
+    double sum = 0.0;
+    int failed = 0;
+    for (size_t i = 0; i < lens_steps.size(); ++i) {
+      const LensPerturbation& step = lens_steps[i];
+      Model perturbed = model;
+      for (int j = 0; j < cameras[step.camera]->num_params(); ++j) {
+        perturbed.constants[step.camera].lens[j] += step.delta[j];
+      }
+      Parameters refit = parameters;
+      ceres::Problem refit_problem;
+      AddResiduals(perturbed, corners, refit_free, /*huber_px=*/0.0, &refit,
+                   &refit_problem);
+      ceres::Solver::Summary summary;
+      ceres::Solve(solver_options, &refit_problem, &summary);
+      if (summary.IsSolutionUsable() && std::isfinite(refit.n)) {
+        sum += (refit.n - parameters.n) * (refit.n - parameters.n);
+      } else {
+        ++failed;
+      }
+      if (progress) {
+        progress(1 + (groups >= 2 ? groups : 0) + static_cast<int>(i) + 1,
+                 total_steps);
+      }
+    }
+    if (failed == 0) {
+      result.sigma_n_lenses = std::sqrt(sum);
+    } else {
+      result.notes.push_back("lens uncertainty: " + std::to_string(failed) +
+                             " of " + std::to_string(lens_steps.size()) +
+                             " refits failed; sigma_n leaves the lenses out");
     }
   }
 

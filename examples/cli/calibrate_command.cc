@@ -215,10 +215,10 @@ int RunCalibrate() {
     return RunCalibrateUnderwater(command, *target, paths, underwater);
   }
   if (!FLAGS_air.empty() || FLAGS_estimate_air_gap ||
-      FLAGS_estimate_port_tilt) {
+      FLAGS_estimate_port_tilt || FLAGS_thin_port) {
     PrintError(command,
-               "--air, --estimate-air-gap and --estimate-port-tilt go with "
-               "--underwater");
+               "--air, --estimate-air-gap, --estimate-port-tilt and "
+               "--thin-port go with --underwater");
     return kExitUsage;
   }
 

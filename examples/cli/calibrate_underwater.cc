@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -22,6 +23,7 @@
 #include "progress.h"
 #include "rcm/calib/calibration_report.h"
 #include "rcm/calib/underwater_calibration.h"
+#include "rcm/calib/underwater_model_selection.h"
 #include "rcm/io/atomic_file.h"
 #include "rcm/io/calibration_covariance_file.h"
 #include "rcm/io/camchain.h"
@@ -35,8 +37,11 @@ DEFINE_bool(underwater, false,
             "ports, with the lenses of the air calibration --air held "
             "(--left alone: one camera, n only)");
 DEFINE_bool(estimate_port_tilt, false,
-            "--underwater: also estimate each port's tilt (two angles per "
-            "port)");
+            "--underwater: the ports are tilted: fit only candidate models "
+            "that estimate each port's tilt (two angles per port)");
+DEFINE_bool(thin_port, false,
+            "--underwater: the ports are thin (the paper's model): fit only "
+            "candidate models without an air gap or tilt");
 
 namespace rcm::cli {
 
@@ -47,6 +52,8 @@ namespace {
 using calib::ImageSize;
 using calib::StereoView;
 using calib::UnderwaterCalibration;
+using calib::UnderwaterCandidate;
+using calib::UnderwaterModelSelection;
 
 
 std::string SizeText(int width, int height) {
@@ -166,6 +173,80 @@ Status WriteUnderwaterReport(const std::string& folder,
                              calib::FormatPerViewCsv(*report));
 }
 
+// The candidates as the JSON lists them.
+nlohmann::json CandidatesJson(const UnderwaterModelSelection& selection) {
+  nlohmann::json list = nlohmann::json::array();
+  for (size_t k = 0; k < selection.candidates.size(); ++k) {
+    const UnderwaterCandidate& candidate = selection.candidates[k];
+    nlohmann::json item = {{"model", candidate.model.Name()},
+                           {"chosen", static_cast<int>(k) == selection.chosen},
+                           {"ok", candidate.fit.has_value()}};
+    if (!candidate.fit) {
+      item["error"] = candidate.error;
+      list.push_back(item);
+      continue;
+    }
+    const UnderwaterCalibration& fit = *candidate.fit;
+    item["n"] = fit.n;
+    item["sigma_n"] = candidate.sigma_n_noise;
+    item["sigma_n_covariance"] = fit.sigma_n;
+    item["sigma_n_leave_out"] = JsonNumber(fit.sigma_n_leave_out);
+    item["rms_px"] = fit.rms_px;
+    item["held_out_rms_px"] = std::isfinite(candidate.held_out_rms_px)
+                                  ? nlohmann::json(candidate.held_out_rms_px)
+                                  : nullptr;
+    item["evidence_sigmas"] = std::isfinite(candidate.evidence)
+                                  ? nlohmann::json(candidate.evidence)
+                                  : nullptr;
+    item["plausible"] = candidate.plausible;
+    item["parameters"] = fit.num_parameters;
+    list.push_back(item);
+  }
+  return list;
+}
+
+// The candidates as rcm calibrate prints them: one row each.
+std::string CandidateTable(const UnderwaterModelSelection& selection) {
+  std::string table =
+      "candidate models (evidence: held-out error above the best's, in "
+      "standard errors over " +
+      std::to_string(selection.num_evidence_views) +
+      " views; plausible within 2):\n";
+  char line[256];
+  std::snprintf(line, sizeof(line), "  %-40s %-19s %8s %9s %9s\n", "model",
+                "n", "rms px", "held-out", "evidence");
+  table += line;
+  for (size_t k = 0; k < selection.candidates.size(); ++k) {
+    const UnderwaterCandidate& candidate = selection.candidates[k];
+    const std::string name =
+        (static_cast<int>(k) == selection.chosen ? "* " : "  ") +
+        candidate.model.Name();
+    if (!candidate.fit) {
+      table += "  " + name + ": " + candidate.error + "\n";
+      continue;
+    }
+    const std::string held_out =
+        std::isfinite(candidate.held_out_rms_px)
+            ? FormatFixed(candidate.held_out_rms_px, 4)
+            : std::string("-");
+    const std::string evidence =
+        std::isfinite(candidate.evidence)
+            ? FormatFixed(candidate.evidence, 1) +
+                  (candidate.plausible ? "" : " x")
+            : std::string("-");
+    std::snprintf(
+        line, sizeof(line), "  %-40s %-19s %8.4f %9s %9s\n", name.c_str(),
+        WithSigma(candidate.fit->n, candidate.sigma_n_noise, 5, std::nullopt)
+            .c_str(),
+        candidate.fit->rms_px, held_out.c_str(), evidence.c_str());
+    table += line;
+  }
+  table +=
+      "  (* chosen: the lowest held-out error, the simplest without folds; x: "
+      "ruled out, evidence above 2)\n";
+  return table;
+}
+
 }  // namespace
 
 int RunCalibrateUnderwater(const Subcommand& command,
@@ -179,14 +260,20 @@ int RunCalibrateUnderwater(const Subcommand& command,
                "the rig whose lenses it keeps");
     return kExitUsage;
   }
-  calib::UnderwaterCalibrationOptions options;
-  options.estimate_air_gap = FLAGS_estimate_air_gap;
-  options.estimate_port_tilt = FLAGS_estimate_port_tilt;
-  options.huber_px = run.huber_px;
-  options.outlier_sigmas = run.outlier_sigmas;
-  options.min_corners_per_view = run.min_corners;
-  options.folds = run.folds;
-  options.estimate_board_warp = run.estimate_board_warp;
+  if (FLAGS_thin_port && (FLAGS_estimate_air_gap || FLAGS_estimate_port_tilt)) {
+    PrintError(command,
+               "--thin-port contradicts --estimate-air-gap and "
+               "--estimate-port-tilt: a thin port has neither");
+    return kExitUsage;
+  }
+  calib::UnderwaterModelSelectionOptions options;
+  options.fit.huber_px = run.huber_px;
+  options.fit.outlier_sigmas = run.outlier_sigmas;
+  options.fit.min_corners_per_view = run.min_corners;
+  options.fit.folds = run.folds;
+  options.candidates = calib::UnderwaterCandidates(
+      !run.estimate_board_warp, FLAGS_estimate_air_gap,
+      FLAGS_estimate_port_tilt, FLAGS_thin_port);
   if (const Status status = options.Check(); !status.ok()) {
     PrintError(command, status.message());
     return kExitUsage;
@@ -251,15 +338,35 @@ int RunCalibrateUnderwater(const Subcommand& command,
   }
 
   const std::vector<StereoView>& views = detections->views;
-  Progress solving("rcm calibrate: underwater bundle adjustment",
-                   static_cast<size_t>(1 + std::max(0, run.folds)));
-  const StatusOr<UnderwaterCalibration> result = calib::CalibrateUnderwater(
-      target, views, sizes[0], one_camera ? ImageSize{0, 0} : sizes[1],
-      *air_rig, options,
-      [&solving](int done, int) { solving.Update(static_cast<size_t>(done)); });
-  if (!result.ok()) {
-    PrintError(command, result.status().message());
+  // The selection reports hundredths of a candidate; the bar counts
+  // candidates, with the percentage of the one being fitted.
+  const size_t num_candidates = options.candidates.size();
+  std::optional<Progress> solving(
+      std::in_place, "rcm calibrate: underwater candidate models",
+      num_candidates);
+  const StatusOr<UnderwaterModelSelection> selection =
+      calib::SelectUnderwaterModel(
+          target, views, sizes[0], one_camera ? ImageSize{0, 0} : sizes[1],
+          *air_rig, options, [&solving](int done, int) {
+            solving->Update(static_cast<size_t>(done / 100),
+                            std::to_string(done % 100) + " % of the next");
+          });
+  solving.reset();
+  if (!selection.ok()) {
+    PrintError(command, selection.status().message());
     return kExitFailure;
+  }
+  const UnderwaterCalibration* result = &selection->Chosen();
+  const calib::UnderwaterCandidateModel& model =
+      selection->candidates[selection->chosen].model;
+  // The conventional fit ran with the thin-port candidate of the same
+  // board, when there was one.
+  calib::ConventionalFit conventional = result->conventional;
+  for (const UnderwaterCandidate& candidate : selection->candidates) {
+    if (candidate.fit && candidate.model.board_warp == model.board_warp &&
+        !candidate.model.air_gap && !candidate.model.port_tilt) {
+      conventional = candidate.fit->conventional;
+    }
   }
 
   // The report first, the camchain last.
@@ -271,14 +378,14 @@ int RunCalibrateUnderwater(const Subcommand& command,
     return kExitFailure;
   }
   std::vector<std::string> warnings = result->notes;
-  if (result->conventional.ok &&
-      result->conventional.pixel_sigma < 0.9 * result->pixel_sigma) {
+  if (!selection->pinned) warnings.push_back(selection->advice);
+  if (conventional.ok && conventional.pixel_sigma < 0.9 * result->pixel_sigma) {
     warnings.push_back(
         "a conventional " +
-        std::string(LensModelName(result->conventional.model)) +
+        std::string(LensModelName(conventional.model)) +
         " model fitted freely to the same corners fits them better (pixel "
         "noise " +
-        FormatFixed(result->conventional.pixel_sigma, 3) + " px against " +
+        FormatFixed(conventional.pixel_sigma, 3) + " px against " +
         FormatFixed(result->pixel_sigma, 3) +
         " px): the port model may not describe the housing (an air gap or "
         "glass: port blocks, --estimate-air-gap; a tilted port: "
@@ -296,9 +403,18 @@ int RunCalibrateUnderwater(const Subcommand& command,
   json["target"] = calib::DescribeTarget(target);
   json["source"] = input->description;
   json["cameras"] = one_camera ? 1 : 2;
-  json["n"] = result->n;
-  json["sigma_n"] = result->sigma_n;
+  json["n"] = selection->n;
+  json["sigma_n"] = selection->sigma_n;
+  json["sigma_n_noise"] = selection->sigma_n_noise;
+  json["sigma_n_lenses"] = selection->sigma_n_lenses;
+  json["sigma_n_model"] = selection->sigma_n_model;
+  json["sigma_n_covariance"] = result->sigma_n;
   json["sigma_n_leave_out"] = JsonNumber(result->sigma_n_leave_out);
+  json["model"] = model.Name();
+  json["pinned"] = selection->pinned;
+  json["advice"] = selection->advice;
+  json["evidence_views"] = selection->num_evidence_views;
+  json["candidates"] = CandidatesJson(*selection);
   json["rms_px"] = result->rms_px;
   json["inlier_rms_px"] = result->inlier_rms_px;
   json["pixel_sigma"] = result->pixel_sigma;
@@ -332,15 +448,13 @@ int RunCalibrateUnderwater(const Subcommand& command,
         {"tilt_estimated", port.tilt_estimated}};
   }
   json["conventional"] = {
-      {"model", std::string(LensModelName(result->conventional.model))},
-      {"ok", result->conventional.ok},
-      {"rms_px", result->conventional.ok
-                     ? nlohmann::json(result->conventional.rms_px)
-                     : nullptr},
-      {"pixel_sigma", result->conventional.ok
-                          ? nlohmann::json(result->conventional.pixel_sigma)
-                          : nullptr},
-      {"error", result->conventional.error}};
+      {"model", std::string(LensModelName(conventional.model))},
+      {"ok", conventional.ok},
+      {"rms_px",
+       conventional.ok ? nlohmann::json(conventional.rms_px) : nullptr},
+      {"pixel_sigma",
+       conventional.ok ? nlohmann::json(conventional.pixel_sigma) : nullptr},
+      {"error", conventional.error}};
   json["board_flatness"] =
       BoardFlatnessJson(result->board_warp_estimated, result->board_warp,
                         result->board_warp_covariance);
@@ -384,20 +498,29 @@ int RunCalibrateUnderwater(const Subcommand& command,
       "refractive model: rms %.4f px (inliers %.4f px), pixel noise %.4f px "
       "per axis\n",
       result->rms_px, result->inlier_rms_px, result->pixel_sigma);
-  if (result->conventional.ok) {
+  if (conventional.ok) {
     std::printf(
         "conventional %s fitted freely to the same corners: rms %.4f px, "
         "pixel noise %.4f px\n",
-        std::string(LensModelName(result->conventional.model)).c_str(),
-        result->conventional.rms_px, result->conventional.pixel_sigma);
+        std::string(LensModelName(conventional.model)).c_str(),
+        conventional.rms_px, conventional.pixel_sigma);
   } else {
-    std::printf("conventional model: %s\n", result->conventional.error.c_str());
+    std::printf("conventional model: %s\n", conventional.error.c_str());
   }
-  std::printf("+- covariance sigma%s\n",
+  std::printf("%s", CandidateTable(*selection).c_str());
+  std::printf(
+      "n %s (%s)\n  sigma_n: noise %.5f (covariance %.5f%s), air lenses "
+      "%.5f%s, models the data cannot tell apart %.5f\n",
+      WithSigma(selection->n, selection->sigma_n, 5, std::nullopt).c_str(),
+      model.Name().c_str(), selection->sigma_n_noise, result->sigma_n,
+      result->sigma_n_leave_out
+          ? (", leave-out " + FormatFixed(*result->sigma_n_leave_out, 5)).c_str()
+          : "",
+      selection->sigma_n_lenses,
+      result->sigma_n_lenses ? "" : " (the air camchain has no lens covariance)",
+      selection->sigma_n_model);
+  std::printf("below: +- covariance sigma%s\n",
               result->sigma_n_leave_out ? " (leave-out sigma)" : "");
-  std::printf("n %s\n", WithSigma(result->n, result->sigma_n, 5,
-                                  result->sigma_n_leave_out)
-                            .c_str());
   if (result->extrinsics_estimated) {
     std::printf(
         "cam1 has turned by %s deg since the air calibration: %s +- %s deg "
@@ -412,10 +535,14 @@ int RunCalibrateUnderwater(const Subcommand& command,
   } else {
     std::printf("extrinsics: the air calibration's (one camera)\n");
   }
-  std::printf("%s\n", BoardFlatnessText(result->board_warp_estimated,
-                                         result->board_warp,
-                                         result->board_warp_covariance)
-                           .c_str());
+  if (!result->board_warp_estimated && run.estimate_board_warp) {
+    std::printf("board flatness: flat in the chosen model\n");
+  } else {
+    std::printf("%s\n", BoardFlatnessText(result->board_warp_estimated,
+                                           result->board_warp,
+                                           result->board_warp_covariance)
+                             .c_str());
+  }
   for (int c = 0; c < (one_camera ? 1 : 2); ++c) {
     const calib::PortEstimate& port = result->ports[c];
     if (!port.air_gap_estimated && !port.tilt_estimated) continue;

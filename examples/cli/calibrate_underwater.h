@@ -12,6 +12,7 @@
 
 DECLARE_bool(underwater);
 DECLARE_bool(estimate_port_tilt);
+DECLARE_bool(thin_port);
 
 namespace rcm::cli {
 

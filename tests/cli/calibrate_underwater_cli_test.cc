@@ -119,6 +119,30 @@ void ExpectUnderwaterCalibrationRecoversTheDive(const nlohmann::json& json,
               "drift %.3f deg\n",
               json["n"].get<double>(), json["sigma_n"].get<double>(),
               leave_out, error, json["extrinsic_change_deg"].get<double>());
+  // The candidate models (calib/underwater_model_selection.h): all eight
+  // fitted, one chosen, sigma_n the root sum of squares of its parts, and
+  // the lenses' part 0 (the simulated air camchain has no sidecar).
+  const nlohmann::json& candidates = json["candidates"];
+  ASSERT_EQ(candidates.size(), 8u);
+  int chosen = 0;
+  for (const nlohmann::json& candidate : candidates) {
+    EXPECT_TRUE(candidate["ok"].get<bool>()) << candidate.dump();
+    chosen += candidate["chosen"].get<bool>();
+    if (candidate["chosen"].get<bool>()) {
+      EXPECT_EQ(candidate["model"], json["model"]);
+      EXPECT_EQ(candidate["n"], json["n"]);
+    }
+  }
+  EXPECT_EQ(chosen, 1);
+  EXPECT_EQ(json["sigma_n_lenses"].get<double>(), 0.0);
+  EXPECT_NEAR(json["sigma_n"].get<double>(),
+              std::hypot(json["sigma_n_noise"].get<double>(),
+                         json["sigma_n_model"].get<double>()),
+              1e-15);
+  if (test::ChecksStatistics()) {
+    EXPECT_LE(std::abs(error), 3.0 * json["sigma_n"].get<double>());
+    EXPECT_EQ(json["evidence_views"].get<int>(), json["views_used"].get<int>());
+  }
   const double drift_tolerance = test::ChecksStatistics() ? 0.05 : 0.2;
   if (test::ChecksStatistics()) {
     EXPECT_LE(std::abs(error), 3.0 * leave_out);
@@ -378,6 +402,14 @@ TEST(UnderwaterCli, FlagsThatNeedUnderwater) {
                 "--left l --right r --out " +
                 water + " " + Board(0.03))),
       water, "--uncertainty-distance does not go with --underwater", 2);
+  ExpectRefused(Rcm(Words("calibrate --thin-port --left l --right r --out " +
+                          water + " " + Board(0.03))),
+                water, "go with --underwater", 2);
+  ExpectRefused(
+      Rcm(Words("calibrate --underwater --thin-port --estimate-air-gap --air "
+                "a.yaml --left l --right r --out " +
+                water + " " + Board(0.03))),
+      water, "--thin-port contradicts --estimate-air-gap", 2);
 }
 
 }  // namespace

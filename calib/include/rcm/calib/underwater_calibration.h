@@ -149,6 +149,9 @@ struct UnderwaterCalibrationOptions {
   // model, intrinsics free, no refraction) to the same corners, so that
   // the two fits can be compared.
   bool fit_conventional_model = true;
+  // Carry the air lenses' covariance (air_rig.calibration_uncertainty(),
+  // from the air calibration's sidecar) to n: sigma_n_lenses (header).
+  bool propagate_lens_covariance = true;
   // Threads for Ceres.
   int num_threads = 2;
 
@@ -225,6 +228,16 @@ struct UnderwaterLeaveOut {
   // UnderwaterCovariance::matrix (w of the extrinsics about the full
   // solution, left perturbation).
   Eigen::VectorXd sigma;
+  // The held-out error of each input view (the evidence of
+  // underwater_model_selection.h): with the parameters of the replicate
+  // that left the view out held, the view's target pose is fitted to its
+  // inlier corners alone, and
+  //   held_out_ssr[v] = sum |e|^2 over those corners   [px^2],
+  //   held_out_corners[v] = their number.
+  // NaN and 0 for a view that was not used, whose replicate failed, or a
+  // corner of which the held parameters cannot image.
+  std::vector<double> held_out_ssr;
+  std::vector<int> held_out_corners;
 };
 
 // The conventional underwater calibration of the same corners: the air
@@ -256,6 +269,15 @@ struct UnderwaterCalibration {
   double n = 0.0;
   double sigma_n = 0.0;  // covariance
   std::optional<double> sigma_n_leave_out;
+  // What the air lenses' uncertainty does to n, when the air rig carries a
+  // lens covariance (and propagate_lens_covariance): with C_c camera c's
+  // lens covariance = sum_i l_i e_i e_i^T, the final least squares is
+  // solved again, from the solution, with camera c's lens moved by
+  // sqrt(l_i) e_i, once per eigenpair, and
+  //   sigma_n_lenses^2 = sum_{c, i} (n_{c,i} - n)^2,
+  // the first-order propagation through the refit of every other unknown
+  // (so the extrinsics fitted through those lenses move with them).
+  std::optional<double> sigma_n_lenses;
   // The air cameras (bit for bit), the underwater extrinsics and the ports
   // (with the estimated gaps and normals; none when the air rig had none
   // and nothing about the ports was estimated).
@@ -310,7 +332,8 @@ struct UnderwaterCalibration {
 // image sizes are those of the views' images: each must equal its air
 // camera's (a camera that saw no target may pass {0, 0}). `progress`, when
 // set, is called with (done, total) after the main fit and each leave-out
-// replicate. Fails with one line (header).
+// replicate, and then after each lens refit (sigma_n_lenses). Fails with
+// one line (header).
 StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     const CalibrationTarget& target, const std::vector<StereoView>& views,
     const ImageSize& cam0_size, const ImageSize& cam1_size,
