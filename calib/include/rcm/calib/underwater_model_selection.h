@@ -4,8 +4,9 @@
 //
 // On a real dive the error of n is set by what the model leaves out, not
 // by the pixel noise: a hand-held board's bow, a housing's air gap, a port
-// tilted on its seat each move n by 0.02-0.07 while the covariance of any
-// one fit says 0.003 (docs/calibrate.md, "What limits n on a real dive").
+// tilted on its seat each move n by hundredths while the covariance of any
+// one fit says thousandths (docs/calibrate.md, "What limits n on a real
+// dive").
 // So each candidate model is fitted (CalibrateUnderwater), and
 //
 // Evidence, per candidate k (held-out error, UnderwaterLeaveOut): over
@@ -18,8 +19,8 @@
 // the t statistic of k's excess held-out error over the best's. Views,
 // not corners, are the unit: a model error is shared by the corners of a
 // view, so corner counts would make every difference look significant
-// (an RMS of 0.253 against 0.277 px is 1300 in chi^2 over 6500
-// residuals, and says nothing when both are model error); and ratios,
+// (an RMS 10 % lower over 6000 residuals is a chi^2 difference above
+// 1000, and says nothing when both are model error); and ratios,
 // not differences, so that a near view with many pixels does not outvote
 // the rest.
 //
