@@ -100,6 +100,7 @@ int WeighEvidence(double evidence_sigmas,
 // replicates; Wilson-Hilferty's quantile), else the covariance's.
 double NoiseSigma(const UnderwaterCalibration& fit) {
   if (!fit.sigma_n_leave_out || !fit.leave_out) return fit.sigma_n;
+  if (!(fit.sigma_n > 0.0)) return *fit.sigma_n_leave_out;
   const double dof = fit.leave_out->folds - fit.leave_out->failed_folds - 1.0;
   if (dof < 1.0) return fit.sigma_n;
   constexpr double kZ95 = 1.6448536269514722;
