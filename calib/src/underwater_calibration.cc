@@ -861,8 +861,9 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
   if (options.propagate_lens_covariance) {
     lens_steps = LensPerturbations(air_rig, camera_used);
   }
-  const int total_steps = 1 + (groups >= 2 ? groups : 0) +
-                          static_cast<int>(lens_steps.size());
+  const int fold_steps = groups >= 2 ? groups : 0;
+  const int total_steps =
+      1 + fold_steps + static_cast<int>(lens_steps.size());
   if (progress) progress(1, total_steps);
   if (options.folds > 0 && groups < 2) {
     result.notes.push_back("leave-out: fewer than 2 views to leave out");
@@ -962,8 +963,7 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
         ++failed;
       }
       if (progress) {
-        progress(1 + (groups >= 2 ? groups : 0) + static_cast<int>(i) + 1,
-                 total_steps);
+        progress(2 + fold_steps + static_cast<int>(i), total_steps);
       }
     }
     if (failed == 0) {

@@ -51,9 +51,9 @@ int WeighEvidence(double evidence_sigmas,
       static_cast<int>(common.size()) < kMinEvidenceViews) {
     return static_cast<int>(common.size());
   }
-  // The best: the lowest mean log held-out SSR (the geometric mean over
+  // The best: the lowest sum of log held-out SSRs (the geometric mean over
   // views, the scale of the paired log ratios below).
-  std::vector<double> mean_log(candidates->size(), 0.0);
+  std::vector<double> sum_log(candidates->size(), 0.0);
   int best = fitted.front();
   for (int k : fitted) {
     const UnderwaterCandidate& candidate = (*candidates)[k];
@@ -61,11 +61,11 @@ int WeighEvidence(double evidence_sigmas,
     int corners = 0;
     for (int v : common) {
       total += HeldOut(candidate, v);
-      mean_log[k] += std::log(std::max(HeldOut(candidate, v), kTinySsr));
+      sum_log[k] += std::log(std::max(HeldOut(candidate, v), kTinySsr));
       corners += candidate.fit->leave_out->held_out_corners[v];
     }
     (*candidates)[k].held_out_rms_px = std::sqrt(total / corners);
-    if (mean_log[k] < mean_log[best]) best = k;
+    if (sum_log[k] < sum_log[best]) best = k;
   }
   const double num_common = static_cast<double>(common.size());
   for (int k : fitted) {
@@ -74,14 +74,13 @@ int WeighEvidence(double evidence_sigmas,
       candidate.evidence = 0.0;
       continue;
     }
+    // The paired log ratios; their mean is the difference of the means.
+    const double mean = (sum_log[k] - sum_log[best]) / num_common;
     std::vector<double> d;
-    double mean = 0.0;
     for (int v : common) {
       d.push_back(std::log(std::max(HeldOut(candidate, v), kTinySsr) /
                            std::max(HeldOut((*candidates)[best], v), kTinySsr)));
-      mean += d.back();
     }
-    mean /= num_common;
     double sum = 0.0;
     for (const double x : d) sum += (x - mean) * (x - mean);
     const double se = std::sqrt(sum / (num_common - 1.0) / num_common);
