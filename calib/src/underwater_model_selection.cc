@@ -234,9 +234,14 @@ StatusOr<UnderwaterModelSelection> SelectUnderwaterModel(
   // a candidate, summed over the candidates.
   constexpr int kSteps = 100;
   const int parallel = std::clamp(options.fit.num_threads, 1, num_candidates);
+  // The lens refits (sigma_n_lenses) only count for the chosen candidate:
+  // they run once, after the choice, as one more candidate's worth of steps.
+  const bool lens_refits = options.fit.propagate_lens_covariance &&
+                           air_rig.calibration_uncertainty().has_value();
+  const int total_steps = (num_candidates + (lens_refits ? 1 : 0)) * kSteps;
   UnderwaterModelSelection selection;
   selection.candidates.resize(num_candidates);
-  std::vector<int> done(num_candidates, 0);
+  std::vector<int> done(num_candidates + 1, 0);
   std::mutex progress_mutex;
   const auto report = [&](int k, int steps) {
     if (!progress) return;
@@ -244,7 +249,7 @@ StatusOr<UnderwaterModelSelection> SelectUnderwaterModel(
     done[k] = steps;
     int sum = 0;
     for (int d : done) sum += d;
-    progress(sum, num_candidates * kSteps);
+    progress(sum, total_steps);
   };
   ParallelFor(num_candidates, parallel, 1, [&](int64_t begin, int64_t end) {
     for (int k = static_cast<int>(begin); k < end; ++k) {
@@ -252,6 +257,7 @@ StatusOr<UnderwaterModelSelection> SelectUnderwaterModel(
       candidate.model = options.candidates[k];
       UnderwaterCalibrationOptions fit = options.fit;
       fit.num_threads = std::max(1, options.fit.num_threads / parallel);
+      fit.propagate_lens_covariance = false;
       fit.estimate_board_warp = candidate.model.board_warp;
       fit.estimate_air_gap = candidate.model.air_gap;
       fit.estimate_port_tilt = candidate.model.port_tilt;
@@ -310,7 +316,35 @@ StatusOr<UnderwaterModelSelection> SelectUnderwaterModel(
     const UnderwaterCandidate& chosen = candidates[selection.chosen];
     if (candidate.evidence < chosen.evidence) selection.chosen = k;
   }
-  const UnderwaterCandidate& chosen = candidates[selection.chosen];
+  UnderwaterCandidate& chosen = candidates[selection.chosen];
+  if (lens_refits) {
+    // The chosen model's fit again, every thread on its lens refits (the
+    // main fit is the same least squares from the same start; no folds).
+    UnderwaterCalibrationOptions fit = options.fit;
+    fit.estimate_board_warp = chosen.model.board_warp;
+    fit.estimate_air_gap = chosen.model.air_gap;
+    fit.estimate_port_tilt = chosen.model.port_tilt;
+    fit.folds = 0;
+    fit.fit_conventional_model = false;
+    const StatusOr<UnderwaterCalibration> lenses = CalibrateUnderwater(
+        target, views, cam0_size, cam1_size, air_rig, fit,
+        [&](int steps, int total) {
+          report(num_candidates, steps * kSteps / std::max(total, 1));
+        });
+    if (lenses.ok()) {
+      chosen.fit->sigma_n_lenses = lenses->sigma_n_lenses;
+      for (const std::string& note : lenses->notes) {
+        if (note.rfind("lens uncertainty", 0) == 0) {
+          chosen.fit->notes.push_back(note);
+        }
+      }
+    } else {
+      chosen.fit->notes.push_back(
+          "lens uncertainty: the refit failed (" + lenses.status().message() +
+          "); sigma_n leaves the lenses out");
+    }
+    report(num_candidates, kSteps);
+  }
   selection.n = chosen.fit->n;
   selection.sigma_n_noise = chosen.sigma_n_noise;
   selection.sigma_n_lenses = chosen.fit->sigma_n_lenses.value_or(0.0);

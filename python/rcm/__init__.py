@@ -33,7 +33,7 @@ from ._rcm import (
     ClosedFormResult,
     Correspondences,
     FlatPort,
-    LocusEstimate,
+    FrameEstimate,
     MediumSwitch,
     OnlineEstimate,
     OnlineEstimator,

@@ -439,19 +439,18 @@ noise: a seed, not the estimator of record. Thin ports only.
              "a positive finite number or a pixel cannot be undistorted); no "
              "mask.");
 
-  py::class_<LocusEstimate>(module, "LocusEstimate",
-                            "One frame's own estimate: n, sigma_n, crlb, "
-                            "sigma_px (pixels), inliers (count).")
-      .def_readonly("n", &LocusEstimate::n)
-      .def_readonly("sigma_n", &LocusEstimate::sigma_n)
-      .def_readonly("crlb", &LocusEstimate::crlb)
-      .def_readonly("sigma_px", &LocusEstimate::sigma_px)
-      .def_readonly("inliers", &LocusEstimate::inliers)
-      .def("__repr__", [](const LocusEstimate& e) {
-        return "LocusEstimate(n=" + Fixed(e.n, 9) +
-               ", sigma_n=" + Fixed(e.sigma_n, 6) +
-               ", inliers=" + std::to_string(e.inliers) + ")";
-      });
+  py::class_<PooledLocusEstimate> frame_estimate(
+      module, "FrameEstimate",
+      "One frame's own estimate, what refine_refractive_index reports on that "
+      "frame's matches alone: n, sigma_n (total), sigma_n_noise, "
+      "sigma_n_calibration, sigma_n_systematic, crlb, sigma_px (pixels), "
+      "inliers.");
+  BindPooledFields<PooledLocusEstimate>(frame_estimate);
+  frame_estimate.def("__repr__", [](const PooledLocusEstimate& e) {
+    return "FrameEstimate(n=" + Fixed(e.n, 9) +
+           ", sigma_n=" + Fixed(e.sigma_n, 6) +
+           ", inliers=" + std::to_string(e.inliers) + ")";
+  });
 
   using OnlineEstimate = OnlineRefractiveIndexEstimator::Estimate;
   py::class_<OnlineEstimate> online_estimate(

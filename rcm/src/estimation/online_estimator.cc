@@ -160,6 +160,20 @@ FrameFit FitFrame(const StereoRig& rig,
   return fit;
 }
 
+StatusOr<PooledLocusEstimate> FrameEstimateOf(const StereoRig& rig,
+                                              const FrameFit& fit,
+                                              const RefinementOptions& options) {
+  if (!fit.estimate.ok()) return fit.estimate.status();
+  FrameEstimateSums own;
+  if (fit.model) {
+    own.Add(fit.model->n, fit.model->information, fit.model->rotation_coupling);
+  }
+  const StatusOr<CalibratedLocusEstimate> calibrated = EstimateWithCalibration(
+      rig, fit.cost, fit.normal_equations, own, options);
+  if (!calibrated.ok()) return calibrated.status();
+  return PooledEstimateOf(*calibrated);
+}
+
 bool SelfCalibrates(const StereoRig& rig, const RefinementOptions& options) {
   return options.self_calibrate_rotation && rig.calibration_uncertainty() &&
          !rig.calibration_uncertainty()->RotationCovariance().isZero(0.0);
@@ -290,7 +304,7 @@ OnlineRefractiveIndexEstimator::AddFrame(
     }
     update.inliers = std::move(fit.inliers);
   }
-  update.frame_estimate = std::move(fit.estimate);
+  update.frame_estimate = FrameEstimateOf(rig_, fit, options_);
   update.cumulative = Current();
   return update;
 }

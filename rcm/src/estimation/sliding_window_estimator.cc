@@ -101,7 +101,7 @@ SlidingWindowRefractiveIndexEstimator::AddFrame(
   FrameFit fit = FitFrame(rig_, frame_matches, options_);
   update.correspondences = fit.correspondences;
   update.usable = fit.usable;
-  update.frame_estimate = fit.estimate;
+  update.frame_estimate = FrameEstimateOf(rig_, fit, options_);
   if (!fit.estimate.ok()) {
     ++num_skipped_frames_;
     update.decision = Decision::kSkipped;

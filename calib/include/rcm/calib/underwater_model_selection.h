@@ -145,9 +145,12 @@ struct UnderwaterModelSelection {
 };
 
 // Fits every candidate and chooses (header). The candidates are fitted
-// side by side on options.fit.num_threads threads. `progress`, when set, is
+// side by side on options.fit.num_threads threads, without lens refits;
+// the chosen one is then fitted again, all threads on the lens refits of
+// its sigma_n_lenses (the others' are not used). `progress`, when set, is
 // called with (done, total) in hundredths of a candidate as the fits
-// advance, one call at a time but from any of those threads. Fails with the simplest
+// advance (the lens refits count as one more candidate), one call at a
+// time but from any of those threads. Fails with the simplest
 // candidate's error when no candidate can be fitted, or on bad options.
 StatusOr<UnderwaterModelSelection> SelectUnderwaterModel(
     const CalibrationTarget& target, const std::vector<StereoView>& views,

@@ -23,7 +23,9 @@
 // grows by the frames' consistency test and the calibration's uncertainty,
 // as the batch's does, but with cam1's rotation held at the calibration's:
 // calibration_propagation.h). Each frame's own
-// estimate (n_f, sigma_f) is the same computed on C_f, G_f alone; a frame
+// estimate (n_f, sigma_f) is the same computed on C_f, G_f alone (and the
+// reported one, FrameEstimateOf, with the frame's own calibration share and
+// self-calibrated rotation, as the batch of that frame); a frame
 // with too few inliers or too little information for an estimate of its
 // own still adds its inliers to the running sums, as the batch would.
 //
@@ -189,6 +191,18 @@ FrameFit FitFrame(const StereoRig& rig,
                   const std::vector<StereoCorrespondence>& frame_matches,
                   const RefinementOptions& options);
 
+// The frame's own estimate as the estimators report it: EstimateWithCalibration
+// of the frame alone, so that its sigma_n counts what the pooled one counts
+// (pixel noise with cam1's rotation marginalized when it is self-calibrated,
+// the calibration's uncertainty, the systematic floor), i.e. what the batch
+// refinement reports on that frame's matches alone. `fit.estimate` (n_f,
+// sigma_f: pixel noise at the frame's own rotation) stays the estimators'
+// internal measure of frame-to-frame agreement. The error says why there is
+// no estimate.
+StatusOr<PooledLocusEstimate> FrameEstimateOf(const StereoRig& rig,
+                                              const FrameFit& fit,
+                                              const RefinementOptions& options);
+
 class OnlineRefractiveIndexEstimator {
  public:
   // Fails on invalid options or options.refine_rotation (the rotation
@@ -210,9 +224,9 @@ class OnlineRefractiveIndexEstimator {
     bool skipped = false;
     // Indices into the frame of the inliers added to the running sums.
     std::vector<int64_t> inliers;
-    // The frame's own estimate, and the cumulative one after the frame;
-    // each with the reason when there is none.
-    StatusOr<LocusEstimate> frame_estimate = Status::Error("no estimate");
+    // The frame's own estimate (FrameEstimateOf), and the cumulative one
+    // after the frame; each with the reason when there is none.
+    StatusOr<PooledLocusEstimate> frame_estimate = Status::Error("no estimate");
     StatusOr<Estimate> cumulative = Status::Error("no estimate");
   };
   FrameUpdate AddFrame(const std::vector<StereoCorrespondence>& frame_matches);

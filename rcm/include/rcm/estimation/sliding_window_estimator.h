@@ -125,7 +125,7 @@ class SlidingWindowRefractiveIndexEstimator {
     int64_t usable = 0;           // pixels that could be undistorted
     Decision decision = Decision::kSkipped;
     // The frame's own estimate, with the reason when there is none.
-    StatusOr<LocusEstimate> frame_estimate = Status::Error("no estimate");
+    StatusOr<PooledLocusEstimate> frame_estimate = Status::Error("no estimate");
     // z against the window estimate before this frame, when both exist.
     std::optional<double> z;
     // The window estimate after this frame, with the reason when there is
