@@ -37,6 +37,7 @@
 #include "rcm/io/camchain.h"
 #include "rcm/io/number_format.h"
 #include "target_flags.h"
+#include "medium_flag.h"
 
 DEFINE_string(report, "",
               "folder of the report (pictures, per-view CSV, JSON); default: "
@@ -132,7 +133,8 @@ extern const Subcommand kCalibrateCommand = {
     kUsage,
     {__FILE__, kImageInputFlagsSource, kCalibrationInputFlagsSource,
      kTargetFlagsSource,
-     kLensModelFlagSource, kUnderwaterFlagsSource, kAirGapFlagSource, kAirFlagSource},
+     kLensModelFlagSource, kUnderwaterFlagsSource, kAirGapFlagSource, kAirFlagSource,
+     kMediumFlagSource},
     RunCalibrate};
 
 namespace {
@@ -219,10 +221,10 @@ int RunCalibrate() {
     return RunCalibrateUnderwater(command, *target, paths, underwater);
   }
   if (!FLAGS_air.empty() || FLAGS_estimate_air_gap ||
-      FLAGS_estimate_port_tilt || FLAGS_thin_port) {
+      FLAGS_estimate_port_tilt || FLAGS_thin_port || !FLAGS_medium.empty()) {
     PrintError(command,
-               "--air, --estimate-air-gap, --estimate-port-tilt and "
-               "--thin-port go with --underwater");
+               "--air, --estimate-air-gap, --estimate-port-tilt, --thin-port "
+               "and --medium go with --underwater");
     return kExitUsage;
   }
 

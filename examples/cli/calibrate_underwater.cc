@@ -21,6 +21,7 @@
 #include "calibration_run.h"
 #include "image_input_flags.h"
 #include "progress.h"
+#include "medium_flag.h"
 #include "rcm/calib/calibration_report.h"
 #include "rcm/calib/underwater_calibration.h"
 #include "rcm/calib/underwater_model_selection.h"
@@ -266,6 +267,11 @@ int RunCalibrateUnderwater(const Subcommand& command,
                "--estimate-port-tilt: a thin port has neither");
     return kExitUsage;
   }
+  const StatusOr<std::optional<MediumPrior>> medium = MediumFromFlag();
+  if (!medium.ok()) {
+    PrintError(command, medium.status().message());
+    return kExitUsage;
+  }
   calib::UnderwaterModelSelectionOptions options;
   options.fit.huber_px = run.huber_px;
   options.fit.outlier_sigmas = run.outlier_sigmas;
@@ -379,6 +385,23 @@ int RunCalibrateUnderwater(const Subcommand& command,
   }
   std::vector<std::string> warnings = result->notes;
   if (!selection->pinned) warnings.push_back(selection->advice);
+  // The medium (--medium): n against its physics.
+  nlohmann::json medium_json = nullptr;
+  if (*medium) {
+    const MediumCheck check =
+        CheckAgainstMedium(selection->n, selection->sigma_n, **medium);
+    medium_json = {{"name", (*medium)->name},
+                   {"n", (*medium)->n},
+                   {"sigma", (*medium)->sigma},
+                   {"range", {(*medium)->min_n, (*medium)->max_n}},
+                   {"z", check.z},
+                   {"contradicts", check.contradicts}};
+    if (check.contradicts) {
+      warnings.push_back(check.message +
+                         ": the air calibration may not describe the lenses "
+                         "under water, or the water is another");
+    }
+  }
   if (conventional.ok && conventional.pixel_sigma < 0.9 * result->pixel_sigma) {
     warnings.push_back(
         "a conventional " +
@@ -413,6 +436,7 @@ int RunCalibrateUnderwater(const Subcommand& command,
   json["model"] = model.Name();
   json["pinned"] = selection->pinned;
   json["advice"] = selection->advice;
+  json["medium"] = medium_json;
   json["evidence_views"] = selection->num_evidence_views;
   json["candidates"] = CandidatesJson(*selection);
   json["rms_px"] = result->rms_px;

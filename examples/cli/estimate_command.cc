@@ -21,11 +21,13 @@
 #include "air_gap_flag.h"
 #include "command.h"
 #include "image_input_flags.h"
+#include "medium_flag.h"
 #include "progress.h"
 #include "rig_flags.h"
 #include "rcm/estimation/batch_refinement.h"
 #include "rcm/estimation/calibration_propagation.h"
 #include "rcm/estimation/match_refractive_index.h"
+#include "rcm/estimation/medium_drift.h"
 #include "rcm/estimation/prepared_correspondence.h"
 #include "rcm/frontend/stereo_front_end.h"
 #include "rcm/geometry/epipolar.h"
@@ -903,7 +905,8 @@ extern const Subcommand kEstimateCommand = {
     "estimate",
     "refractive index n from stereo images or correspondences",
     kUsage,
-    {__FILE__, kRigFlagsSource, kImageInputFlagsSource, kAirGapFlagSource},
+    {__FILE__, kRigFlagsSource, kImageInputFlagsSource, kAirGapFlagSource,
+     kMediumFlagSource},
     RunEstimate};
 
 namespace {
@@ -951,6 +954,11 @@ int RunEstimate() {
   const RefinementOptions refinement = RefinementOptionsFromFlags();
   if (const Status status = refinement.Check(); !status.ok()) {
     PrintError(command, status.message());
+    return kExitUsage;
+  }
+  const StatusOr<std::optional<MediumPrior>> medium = MediumFromFlag();
+  if (!medium.ok()) {
+    PrintError(command, medium.status().message());
     return kExitUsage;
   }
   PaperOnlineEstimatorOptions paper_options;
@@ -1100,6 +1108,54 @@ int RunEstimate() {
   for (const std::string& warning : UncertaintyWarnings(*report, *rig)) {
     PrintWarning(command, warning);
   }
+  // The medium (--medium): the estimate against it, and with the
+  // refinement of thin ports cam1's rotation assuming it.
+  nlohmann::json medium_json = nullptr;
+  std::vector<std::string> medium_lines;
+  if (*medium) {
+    const MediumPrior& water = **medium;
+    const MediumCheck check =
+        CheckAgainstMedium(report->n, report->sigma_n, water);
+    medium_json = {{"name", water.name},
+                   {"n", water.n},
+                   {"sigma", water.sigma},
+                   {"range", {water.min_n, water.max_n}},
+                   {"z", check.z},
+                   {"contradicts", check.contradicts}};
+    medium_lines.push_back("  medium     " + water.Describe() + ": n is " +
+                           FormatFixed(check.z, 1) + " sigma from it");
+    if (check.contradicts) {
+      PrintWarning(command,
+                   check.message +
+                       ": the camchain may no longer describe the rig (it "
+                       "turned since the calibration?), or the water is "
+                       "another");
+    }
+    if (FLAGS_estimator == "refine" && !rig->HasThickPort()) {
+      const StatusOr<MediumDrift> drift =
+          EstimateDriftAssumingMedium(*rig, matches, refinement, water);
+      if (drift.ok()) {
+        const Eigen::Vector3d degrees =
+            drift->assuming_medium.rotation->angle_axis * 180.0 / M_PI;
+        medium_json["assuming_medium"] = {
+            {"n", drift->assuming_medium.n},
+            {"sigma_n", drift->assuming_medium.sigma_n},
+            {"rotation_deg", {degrees.x(), degrees.y(), degrees.z()}},
+            {"turned_deg", drift->angle * 180.0 / M_PI},
+            {"sigma_turned_deg", drift->sigma_angle * 180.0 / M_PI},
+            {"turned", drift->turned}};
+        medium_lines.push_back("             " + drift->message);
+        if (drift->turned) {
+          PrintWarning(command, "the calibration is stale: " + drift->message +
+                                    "; calibrate in the water (rcm calibrate "
+                                    "--underwater) or re-calibrate in air");
+        }
+      } else {
+        medium_json["assuming_medium_error"] = drift.status().message();
+        medium_lines.push_back("             " + drift.status().message());
+      }
+    }
+  }
 
   const StereoRig::RectificationDeviation deviation =
       rig->DeviationFromRectified();
@@ -1122,6 +1178,7 @@ int RunEstimate() {
   json["correspondences"] = matches.size();
   json["frames"] = frames.size();
   json.update(report->extra);
+  json["medium"] = medium_json;
   json["rig"] = {
       {"calib", FLAGS_calib},
       {"left", FLAGS_left_camera},
@@ -1270,6 +1327,7 @@ int RunEstimate() {
       text << line << "\n";
     }
   }
+  for (const std::string& line : medium_lines) text << line << "\n";
   if (!written.empty()) {
     text << "  wrote     ";
     for (const std::string& path : written) text << " " << path;

@@ -270,13 +270,19 @@ TEST(UnderwaterCli, OneCameraGivesN) {
   // The same run from the corners it wrote: the same n, to rounding (the
   // file keeps the corners in point order, the detector in its own, so
   // the sums run in another order).
+  // (With a --medium that the simulated 1.342 contradicts: flagged in one
+  // warning, and in the JSON, the answer unchanged.)
   const RunResult again = Rcm(
       Words("calibrate --underwater --air " + dive + "/camchain.yaml --left " +
             dive + "/left --out " + Folder("again") + " --json --folds 0 " +
-            Board(0.03) + " --corners " + corners));
+            Board(0.03) + " --corners " + corners + " --medium 1.20:0.001"));
   constexpr double kSameCornersTolerance = 1e-12;
   EXPECT_NEAR(Json(again)["n"].get<double>(), json["n"].get<double>(),
               kSameCornersTolerance);
+  EXPECT_TRUE(json["medium"].is_null());
+  EXPECT_TRUE(Json(again)["medium"]["contradicts"].get<bool>());
+  EXPECT_NE(again.err.find("contradicts n 1.2000 +- 0.0010"), std::string::npos)
+      << again.err;
   EXPECT_EQ(json["cameras"].get<int>(), 1);
   EXPECT_FALSE(json["extrinsics_estimated"].get<bool>());
   EXPECT_TRUE(json["extrinsic_change_deg"].is_null());
@@ -410,6 +416,15 @@ TEST(UnderwaterCli, FlagsThatNeedUnderwater) {
                 "a.yaml --left l --right r --out " +
                 water + " " + Board(0.03))),
       water, "--thin-port contradicts --estimate-air-gap", 2);
+  ExpectRefused(Rcm(Words("calibrate --medium sea --left l --right r --out " +
+                          water + " " + Board(0.03))),
+                water, "go with --underwater", 2);
+  // A --medium that cannot parse: refused before anything is read.
+  ExpectRefused(
+      Rcm(Words("calibrate --underwater --medium salty --air a.yaml --left l "
+                "--right r --out " +
+                water + " " + Board(0.03))),
+      water, "--medium: expected fresh, sea or N:SIGMA", 2);
 }
 
 }  // namespace

@@ -255,6 +255,62 @@ TEST(EstimateCli, PinnedAtTheUpperBoundIsRefused) {
               1e-9);
 }
 
+// A narrow rig turned 0.5 degree since its calibration, at one depth:
+// n and the turn are nearly collinear, so the images alone cannot give the
+// turn; the medium's physics can (medium_drift.h). The drift is found
+// within 3 of its sigmas, and said stale in one warning line.
+TEST(EstimateCli, MediumGivesTheTurnOfAStaleNarrowRig) {
+  const std::string dive = test::TempFilePath("stale");
+  std::filesystem::remove_all(dive);
+  const RunResult simulated =
+      Rcm({"simulate", "--out", dive, "--rig", "narrow", "--noimages",
+           "--depth-range", "0.9,1.1", "--matches-per-frame", "300",
+           "--frames", "10", "--n", "1.340", "--match-noise", "0.3",
+           "--extrinsic-drift", "0.3,0.4,0"});
+  ASSERT_EQ(simulated.exit_code, 0) << simulated.err;
+  const RunResult result =
+      Rcm({"estimate", "--calib", dive + "/camchain.yaml", "--matches",
+           dive + "/matches.csv", "--medium", "sea", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json medium = nlohmann::json::parse(result.out)["medium"];
+  ASSERT_TRUE(medium.is_object()) << result.out;
+  EXPECT_EQ(medium["name"].get<std::string>(), "sea water");
+  const nlohmann::json& assuming = medium["assuming_medium"];
+  EXPECT_TRUE(assuming["turned"].get<bool>());
+  EXPECT_LT(std::abs(assuming["turned_deg"].get<double>() - 0.5),
+            3.0 * assuming["sigma_turned_deg"].get<double>());
+  EXPECT_NE(result.err.find("the calibration is stale: assuming sea water, "
+                            "cam1 has turned by 0.5"),
+            std::string::npos)
+      << result.err;
+}
+
+// An estimate that contradicts the medium is flagged in one line; the
+// answer stays the data's.
+TEST(EstimateCli, EstimateThatContradictsTheMediumIsFlagged) {
+  const std::string matches = ExactMatches(1.333);
+  for (const char* estimator : {"refine", "window"}) {
+    const RunResult result =
+        Rcm({"estimate", "--calib", kRig, "--matches", matches, "--estimator",
+             estimator, "--medium", "1.40:0.002", "--json"});
+    ASSERT_EQ(result.exit_code, 0) << result.err;
+    const nlohmann::json json = nlohmann::json::parse(result.out);
+    EXPECT_NEAR(json["n"].get<double>(), 1.333, 1e-6) << estimator;
+    EXPECT_TRUE(json["medium"]["contradicts"].get<bool>()) << estimator;
+    EXPECT_NE(result.err.find("contradicts n 1.4000 +- 0.0020"),
+              std::string::npos)
+        << result.err;
+  }
+}
+
+TEST(EstimateCli, MalformedMediumIsOneLineError) {
+  for (const char* medium : {"salty", "1.34", "1.34:0", "3:0.1"}) {
+    ExpectFailsWithOneLine(Rcm({"estimate", "--calib", kRig, "--matches",
+                                kDemoMatches, "--medium", medium}),
+                           2, "--medium");
+  }
+}
+
 TEST(EstimateCli, RefineDoesNotWarnOnUnrectifiedRig) {
   const RunResult result =
       Rcm({"estimate", "--calib",

@@ -74,18 +74,33 @@ ceres::CostFunction* NewRotationPrior(const Eigen::Matrix3d& covariance,
   return new ceres::NormalPrior(root_information, ceres::Vector::Zero(3));
 }
 
+// The prior on n (RefinementOptions::n_prior) in pixels of residual:
+// sigma_px (n - mean) / sigma, as NewRotationPrior's.
+ceres::CostFunction* NewIndexPrior(const IndexPrior& prior, double sigma_px) {
+  ceres::Matrix root_information(1, 1);
+  root_information(0, 0) = sigma_px / prior.sigma;
+  ceres::Vector mean(1);
+  mean[0] = prior.n;
+  return new ceres::NormalPrior(root_information, mean);
+}
+
 // One Ceres problem over `indices` of `matches`, with the rotation
 // correction when `with_rotation` and its prior when `prior` is not null
-// (NewRotationPrior); returns the summary.
+// (NewRotationPrior), and the prior on n when `n_prior` is not null
+// (NewIndexPrior); returns the summary.
 ceres::Solver::Summary Solve(const Eigen::Matrix3d& essential,
                              const std::vector<PreparedCorrespondence>& matches,
                              const std::vector<int64_t>& indices,
                              RobustLoss loss, const RefinementOptions& options,
                              bool with_rotation, ceres::CostFunction* prior,
+                             ceres::CostFunction* n_prior,
                              Parameters* parameters, ceres::Problem* problem) {
   ceres::LossFunction* loss_function = NewLossFunction(loss, options.loss_scale_px);
   if (prior != nullptr) {
     problem->AddResidualBlock(prior, nullptr, parameters->rotation);
+  }
+  if (n_prior != nullptr) {
+    problem->AddResidualBlock(n_prior, nullptr, &parameters->n);
   }
   for (const int64_t i : indices) {
     if (with_rotation) {
@@ -133,6 +148,10 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
     const RefinementOptions& options) {
   RCM_RETURN_IF_ERROR(options.Check());
   if (rig.HasThickPort()) {
+    if (options.n_prior) {
+      return Status::Error(
+          "the prior on n (the medium) is available for thin ports only");
+    }
     // The thick-port model (thick_port_refinement.h); a rig without ports
     // or with thin ones takes the paper's model below, unchanged.
     ThickPortRefinementOptions thick_options;
@@ -205,7 +224,11 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
             : nullptr;
     const ceres::Solver::Summary stage1 =
         Solve(essential, matches, all, options.loss, options, with_rotation,
-              prior, &parameters, &problem);
+              prior,
+              options.n_prior
+                  ? NewIndexPrior(*options.n_prior, 0.5 * options.loss_scale_px)
+                  : nullptr,
+              &parameters, &problem);
     if (!stage1.IsSolutionUsable()) {
       return Status::Error("the robust refinement failed: " + stage1.message);
     }
@@ -268,9 +291,8 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
     }
     return std::sqrt(sum / static_cast<double>(dof));
   };
-  double prior_sigma_px = mode == RotationMode::kPrior
-                              ? data_sigma_px(parameters)
-                              : 0.0;
+  const bool with_prior = mode == RotationMode::kPrior || options.n_prior;
+  double prior_sigma_px = with_prior ? data_sigma_px(parameters) : 0.0;
   constexpr int kMaxPriorSolves = 3;
   constexpr double kPriorSigmaTolerance = 0.02;  // relative
   for (int solve = 0;; ++solve) {
@@ -282,7 +304,11 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
             : nullptr;
     const ceres::Solver::Summary stage2 =
         Solve(essential, matches, inliers, RobustLoss::kNone, options,
-              with_rotation, prior, &parameters, &problem);
+              with_rotation, prior,
+              options.n_prior ? NewIndexPrior(*options.n_prior,
+                                              std::max(prior_sigma_px, 1e-6))
+                              : nullptr,
+              &parameters, &problem);
     if (!stage2.IsSolutionUsable()) {
       return Status::Error("the least-squares refinement failed: " +
                            stage2.message);
@@ -291,7 +317,7 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
     summary.sigma_px = data_sigma_px(parameters);
     summary.cost = 0.5 * summary.sigma_px * summary.sigma_px *
                    static_cast<double>(dof);
-    if (mode != RotationMode::kPrior || solve + 1 >= kMaxPriorSolves ||
+    if (!with_prior || solve + 1 >= kMaxPriorSolves ||
         std::abs(summary.sigma_px - prior_sigma_px) <=
             kPriorSigmaTolerance * summary.sigma_px) {
       break;
@@ -323,7 +349,8 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
   const double inflation =
       summary.consistency ? summary.consistency->inflation : 1.0;
   StatusOr<CalibrationPropagation> propagation = PropagateCalibration(
-      equations, layout, uncertainty, mode, summary.sigma_px, inflation);
+      equations, layout, uncertainty, mode, summary.sigma_px, inflation,
+      options.n_prior ? options.n_prior->sigma : 0.0);
   if (!propagation.ok()) return propagation.status();
   summary.sigma_n = propagation->sigma_n;
   summary.sigma_n_noise = propagation->sigma_n_noise;
@@ -347,7 +374,8 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
     correction.cam1_from_cam0 = final_extrinsics;
     summary.rotation = correction;
   }
-  if (rig.calibration_uncertainty() || layout.NumSystematic() > 0) {
+  if (rig.calibration_uncertainty() || layout.NumSystematic() > 0 ||
+      options.n_prior) {
     summary.calibration = *propagation;
   }
 

@@ -376,7 +376,7 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
     const LocusNormalEquations& equations,
     const CalibrationParameterLayout& layout,
     const CalibrationUncertainty& uncertainty, RotationMode mode,
-    double sigma_px, double noise_inflation) {
+    double sigma_px, double noise_inflation, double n_prior_sigma) {
   const int size = layout.Size();
   CHECK_EQ(equations.information.rows(), size);
   CHECK(sigma_px >= 0.0 && noise_inflation >= 1.0);
@@ -456,6 +456,9 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
     }
     prior.bottomRightCorner<3, 3>() = ldlt.solve(Eigen::Matrix3d::Identity());
   }
+  Eigen::MatrixXd n_prior = Eigen::MatrixXd::Zero(nx, nx);
+  if (n_prior_sigma > 0.0) n_prior(0, 0) = 1.0 / (n_prior_sigma * n_prior_sigma);
+  prior += n_prior;
   // In the sigma^2-scaled form, stable down to exact data (sigma = 0):
   // H' = sigma^2 H = A + sigma^2 P, S = H'^-1 B.
   const Eigen::MatrixXd h = a + variance * prior;
@@ -469,6 +472,8 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
   const Eigen::MatrixXd noise = variance * h_inverse * a * h_inverse;
   const Eigen::MatrixXd from_prior =
       variance * variance * h_inverse * prior * h_inverse;
+  const Eigen::MatrixXd from_n_prior =
+      variance * variance * h_inverse * n_prior * h_inverse;
   const Eigen::MatrixXd s = h_inverse * b;
   const Eigen::MatrixXd from_held = s * sigma_p * s.transpose();
 
@@ -497,7 +502,8 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
   result.variance_systematic = shares[3];
   result.variance_translation =
       from_held(0, 0) - shares[0] - shares[2] - shares[3];
-  result.variance_rotation += from_prior(0, 0);
+  result.variance_medium = from_n_prior(0, 0);
+  result.variance_rotation += from_prior(0, 0) - from_n_prior(0, 0);
 
   const double noise_variance =
       noise(0, 0) * noise_inflation * noise_inflation;

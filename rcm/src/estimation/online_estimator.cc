@@ -278,6 +278,11 @@ StatusOr<OnlineRefractiveIndexEstimator> OnlineRefractiveIndexEstimator::Create(
         "the online estimator estimates n alone: the rotation correction "
         "(refine_rotation) is available in the batch refinement only");
   }
+  if (options.n_prior) {
+    return Status::Error(
+        "the online estimator estimates n from the data alone: the prior on "
+        "n (the medium) is available in the batch refinement only");
+  }
   return OnlineRefractiveIndexEstimator(rig, options);
 }
 

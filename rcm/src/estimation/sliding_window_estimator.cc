@@ -61,6 +61,11 @@ SlidingWindowRefractiveIndexEstimator::Create(
         "correction (refine_rotation) is available in the batch refinement "
         "only");
   }
+  if (options.n_prior) {
+    return Status::Error(
+        "the sliding-window estimator estimates n from the data alone: the "
+        "prior on n (the medium) is available in the batch refinement only");
+  }
   return SlidingWindowRefractiveIndexEstimator(rig, options, window_options);
 }
 

@@ -258,6 +258,9 @@ struct CalibrationPropagation {
   double variance_rotation = 0.0;
   double variance_translation = 0.0;
   double variance_lenses = 0.0;
+  // With a prior on n (RefinementOptions::n_prior): its share, part of
+  // sigma_n_calibration^2 (the medium's uncertainty).
+  double variance_medium = 0.0;
   // The systematic residual field's share, sigma_n_systematic^2: part of
   // sigma_n, reported apart from the calibration's.
   double variance_systematic = 0.0;
@@ -275,13 +278,16 @@ struct CalibrationPropagation {
 };
 
 // The propagation above from the sums at the solution. `noise_inflation`
-// (>= 1) scales the pixel-noise share. Fails when the information on the
-// estimated parameters is singular (w free and not separable from n).
+// (>= 1) scales the pixel-noise share. `n_prior_sigma` > 0: n has the
+// prior N(., n_prior_sigma^2) (RefinementOptions::n_prior), in P as w's
+// prior is: P_nn = 1 / n_prior_sigma^2, its share variance_medium. Fails
+// when the information on the estimated parameters is singular (w free and
+// not separable from n).
 StatusOr<CalibrationPropagation> PropagateCalibration(
     const LocusNormalEquations& equations,
     const CalibrationParameterLayout& layout,
     const CalibrationUncertainty& uncertainty, RotationMode mode,
-    double sigma_px, double noise_inflation = 1.0);
+    double sigma_px, double noise_inflation = 1.0, double n_prior_sigma = 0.0);
 
 }  // namespace rcm
 

@@ -38,6 +38,12 @@ std::optional<RobustLoss> RobustLossFromName(std::string_view name);
 // rho(s) above.
 double RobustLossRho(RobustLoss loss, double scale, double squared_residual);
 
+// A Gaussian prior on n: N(n, sigma^2) (medium_prior.h gives the water's).
+struct IndexPrior {
+  double n = 0.0;
+  double sigma = 0.0;
+};
+
 struct RefinementOptions {
   // Loss of stage 1.
   RobustLoss loss = RobustLoss::kCauchy;
@@ -81,6 +87,14 @@ struct RefinementOptions {
   // independent, as simulated matches' are. rcm estimate gives matches of
   // its image front end 0.03 px.
   double systematic_px = 0.0;
+  // A prior on n from the physics of the medium (medium_prior.h, rcm
+  // estimate --medium), batch refinement of thin ports only: the term
+  // (sigma_px (n - prior.n) / prior.sigma)^2 joins the least squares as
+  // cam1's rotation prior does, and its share of sigma_n is reported
+  // (CalibrationPropagation::variance_medium). Where the data cannot tell n
+  // from cam1's rotation (a narrow field at one depth) it is what makes
+  // the rotation observable. Unset (the default): n is the free unknown.
+  std::optional<IndexPrior> n_prior;
   // Solver iterations per stage; >= 1.
   int max_num_iterations = 100;
   // Threads for evaluating residuals; >= 1.
