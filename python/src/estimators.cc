@@ -17,6 +17,7 @@
 #include "rcm/estimation/batch_refinement.h"
 #include "rcm/estimation/closed_form.h"
 #include "rcm/estimation/online_estimator.h"
+#include "rcm/estimation/medium_prior.h"
 #include "rcm/estimation/paper_online_estimator.h"
 #include "rcm/estimation/refinement_options.h"
 #include "rcm/estimation/sliding_window_estimator.h"
@@ -45,7 +46,39 @@ std::vector<OptionField> RefinementFields(RefinementOptions* o) {
       [o]() {
         return py::object(py::str(std::string(RobustLossName(o->loss))));
       }};
+  // A prior on n: None, a medium ('fresh', 'sea', 'N:SIGMA'; medium_prior.h)
+  // or a pair (n, sigma).
+  OptionField n_prior{
+      "n_prior",
+      [o](const py::handle& value) {
+        if (value.is_none()) {
+          o->n_prior.reset();
+        } else if (py::isinstance<py::str>(value)) {
+          const MediumPrior medium =
+              ValueOrThrow(ParseMediumPrior(value.cast<std::string>()));
+          o->n_prior = IndexPrior{medium.n, medium.sigma};
+        } else {
+          py::sequence pair;
+          if (!py::isinstance<py::sequence>(value) ||
+              (pair = value.cast<py::sequence>()).size() != 2) {
+            ThrowTypeError(
+                "n_prior must be None, 'fresh', 'sea', 'N:SIGMA' or a pair "
+                "(n, sigma)");
+          }
+          try {
+            o->n_prior = IndexPrior{pair[0].cast<double>(),
+                                    pair[1].cast<double>()};
+          } catch (const py::cast_error&) {
+            ThrowTypeError("n_prior's pair must be two numbers (n, sigma)");
+          }
+        }
+      },
+      [o]() -> py::object {
+        if (!o->n_prior) return py::none();
+        return py::make_tuple(o->n_prior->n, o->n_prior->sigma);
+      }};
   return {loss,
+          n_prior,
           DoubleOption("loss_scale_px", &o->loss_scale_px),
           DoubleOption("inlier_threshold_px", &o->inlier_threshold_px, true),
           IntOption("num_scan_points", &o->num_scan_points),
@@ -94,6 +127,7 @@ py::object CalibrationDict(const std::optional<CalibrationPropagation>& c) {
   d["variance_rotation"] = c->variance_rotation;
   d["variance_translation"] = c->variance_translation;
   d["variance_lenses"] = c->variance_lenses;
+  d["variance_medium"] = c->variance_medium;
   d["variance_systematic"] = c->variance_systematic;
   d["dn_drotation"] = ToNumpy(c->dn_drotation);
   d["dn_dtranslation"] = ToNumpy(c->dn_dtranslation);
@@ -391,6 +425,8 @@ Keyword options (RefinementOptions, same names and defaults):
   inlier_threshold_px=2.0 (pixels, inf keeps all), num_scan_points=51,
   min_inliers=10, max_crlb_per_px=0.1, refine_rotation=False,
   self_calibrate_rotation=True, systematic_px=0.0 (pixels),
+  n_prior=None (a prior on n: 'fresh', 'sea', 'N:SIGMA' or (n, sigma); with
+  refine_rotation=True it gives cam1's turn on a narrow rig),
   max_num_iterations=100, num_threads=2.
 Returns an rcm.RefinementResult. Raises ValueError with the library's
 one-line message (too few inliers, n unobservable, n pinned at 2, bad

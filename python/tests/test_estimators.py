@@ -190,7 +190,24 @@ def test_option_keywords():
         "loss": "cauchy", "loss_scale_px": 1.0, "inlier_threshold_px": 2.0,
         "num_scan_points": 51, "min_inliers": 10, "max_crlb_per_px": 0.1,
         "refine_rotation": False, "self_calibrate_rotation": True,
-        "systematic_px": 0.0, "max_num_iterations": 100, "num_threads": 2}
+        "systematic_px": 0.0, "max_num_iterations": 100, "num_threads": 2,
+        "n_prior": None}
+
+
+def test_n_prior_of_the_medium(realistic_rig):
+    # Exact matches at the medium's own n: the prior costs nothing at the
+    # truth, so n and cam1's (zero) rotation stay exact (EXACT), and the
+    # medium's share of sigma_n is reported.
+    matches = sample(realistic_rig, 1.3415, frames=2, per_frame=200)
+    for prior in ["1.3415:0.003", (1.3415, 0.003)]:
+        result = rcm.refine_refractive_index(realistic_rig, matches,
+                                             n_prior=prior,
+                                             refine_rotation=True)
+        assert abs(result.n - 1.3415) < EXACT
+        assert np.abs(result.rotation["angle_axis"]).max() < EXACT
+        assert result.calibration["variance_medium"] >= 0.0
+    sea = rcm.refine_refractive_index(realistic_rig, matches, n_prior="sea")
+    assert abs(sea.n - 1.3415) < 1e-6
 
 
 def test_options_change_the_estimate(realistic_rig):
@@ -215,6 +232,10 @@ def test_options_change_the_estimate(realistic_rig):
     ({"min_inliers": 1}, ValueError, "min_inliers"),
     ({"refine_rotation": 1}, TypeError, "refine_rotation"),
     ({"num_threads": 0}, ValueError, "thread"),
+    ({"n_prior": "salty"}, ValueError, "expected fresh, sea or N:SIGMA"),
+    ({"n_prior": (1.34,)}, TypeError, "n_prior"),
+    ({"n_prior": ("a", 0.1)}, TypeError, "n_prior"),
+    ({"n_prior": (1.34, 0.0)}, ValueError, "prior on n"),
 ])
 def test_bad_options(realistic_rig, kwargs, error_type, text):
     matches = sample(realistic_rig, 1.333, frames=1, per_frame=50)
