@@ -64,9 +64,6 @@ skipped=(
   # [StereoCalibration.*, UnderwaterCalibration.*, CrossValidation.*]: Monte Carlo
   'StereoCalibration.MonteCarloSigmaIsHonest'
   'UnderwaterCalibration.MonteCarloSigmaIsHonest'
-  # [UnderwaterModelSelection.MonteCarloHonestUnderThemAll, one trial]: the
-  # candidates' Monte Carlo under each model error alone
-  'UnderwaterModelSelection.MonteCarloHonestUnderA*'
   'OpenCvSampleStereo.LeaveOneOutIsStable'
   # [BoardWarp.Exact*, MeanFramesProjection.JacobianMatchesCentralDifferences]:
   # Monte Carlo of the warp's sigma and of the mean-frames projection spread

@@ -257,6 +257,11 @@ int RunDemo() {
     PrintError(command, drift.message());
     return kExitUsage;
   }
+  if (const Status lens = LensChangeFromFlag(&simulation->options);
+      !lens.ok()) {
+    PrintError(command, lens.message());
+    return kExitUsage;
+  }
   const std::string folder = FLAGS_out.empty() ? kDefaultFolder : FLAGS_out;
   std::error_code error;
   std::filesystem::create_directories(folder, error);

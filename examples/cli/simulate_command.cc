@@ -54,8 +54,8 @@ constexpr char kUsage[] =
     "0.005]\n"
     "                    [--matches-per-frame 500] [--calib RIG.yaml | --rig "
     "narrow]\n"
-    "                    [--extrinsic-drift 0.5,0,0] [--board chessboard "
-    "--cols 9 --rows 6\n"
+    "                    [--extrinsic-drift 0.5,0,0] [--lens-change 0.5,-0.3]\n"
+    "                    [--board chessboard --cols 9 --rows 6\n"
     "                    --square 0.03 [--board-distance 0.6,2]] [--seed "
     "1]\n\n"
     "A robot moves through a textured pool with the stereo rig looking 16\n"
@@ -65,7 +65,7 @@ constexpr char kUsage[] =
     "  left/000000.png ...   8-bit mono images of cam0\n"
     "  right/000000.png ...  8-bit mono images of cam1\n"
     "  camchain.yaml         the in-air calibration (Kalibr), without the\n"
-    "                        --extrinsic-drift\n"
+    "                        --extrinsic-drift and --lens-change\n"
     "  board.csv             with --board: frame,t,tx,ty,tz,qx,qy,qz,qw,\n"
     "                        visible_left,visible_right (cam0_from_target\n"
     "                        in rcm calibrate's target frame; 1 when the\n"
@@ -204,6 +204,10 @@ int RunSimulate() {
     PrintError(command, drift.message());
     return kExitUsage;
   }
+  if (const Status lens = LensChangeFromFlag(&options); !lens.ok()) {
+    PrintError(command, lens.message());
+    return kExitUsage;
+  }
   if (const Status board = BoardFromFlags(&options); !board.ok()) {
     PrintError(command, board.message());
     return kExitUsage;
@@ -245,6 +249,8 @@ int RunSimulate() {
                                   {options.cam1_drift.translation.x() * 1e3,
                                    options.cam1_drift.translation.y() * 1e3,
                                    options.cam1_drift.translation.z() * 1e3}}};
+  settings["lens_change_percent"] = {100.0 * options.lens_change.focal_scale[0],
+                                    100.0 * options.lens_change.focal_scale[1]};
   // The extrinsics that made the data (camchain.yaml has the calibration).
   settings["true_cam1_from_cam0"] =
       MatrixRows(simulator.value()->true_rig().right_from_left().ToMatrix());
@@ -299,6 +305,13 @@ int RunSimulate() {
               << " deg, moved "
               << FormatFixed(options.cam1_drift.translation.norm() * 1e3, 2)
               << " mm since the calibration in camchain.yaml\n";
+  }
+  if (!options.lens_change.IsZero()) {
+    std::cout << "  lenses   focal lengths changed by "
+              << FormatFixed(100.0 * options.lens_change.focal_scale[0], 2)
+              << " % (cam0), "
+              << FormatFixed(100.0 * options.lens_change.focal_scale[1], 2)
+              << " % (cam1) since the calibration in camchain.yaml\n";
   }
   if (options.board) {
     const std::array<int, 3> visible = CountVisibleBoardFrames(sim);

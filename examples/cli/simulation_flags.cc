@@ -45,6 +45,12 @@ DEFINE_string(extrinsic_drift, "",
               "images and matches are those of the moved rig, the "
               "calibration stays as it was (StereoRig::WithCam1Moved)");
 
+DEFINE_string(lens_change, "",
+              "PCT0[,PCT1]: each camera's focal lengths have changed by this "
+              "many percent since the air calibration (one value: both "
+              "cameras): the images and matches are those of the changed "
+              "lenses, the calibration stays as it was");
+
 namespace rcm::cli {
 
 extern const char kSimulationFlagsSource[] = __FILE__;
@@ -71,6 +77,21 @@ Status ExtrinsicDriftFromFlag(SequenceOptions* options) {
     options->cam1_drift.translation = Eigen::Vector3d(v[3], v[4], v[5]) * 1e-3;
   }
   return options->cam1_drift.Check().WithContext(context);
+}
+
+Status LensChangeFromFlag(SequenceOptions* options) {
+  if (FLAGS_lens_change.empty()) return Status::Ok();
+  const std::string context = "--lens-change " + FLAGS_lens_change;
+  const StatusOr<std::vector<double>> values =
+      ParseNumberList(FLAGS_lens_change);
+  if (!values.ok() || (values->size() != 1 && values->size() != 2)) {
+    return Status::Error(context +
+                         ": expected PCT0[,PCT1] (percent), e.g. 0.5,-0.3");
+  }
+  const std::vector<double>& v = values.value();
+  options->lens_change.focal_scale = {0.01 * v[0],
+                                      0.01 * v[v.size() == 2 ? 1 : 0]};
+  return options->lens_change.Check().WithContext(context);
 }
 
 StatusOr<Simulation> SimulationFromFlags(const std::string& calib,

@@ -47,6 +47,8 @@ StatusOr<Simulation> SimulationFromFlags(const std::string& calib,
 // from the calibration). Errors (wrong flags): not 3 or 6 numbers, not
 // finite, beyond ExtrinsicDrift::Check's limits.
 Status ExtrinsicDriftFromFlag(SequenceOptions* options);
+// --lens-change into options->lens_change; one line on a bad value.
+Status LensChangeFromFlag(SequenceOptions* options);
 
 // The flags' values, for the JSON a run writes next to its outputs.
 nlohmann::json SimulationFlagsJson(const Simulation& simulation);

@@ -960,6 +960,14 @@ void AddSimulateRows(std::vector<BadInputCase>* rows) {
        SimulateArgs({"--extrinsic-drift", "0,0,45", "--out", "$D/out"}),
        "rotation of 45 deg is above 10 deg", outputs});
   rows->push_back(
+      {"SimulateLensChangeMalformed", Nothing(),
+       SimulateArgs({"--lens-change", "0.5,x", "--out", "$D/out"}),
+       "--lens-change 0.5,x: expected PCT0[,PCT1]", outputs});
+  rows->push_back(
+      {"SimulateLensChangeTooLarge", Nothing(),
+       SimulateArgs({"--lens-change", "0,8", "--out", "$D/out"}),
+       "lens change of camera 1: a focal scale of 0.08 is outside", outputs});
+  rows->push_back(
       {"SimulateBoardAprilGrid", Nothing(),
        SimulateArgs({"--board", "aprilgrid", "--cols", "6", "--rows", "6",
                      "--tag-size", "0.088", "--out", "$D/out"}),

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include <algorithm>
 #include <opencv2/imgproc.hpp>
 
@@ -268,6 +270,47 @@ TEST(SequenceSimulator, DriftMovesTheRigThatMakesTheDataOnly) {
   EXPECT_NE(refused.message().find("above 10 deg"), std::string::npos)
       << refused.message();
   options.cam1_drift.rotation = Eigen::Vector3d(0.0, NAN, 0.0);
+  EXPECT_FALSE(SequenceSimulator::Create(rig, options).ok());
+}
+
+// Lenses that changed since the air calibration: the data are those of
+// the changed focal lengths (exact: the changed rig returns n to 1e-9), the
+// calibration's stay; and on it a 0.5 % longer focal length in both
+// cameras moves n by about as much (a flat port scales the paraxial focal
+// length by n).
+TEST(SequenceSimulator, LensChangeScalesTheFocalLengthsOfTheDataOnly) {
+  const StereoRig rig = NarrowFieldRig();
+  SequenceOptions options = MatchesOnly({{1.34, 20}});
+  options.lens_change.focal_scale = {0.005, 0.005};
+  std::unique_ptr<SequenceSimulator> simulator =
+      SequenceSimulator::Create(rig, options).value();
+  for (const auto& [calibrated, changed] :
+       {std::pair{&simulator->rig().left(), &simulator->true_rig().left()},
+        std::pair{&simulator->rig().right(), &simulator->true_rig().right()}}) {
+    EXPECT_EQ(changed->fx(), calibrated->fx() * 1.005);
+    EXPECT_EQ(changed->fy(), calibrated->fy() * 1.005);
+    EXPECT_EQ(changed->cx(), calibrated->cx());
+  }
+  std::vector<StereoCorrespondence> matches;
+  for (int i = 0; i < simulator->num_frames(); ++i) {
+    const SequenceFrame frame = simulator->Frame(i).value();
+    matches.insert(matches.end(), frame.matches.begin(), frame.matches.end());
+  }
+  EXPECT_NEAR(RefineRefractiveIndex(simulator->true_rig(), matches,
+                                    RefinementOptions())
+                  .value()
+                  .n,
+              1.34, 1e-9);
+  const double stale =
+      RefineRefractiveIndex(rig, matches, RefinementOptions()).value().n;
+  std::printf("0.5 %% longer focal lengths: n %.5f for 1.34\n", stale);
+  EXPECT_GT(std::abs(stale - 1.34), 0.002);
+  options.lens_change.focal_scale = {0.0, 0.06};
+  const Status refused = SequenceSimulator::Create(rig, options).status();
+  EXPECT_NE(refused.message().find("lens change of camera 1"),
+            std::string::npos)
+      << refused.message();
+  options.lens_change.focal_scale = {NAN, 0.0};
   EXPECT_FALSE(SequenceSimulator::Create(rig, options).ok());
 }
 

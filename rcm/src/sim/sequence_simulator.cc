@@ -1,5 +1,6 @@
 #include "rcm/sim/sequence_simulator.h"
 
+#include <array>
 #include <cmath>
 #include <random>
 #include <sstream>
@@ -56,6 +57,44 @@ Status ExtrinsicDrift::Check() const {
   return Status::Error(message.str());
 }
 
+Status LensChange::Check() const {
+  for (int c = 0; c < 2; ++c) {
+    if (!(std::abs(focal_scale[c]) <= kMaxRelative)) {
+      std::ostringstream message;
+      message << "lens change of camera " << c << ": a focal scale of "
+              << focal_scale[c] << " is outside [-" << kMaxRelative << ", "
+              << kMaxRelative << "]";
+      return Status::Error(message.str());
+    }
+  }
+  return Status::Ok();
+}
+
+StatusOr<StereoRig> LensChange::Apply(const StereoRig& rig) const {
+  RCM_RETURN_IF_ERROR(Check());
+  std::array<Camera, 2> cameras = {rig.left(), rig.right()};
+  for (int c = 0; c < 2; ++c) {
+    const double* params = cameras[c].params();
+    const std::array<double, 4> intrinsics = {
+        params[0] * (1.0 + focal_scale[c]), params[1] * (1.0 + focal_scale[c]),
+        params[2], params[3]};
+    const std::vector<double> distortion(params + 4,
+                                         params + cameras[c].num_params());
+    StatusOr<Camera> changed =
+        Camera::Create(cameras[c].model(), cameras[c].width(),
+                       cameras[c].height(), intrinsics, distortion);
+    if (!changed.ok()) return changed.status().WithContext("lens change");
+    cameras[c] = *std::move(changed);
+  }
+  StatusOr<StereoRig> changed =
+      StereoRig::Create(cameras[0], cameras[1], rig.right_from_left());
+  if (!changed.ok()) return changed.status().WithContext("lens change");
+  if (rig.ports()) {
+    return changed->WithPorts(rig.ports()->left, rig.ports()->right);
+  }
+  return changed;
+}
+
 Status SequenceOptions::Check() const {
   RCM_RETURN_IF_ERROR(MediaSchedule::Create(media).status());
   RCM_RETURN_IF_ERROR(left_port.Check().WithContext("left port"));
@@ -63,6 +102,7 @@ Status SequenceOptions::Check() const {
   RCM_RETURN_IF_ERROR(scene.Check());
   RCM_RETURN_IF_ERROR(render.Check());
   RCM_RETURN_IF_ERROR(cam1_drift.Check());
+  RCM_RETURN_IF_ERROR(lens_change.Check());
   if (board) {
     RCM_RETURN_IF_ERROR(board->Check());
     RCM_RETURN_IF_ERROR(board_motion.Check());
@@ -98,6 +138,11 @@ StatusOr<std::unique_ptr<SequenceSimulator>> SequenceSimulator::Create(
         options.cam1_drift.rotation, options.cam1_drift.translation);
     if (!moved.ok()) return moved.status().WithContext("extrinsic drift");
     true_rig = std::move(moved).value();
+  }
+  if (!options.lens_change.IsZero()) {
+    StatusOr<StereoRig> changed = options.lens_change.Apply(true_rig);
+    if (!changed.ok()) return changed.status();
+    true_rig = std::move(changed).value();
   }
   std::unique_ptr<SequenceSimulator> simulator(new SequenceSimulator(
       rig, true_rig, options, MediaSchedule::Create(options.media).value()));

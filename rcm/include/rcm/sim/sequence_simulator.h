@@ -11,10 +11,13 @@
 // over a controlled depth range, points at sampled depths (no images
 // then). Noise and outliers are then added as configured.
 //
-// Two things a real dive has that an in-air calibration does not know:
+// Things a real dive has that an in-air calibration does not know:
 // - extrinsic drift: the rig that renders the images and samples the
 //   matches is rig.WithCam1Moved(drift) (stereo_rig.h), while rig() stays
 //   the in-air calibration a user would have (and a writer's camchain);
+// - lenses that changed (LensChange): each camera's focal lengths scaled
+//   by 1 + s_c in that rig (a focus ring or a lens that shifted in its
+//   mount, temperature), the calibration's unchanged;
 // - a calibration board held by a diver (scene_board.h, board_motion.h):
 //   a chessboard in front of the rig, moving smoothly, kept in view of
 //   both cameras whenever possible, rendered into the images through the
@@ -69,6 +72,21 @@ struct ExtrinsicDrift {
   }
 };
 
+// How each camera's focal lengths have changed since the in-air
+// calibration: fx and fy of camera c (0 left, 1 right) become (1 + s_c) fx,
+// (1 + s_c) fy; the principal point and distortion stay.
+struct LensChange {
+  // Largest accepted change: beyond it the lens is another lens.
+  static constexpr double kMaxRelative = 0.05;
+
+  std::array<double, 2> focal_scale = {0.0, 0.0};  // s_c, |s_c| <= 0.05
+
+  Status Check() const;
+  bool IsZero() const { return focal_scale[0] == 0.0 && focal_scale[1] == 0.0; }
+  // `rig` with the change applied (ports kept; no calibration uncertainty).
+  StatusOr<StereoRig> Apply(const StereoRig& rig) const;
+};
+
 struct SequenceOptions {
   // The medium of each frame; its length is the sequence's. Default: 20
   // frames of water.
@@ -94,6 +112,7 @@ struct SequenceOptions {
   double match_max_depth = 0.0;  // meters
   // Default none: the rig is as calibrated.
   ExtrinsicDrift cam1_drift;
+  LensChange lens_change;
   // A chessboard held in front of the rig (default none), and how it
   // moves; the motion's seed is replaced by one derived from `seed`.
   std::optional<SceneBoard> board;
@@ -137,7 +156,8 @@ class SequenceSimulator {
 
   // The in-air calibration (what a user has, and what a writer writes).
   const StereoRig& rig() const { return rig_; }
-  // The rig as it is in the water: rig() with options().cam1_drift.
+  // The rig as it is in the water: rig() with options().cam1_drift and
+  // options().lens_change.
   const StereoRig& true_rig() const { return true_rig_; }
   const SequenceOptions& options() const { return options_; }
   const MediaSchedule& media() const { return media_; }
