@@ -61,6 +61,7 @@ from ._rcm import (
     closed_form_refractive_index,
     default_refinement_options,
     match_stereo,
+    medium_prior,
     read_calibration_target,
     read_correspondences,
     read_stereo_rig,
@@ -70,6 +71,7 @@ from ._rcm import (
     sample_correspondences,
     simulate,
     virtual_pinhole_maps,
+    water_refractive_index,
     write_correspondences,
     write_stereo_rig,
 )

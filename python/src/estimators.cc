@@ -469,6 +469,33 @@ on the left normalized coordinates, and the radially weighted mean (eq. 17).
 Exact on exact data of a rectified rig, biased on others, heavy-tailed with
 noise: a seed, not the estimator of record. Thin ports only.
 )doc");
+  module.def(
+      "water_refractive_index",
+      [](double salinity, double temperature, double wavelength) {
+        return ValueOrThrow(
+            WaterRefractiveIndex(salinity, temperature, wavelength));
+      },
+      py::arg("salinity"), py::arg("temperature"), py::arg("wavelength"),
+      "n of water relative to air (Quan and Fry 1995) from its salinity "
+      "(g/kg, 0-35), temperature (degrees C, 0-30) and the light's "
+      "wavelength (nm, 400-700); ValueError outside that range.");
+  module.def(
+      "medium_prior",
+      [](const std::string& text) {
+        const MediumPrior medium = ValueOrThrow(ParseMediumPrior(text));
+        py::dict d;
+        d["name"] = medium.name;
+        d["n"] = medium.n;
+        d["sigma"] = medium.sigma;
+        d["range"] = py::make_tuple(medium.min_n, medium.max_n);
+        d["description"] = medium.Describe();
+        return d;
+      },
+      py::arg("text"),
+      "The medium's prior on n ('fresh', 'sea' or 'N:SIGMA'; C++ "
+      "ParseMediumPrior) as a dict: name, n, sigma, range (min, max), "
+      "description. ValueError on anything else.");
+
   module.def("closed_form_n", &ClosedFormPerMatch, py::arg("rig"),
              py::arg("matches"),
              "n of eq. 14 for every match (float64 array, NaN where n^2 is not "

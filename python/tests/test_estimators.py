@@ -313,3 +313,21 @@ def test_too_few_matches_and_unobservable_data(realistic_rig):
     with pytest.raises(ValueError) as error:
         rcm.refine_refractive_index(rig, axis)
     one_line(error)
+
+
+def test_water_refractive_index_and_medium_prior():
+    # Pure water at 20 C and the sodium line: 1.33299 (CRC Handbook), as
+    # medium_prior_test.cc.
+    assert abs(rcm.water_refractive_index(0.0, 20.0, 589.3) - 1.33299) < 1e-4
+    with pytest.raises(ValueError) as error:
+        rcm.water_refractive_index(40.0, 20.0, 589.3)
+    assert "0-35 g/kg" in one_line(error)
+    sea = rcm.medium_prior("sea")
+    assert sea["name"] == "sea water"
+    assert sea["range"][0] < sea["n"] < sea["range"][1]
+    assert abs(sea["sigma"] - (sea["range"][1] - sea["range"][0]) / 12 ** 0.5) < 1e-15
+    assert rcm.medium_prior("1.338:0.002")["n"] == 1.338
+    with pytest.raises(ValueError) as error:
+        rcm.medium_prior("brine")
+    assert "expected fresh, sea or N:SIGMA" in one_line(error)
+
