@@ -8,6 +8,7 @@
 #include <string>
 
 #include "rcm/estimation/medium_drift.h"
+#include "rcm/io/number_format.h"
 #include "rcm/sim/stereo_sampler.h"
 #include "support/test_budget.h"
 #include "support/test_rigs.h"
@@ -61,6 +62,10 @@ TEST(MediumPrior, FreshAndSeaWater) {
   // The values docs/estimate.md and the --medium help state.
   EXPECT_EQ(fresh.Describe().substr(0, 31), "fresh water (n 1.3302-1.3404: 0");
   EXPECT_EQ(sea.Describe().substr(0, 29), "sea water (n 1.3356-1.3474: 3");
+  EXPECT_EQ(FormatFixed(fresh.n, 4) + " +- " + FormatFixed(fresh.sigma, 4),
+            "1.3353 +- 0.0029");
+  EXPECT_EQ(FormatFixed(sea.n, 4) + " +- " + FormatFixed(sea.sigma, 4),
+            "1.3415 +- 0.0034");
 }
 
 TEST(MediumPrior, ExplicitIndexAndSigma) {
