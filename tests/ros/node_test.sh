@@ -59,7 +59,19 @@ play_recording_depth() {
   rosbag record -q -O "$2" "${depth_topics[@]}" >"$2.log" 2>&1 &
   local recorder=$!
   pids+=($recorder)
-  sleep 1
+  # Played only once the recorder subscribes to every depth topic (a fixed
+  # 1 s sleep lost the first pair on a loaded machine); at most 10 s.
+  local topic subscribed
+  for _ in $(seq 1 100); do
+    subscribed=1
+    for topic in "${depth_topics[@]}"; do
+      rostopic info "$topic" 2>/dev/null | sed -n '/^Subscribers:/,$p' |
+        grep -q '/record_' || subscribed=0
+    done
+    ((subscribed)) && break
+    sleep 0.1
+  done
+  ((subscribed)) || fail "rosbag record did not subscribe to ${depth_topics[*]}"
   rosbag play -q "$1" >/dev/null 2>&1 || fail "rosbag play $1 failed"
   sleep 2
   kill -INT "$recorder"
