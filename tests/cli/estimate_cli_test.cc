@@ -268,6 +268,20 @@ TEST(EstimateCli, MediumGivesTheTurnOfAStaleNarrowRig) {
            "--frames", "10", "--n", "1.340", "--match-noise", "0.3",
            "--extrinsic-drift", "0.3,0.4,0"});
   ASSERT_EQ(simulated.exit_code, 0) << simulated.err;
+  // Without the medium (item 4 of issue 30, the drift alone): the default
+  // drift prior (0.1 degree) is 5 of its sigmas short of the turn, but the
+  // data pull the self-calibrated rotation to it; n within 3 of its sigmas
+  // (measured 1.0), and the calibration said stale.
+  const RunResult alone =
+      Rcm({"estimate", "--calib", dive + "/camchain.yaml", "--matches",
+           dive + "/matches.csv", "--json"});
+  ASSERT_EQ(alone.exit_code, 0) << alone.err;
+  const nlohmann::json own = nlohmann::json::parse(alone.out);
+  EXPECT_LT(std::abs(own["n"].get<double>() - 1.340),
+            3.0 * own["sigma_n"].get<double>());
+  EXPECT_NE(alone.err.find("the calibration is stale: cam1 has turned by"),
+            std::string::npos)
+      << alone.err;
   const RunResult result =
       Rcm({"estimate", "--calib", dive + "/camchain.yaml", "--matches",
            dive + "/matches.csv", "--medium", "sea", "--json"});
