@@ -23,6 +23,10 @@
 namespace rcm::calib {
 namespace {
 
+// The two refusals of an n on a bound (IsIndexOnBoundError).
+constexpr char kUpperBoundText[] = " ends at the upper bound of [1, 2]";
+constexpr char kLowerBoundText[] = "n ends at the lower bound 1 of [1, 2]";
+
 using internal::Corner;
 using internal::Pose;
 using internal::PoseFromRigid;
@@ -596,8 +600,8 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
 
   const auto upper_bound_error = [&] {
     return Status::Error(
-        "n = " + FormatFixed(parameters.n, 4) +
-        " ends at the upper bound of [1, 2], which is not a physical answer: "
+        "n = " + FormatFixed(parameters.n, 4) + kUpperBoundText +
+        ", which is not a physical answer: "
         "the air calibration probably does not describe these cameras under "
         "water (another rig's file, a lens refocused or zoomed since, a dome "
         "rather than a flat port), or the corners are not the target's");
@@ -757,8 +761,8 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     // in air give 1e-13 against a sigma_n of 1e-16.)
     if (step < -kMaxPullBelowAir * result.sigma_n && step < -kOnBound) {
       return Status::Error(
-          "n ends at the lower bound 1 of [1, 2] and the corners pull it "
-          "below by " +
+          std::string(kLowerBoundText) +
+          " and the corners pull it below by " +
           FormatFixed(-step / result.sigma_n, 1) +
           " sigma, which no medium does: the air calibration probably does "
           "not describe these cameras (focal lengths too long, another "
@@ -1011,6 +1015,13 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     }
   }
   return result;
+}
+
+bool IsIndexOnBoundError(const Status& status) {
+  const std::string& message = status.message();
+  return (message.rfind("n = ", 0) == 0 &&
+          message.find(kUpperBoundText) != std::string::npos) ||
+         message.rfind(kLowerBoundText, 0) == 0;
 }
 
 }  // namespace rcm::calib

@@ -275,18 +275,17 @@ StatusOr<UnderwaterModelSelection> SelectUnderwaterModel(
         candidate.fit = *std::move(result);
       } else {
         candidate.error = result.status().message();
+        candidate.on_bound = IsIndexOnBoundError(result.status());
       }
       report(k, kSteps);
     }
   });
   std::vector<UnderwaterCandidate>& candidates = selection.candidates;
-  // A candidate whose n ends on a bound of [1, 2] (CalibrateUnderwater's
-  // errors that begin "n = ..." / "n ends ...") says the air calibration
-  // does not describe these cameras: the dive is refused, whatever a
-  // richer model makes of it.
+  // A candidate whose n ends on a bound of [1, 2] (IsIndexOnBoundError)
+  // says the air calibration does not describe these cameras: the dive is
+  // refused, whatever a richer model makes of it.
   for (const UnderwaterCandidate& candidate : candidates) {
-    if (!candidate.fit && (candidate.error.rfind("n = ", 0) == 0 ||
-                           candidate.error.rfind("n ends ", 0) == 0)) {
+    if (!candidate.fit && candidate.on_bound) {
       return Status::Error(candidate.error + " (" + candidate.model.Name() +
                            ")");
     }

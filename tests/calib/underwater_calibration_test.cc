@@ -653,10 +653,16 @@ TEST(UnderwaterCalibration, NAtABoundIsAnError) {
   };
   for (const auto& c : cases) {
     const Dive dive = ThinPortDive(AlphasenseFrontUnrectifiedRig(), c.n, 8);
-    EXPECT_THAT(Calibrate(dive, Lean()).status().message(),
-                ::testing::StartsWith(c.message))
+    const Status status = Calibrate(dive, Lean()).status();
+    EXPECT_THAT(status.message(), ::testing::StartsWith(c.message))
         << "n " << c.n;
+    // The refusal is recognized as such (the model selection refuses the
+    // dive on it); other errors are not.
+    EXPECT_TRUE(IsIndexOnBoundError(status)) << "n " << c.n;
   }
+  EXPECT_FALSE(IsIndexOnBoundError(Status::Error(
+      "too few views: 2 views show the target to both cameras")));
+  EXPECT_FALSE(IsIndexOnBoundError(Status::Ok()));
 }
 
 TEST(UnderwaterCalibration, AirIsAnAnswer) {

@@ -340,6 +340,12 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     const StereoRig& air_rig, const UnderwaterCalibrationOptions& options = {},
     const std::function<void(int, int)>& progress = nullptr);
 
+// Whether `status` is CalibrateUnderwater's refusal of an n that ends on a
+// bound of [1, 2] (the upper bound, or the lower one with the corners
+// pulling below it): the air calibration does not describe the cameras,
+// which no richer model of the water mends.
+bool IsIndexOnBoundError(const Status& status);
+
 }  // namespace rcm::calib
 
 #endif  // RCM_CALIB_UNDERWATER_CALIBRATION_H_

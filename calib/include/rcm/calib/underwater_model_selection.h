@@ -116,6 +116,8 @@ struct UnderwaterCandidate {
   // The fit, or why it failed.
   std::optional<UnderwaterCalibration> fit;
   std::string error;
+  // The failure was n on a bound of [1, 2] (IsIndexOnBoundError).
+  bool on_bound = false;
   // The noise sigma of its n (header).
   double sigma_n_noise = 0.0;
   // Evidence (header): held-out RMS [px] over the common views, and the
