@@ -390,12 +390,7 @@ int RunCalibrateUnderwater(const Subcommand& command,
   if (*medium) {
     const MediumCheck check =
         CheckAgainstMedium(selection->n, selection->sigma_n, **medium);
-    medium_json = {{"name", (*medium)->name},
-                   {"n", (*medium)->n},
-                   {"sigma", (*medium)->sigma},
-                   {"range", {(*medium)->min_n, (*medium)->max_n}},
-                   {"z", check.z},
-                   {"contradicts", check.contradicts}};
+    medium_json = MediumJson(**medium, check);
     if (check.contradicts) {
       warnings.push_back(check.message +
                          ": the air calibration may not describe the lenses "

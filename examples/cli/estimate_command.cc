@@ -1116,12 +1116,7 @@ int RunEstimate() {
     const MediumPrior& water = **medium;
     const MediumCheck check =
         CheckAgainstMedium(report->n, report->sigma_n, water);
-    medium_json = {{"name", water.name},
-                   {"n", water.n},
-                   {"sigma", water.sigma},
-                   {"range", {water.min_n, water.max_n}},
-                   {"z", check.z},
-                   {"contradicts", check.contradicts}};
+    medium_json = MediumJson(water, check);
     medium_lines.push_back("  medium     " + water.Describe() + ": n is " +
                            FormatFixed(check.z, 1) + " sigma from it");
     if (check.contradicts) {

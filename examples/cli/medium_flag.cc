@@ -21,4 +21,13 @@ StatusOr<std::optional<MediumPrior>> MediumFromFlag() {
   return std::optional<MediumPrior>(*medium);
 }
 
+nlohmann::json MediumJson(const MediumPrior& medium, const MediumCheck& check) {
+  return {{"name", medium.name},
+          {"n", medium.n},
+          {"sigma", medium.sigma},
+          {"range", {medium.min_n, medium.max_n}},
+          {"z", check.z},
+          {"contradicts", check.contradicts}};
+}
+
 }  // namespace rcm::cli

@@ -7,6 +7,7 @@
 
 #include <gflags/gflags.h>
 
+#include <nlohmann/json.hpp>
 #include <optional>
 
 #include "rcm/estimation/medium_prior.h"
@@ -21,6 +22,9 @@ extern const char kMediumFlagSource[];
 
 // The parsed --medium (nullopt when not given), or "--medium: ..." .
 StatusOr<std::optional<MediumPrior>> MediumFromFlag();
+
+// The JSON's "medium": the medium and an estimate's check against it.
+nlohmann::json MediumJson(const MediumPrior& medium, const MediumCheck& check);
 
 }  // namespace rcm::cli
 
