@@ -72,6 +72,17 @@ play_recording_depth() {
     sleep 0.1
   done
   ((subscribed)) || fail "rosbag record did not subscribe to ${depth_topics[*]}"
+  # ... and stereo_image_proc, which subscribes lazily, to the node's pair.
+  for _ in $(seq 1 100); do
+    subscribed=1
+    for topic in /stereo/rcm/left/image_rect /stereo/rcm/right/image_rect; do
+      rostopic info "$topic" 2>/dev/null | sed -n '/^Subscribers:/,$p' |
+        grep -q 'stereo_image_proc' || subscribed=0
+    done
+    ((subscribed)) && break
+    sleep 0.1
+  done
+  ((subscribed)) || fail "stereo_image_proc did not subscribe to the node's rectified pair"
   rosbag play -q "$1" >/dev/null 2>&1 || fail "rosbag play $1 failed"
   sleep 2
   kill -INT "$recorder"
@@ -175,13 +186,17 @@ echo "node_test: ~hold, ~reset answered; ~reset to n = 7: $(grep message "$work/
 
 # Ignoring the water: n held at 1 (~reset to 1, ~hold still on), the water
 # pairs again; stereo_image_proc's depth is then off by more than 20 %.
+# The bag starts two water pairs before the checked ones: the first pair of
+# a playback can be lost while stereo_image_proc (which subscribes to the
+# node only once its own output has a subscriber) connects (CI lost frame 8
+# of a bag that began with it).
 timeout 10 rosservice call /stereo/rcm/reset "n: 1.0" >"$work/reset_air.txt" 2>&1 ||
   fail "~reset to n = 1 did not answer: $(cat "$work/reset_air.txt")"
 "$python" "$(dirname "$0")/write_stereo_bag.py" "$work/sim" "$work/water.bag" \
-  --rate 4 --t0 1900 --frames 8:16 >/dev/null
+  --rate 4 --t0 1900 --frames 6:16 >/dev/null
 play_recording_depth "$work/water.bag" "$work/depth_n1.bag"
 "$python" "$(dirname "$0")/check_depth.py" "$work/depth_n1.bag" "$work/sim" \
-  --t0 1900 --rate 4 --first 8 --frames 8:16 --off-by-more-than 0.2 \
+  --t0 1900 --rate 4 --first 6 --frames 8:16 --off-by-more-than 0.2 \
   --label "n held at 1: " || fail "depth with n = 1 not off by more than 20 %"
 
 # A stale calibration: a narrow rig (rcm simulate --rig narrow, 6 pairs in
