@@ -949,6 +949,11 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
   if (!lens_steps.empty()) {
     double sum = 0.0;
     int failed = 0;
+    const int left_size = cameras[0]->num_params();
+    const int lens_size = left_size + cameras[1]->num_params();
+    Eigen::MatrixXd extrinsics_lens = Eigen::MatrixXd::Zero(6, lens_size);
+    Eigen::Matrix<double, 6, 6> extrinsics_from_lenses =
+        Eigen::Matrix<double, 6, 6>::Zero();
     for (size_t i = 0; i < lens_steps.size(); ++i) {
       const LensPerturbation& step = lens_steps[i];
       Model perturbed = model;
@@ -963,6 +968,15 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
       ceres::Solve(solver_options, &refit_problem, &summary);
       if (summary.IsSolutionUsable() && std::isfinite(refit.n)) {
         sum += (refit.n - parameters.n) * (refit.n - parameters.n);
+        if (free.extrinsics) {
+          // The extrinsics' move with the lens, about the solution.
+          const Eigen::Matrix<double, 6, 1> moved = ChangeFromAir(
+              water_extrinsics, RigidFromPose(refit.cam1_from_cam0.data()));
+          extrinsics_lens.block(0, step.camera == 0 ? 0 : left_size, 6,
+                                step.delta.size()) +=
+              moved * step.delta.transpose();
+          extrinsics_from_lenses += moved * moved.transpose();
+        }
       } else {
         ++failed;
       }
@@ -972,6 +986,10 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     }
     if (failed == 0) {
       result.sigma_n_lenses = std::sqrt(sum);
+      if (free.extrinsics) {
+        result.extrinsics_lens_covariance = extrinsics_lens;
+        result.extrinsics_covariance_from_lenses = extrinsics_from_lenses;
+      }
     } else {
       result.notes.push_back("lens uncertainty: " + std::to_string(failed) +
                              " of " + std::to_string(lens_steps.size()) +

@@ -332,6 +332,10 @@ StatusOr<UnderwaterModelSelection> SelectUnderwaterModel(
         });
     if (lenses.ok()) {
       chosen.fit->sigma_n_lenses = lenses->sigma_n_lenses;
+      chosen.fit->extrinsics_lens_covariance =
+          lenses->extrinsics_lens_covariance;
+      chosen.fit->extrinsics_covariance_from_lenses =
+          lenses->extrinsics_covariance_from_lenses;
       for (const std::string& note : lenses->notes) {
         if (note.rfind("lens uncertainty", 0) == 0) {
           chosen.fit->notes.push_back(note);

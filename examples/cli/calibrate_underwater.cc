@@ -100,8 +100,11 @@ double ExtrinsicsLeaveOutScale(const calib::ExtrinsicChange& change) {
 // The sidecar of an underwater calibration: medium water, no drift prior
 // (the extrinsics were measured in this dive), the extrinsics' covariance
 // of the bundle adjustment (scaled by the leave-out spread), the lenses'
-// from the air calibration's sidecar when it had one. One camera: the air
-// calibration's extrinsics and their uncertainty are kept.
+// from the air calibration's sidecar when it had one, and then the
+// extrinsics' correlation with the lenses and the lenses' share of the
+// extrinsics' covariance (UnderwaterCalibration::extrinsics_lens_
+// covariance). One camera: the air calibration's extrinsics and their
+// uncertainty are kept.
 CalibrationCovarianceFile UnderwaterCovarianceFile(
     const UnderwaterCalibration& result, const StereoRig& air_rig) {
   CalibrationCovarianceFile file;
@@ -119,6 +122,19 @@ CalibrationCovarianceFile UnderwaterCovarianceFile(
     const double scale = ExtrinsicsLeaveOutScale(result.extrinsic_change);
     file.cameras[1].from_previous_covariance =
         scale * scale * result.extrinsic_change.covariance;
+    // The extrinsics were fitted through the air lenses: their covariance
+    // with the lenses, and the lenses' share of their own.
+    const int lens_size = static_cast<int>(
+        file.cameras[0].intrinsics_covariance.rows() +
+        file.cameras[1].intrinsics_covariance.rows());
+    if (file.cameras[0].intrinsics_covariance.size() > 0 &&
+        file.cameras[1].intrinsics_covariance.size() > 0 &&
+        result.extrinsics_lens_covariance.cols() == lens_size) {
+      *file.cameras[1].from_previous_covariance +=
+          result.extrinsics_covariance_from_lenses;
+      file.cameras[1].from_previous_intrinsics_covariance =
+          result.extrinsics_lens_covariance;
+    }
   }
   return file;
 }

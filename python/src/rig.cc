@@ -89,6 +89,7 @@ py::object UncertaintyDict(const StereoRig& rig) {
   result["extrinsics_covariance"] = ToNumpy(u.extrinsics_covariance);
   result["left_lens_covariance"] = ToNumpy(u.left_lens_covariance);
   result["right_lens_covariance"] = ToNumpy(u.right_lens_covariance);
+  result["extrinsics_lens_covariance"] = ToNumpy(u.extrinsics_lens_covariance);
   return std::move(result);
 }
 
@@ -209,7 +210,9 @@ exact); one read from a file carries the default drift prior (0.1 degree,
       .def_property_readonly("calibration_uncertainty", &UncertaintyDict,
                              "dict(source, extrinsics_covariance (6x6, [w; dt] "
                              "in rad and m), left_lens_covariance, "
-                             "right_lens_covariance) or None (exact).")
+                             "right_lens_covariance, "
+                             "extrinsics_lens_covariance (6 x (p_l + p_r), "
+                             "empty when uncorrelated)) or None (exact).")
       .def(
           "with_ports",
           [](const StereoRig& r, const FlatPort& left, const FlatPort& right) {

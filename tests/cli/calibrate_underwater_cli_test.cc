@@ -14,7 +14,9 @@
 #include <vector>
 
 #include "cli/cli_runner.h"
+#include "rcm/io/calibration_covariance_file.h"
 #include "rcm/io/camchain.h"
+#include "rcm/io/stereo_rig_file.h"
 #include "support/temp_file.h"
 #include "support/test_budget.h"
 
@@ -112,7 +114,8 @@ RunResult Estimate(const std::string& dive, const std::string& calib) {
 // view). The drift comes back within 0.005 degrees per axis.
 void ExpectUnderwaterCalibrationRecoversTheDive(const nlohmann::json& json,
                                                 const std::string& air,
-                                                const std::string& water) {
+                                                const std::string& water,
+                                                bool air_sidecar = false) {
   const double error = json["n"].get<double>() - kTrueN;
   const double leave_out = json["sigma_n_leave_out"].get<double>();
   std::printf("underwater: n %.5f +- %.5f (leave-out %.5f), error %.5f; "
@@ -121,7 +124,8 @@ void ExpectUnderwaterCalibrationRecoversTheDive(const nlohmann::json& json,
               leave_out, error, json["extrinsic_change_deg"].get<double>());
   // The candidate models (calib/underwater_model_selection.h): all eight
   // fitted, one chosen, sigma_n the root sum of squares of its parts, and
-  // the lenses' part 0 (the simulated air camchain has no sidecar).
+  // the lenses' part 0 unless the air camchain was given a sidecar (the
+  // simulated one has none).
   const nlohmann::json& candidates = json["candidates"];
   ASSERT_EQ(candidates.size(), 8u);
   int chosen = 0;
@@ -134,10 +138,16 @@ void ExpectUnderwaterCalibrationRecoversTheDive(const nlohmann::json& json,
     }
   }
   EXPECT_EQ(chosen, 1);
-  EXPECT_EQ(json["sigma_n_lenses"].get<double>(), 0.0);
+  const double lenses = json["sigma_n_lenses"].get<double>();
+  if (air_sidecar) {
+    EXPECT_GT(lenses, 0.0);
+  } else {
+    EXPECT_EQ(lenses, 0.0);
+  }
   EXPECT_NEAR(json["sigma_n"].get<double>(),
-              std::hypot(json["sigma_n_noise"].get<double>(),
-                         json["sigma_n_model"].get<double>()),
+              std::sqrt(std::pow(json["sigma_n_noise"].get<double>(), 2) +
+                        lenses * lenses +
+                        std::pow(json["sigma_n_model"].get<double>(), 2)),
               1e-15);
   if (test::ChecksStatistics()) {
     EXPECT_LE(std::abs(error), 3.0 * json["sigma_n"].get<double>());
@@ -197,15 +207,51 @@ void ExpectRefusedOrCovered(const RunResult& result, const char* what) {
 TEST(UnderwaterCli, NarrowRigThatDriftedHalfADegree) {
   const std::string dive = Folder("dive");
   Simulate(dive, DriftedDive("narrow", 0.03));
+  // The air calibration's sidecar, as rcm calibrate writes one: lens
+  // covariances of the size 30 air views give (0.3 px on the focal lengths
+  // and principal point, 1e-3 on k1, k2, 1e-4 on the rest), the drift prior
+  // 0.1 degree, 0.1 mm.
+  {
+    const StereoRig air = ReadStereoRig(dive + "/camchain.yaml").value();
+    CalibrationCovarianceFile sidecar;
+    sidecar.drift_rotation_sigma = 0.1 * M_PI / 180.0;
+    sidecar.drift_translation_sigma = 1e-4;
+    sidecar.cameras.resize(2);
+    for (int c = 0; c < 2; ++c) {
+      const int size = (c == 0 ? air.left() : air.right()).num_params();
+      Eigen::MatrixXd lens = Eigen::MatrixXd::Zero(size, size);
+      for (int i = 0; i < size; ++i) {
+        const double sigma = i < 4 ? 0.3 : (i < 6 ? 1e-3 : 1e-4);
+        lens(i, i) = sigma * sigma;
+      }
+      sidecar.cameras[c].intrinsics_covariance = lens;
+    }
+    sidecar.cameras[1].from_previous_covariance =
+        Eigen::Matrix<double, 6, 6>::Zero();
+    ASSERT_TRUE(WriteCalibrationCovariance(
+                    CovarianceSidecarPath(dive + "/camchain.yaml"), sidecar)
+                    .ok());
+  }
   const std::string water = Folder("water");
   const nlohmann::json json =
       Json(CalibrateUnderwater(dive, water, 0.03, Folds()));
   ExpectUnderwaterCalibrationRecoversTheDive(json, dive + "/camchain.yaml",
-                                             water + "/camchain.yaml");
+                                             water + "/camchain.yaml",
+                                             /*air_sidecar=*/true);
   if (test::ChecksStatistics()) {
     EXPECT_LE(std::abs(json["n"].get<double>() - kTrueN), 2e-3);
   }
-  EXPECT_TRUE(fs::exists(water + "/camchain-covariance.yaml"));
+  // The water sidecar: the extrinsics' correlation with the air lenses
+  // they were fitted through, which the water camchain's reader takes.
+  const std::string water_sidecar = water + "/camchain-covariance.yaml";
+  const CalibrationCovarianceFile written =
+      ReadCalibrationCovariance(water_sidecar).value();
+  EXPECT_EQ(written.medium, "water");
+  EXPECT_EQ(written.cameras[1].from_previous_intrinsics_covariance.rows(), 6);
+  const StereoRig water_rig = ReadStereoRig(water + "/camchain.yaml").value();
+  ASSERT_TRUE(water_rig.calibration_uncertainty().has_value());
+  EXPECT_EQ(water_rig.calibration_uncertainty()->extrinsics_lens_covariance,
+            written.cameras[1].from_previous_intrinsics_covariance);
   for (const char* file : {"residuals_cam0.png", "residuals_cam1.png",
                            "coverage_cam0.png", "coverage_cam1.png",
                            "per_view_rms.png", "per_view.csv",

@@ -34,5 +34,41 @@ TEST(CalibrationUncertainty, DriftPriorAndChecks) {
   EXPECT_THAT(bad.Check(8, 4).message(), HasSubstr("not finite"));
 }
 
+// The extrinsics' correlation with the lenses: JointCovariance places the
+// blocks, and Check requires both lenses, the 6 x (p_l + p_r) shape and a
+// positive semi-definite joint matrix.
+TEST(CalibrationUncertainty, ExtrinsicsLensCorrelation) {
+  Eigen::MatrixXd root(8, 8);
+  for (int r = 0; r < 8; ++r) {
+    for (int c = 0; c < 8; ++c) root(r, c) = std::sin(1.3 * r + 0.7 * c * c);
+  }
+  const Eigen::MatrixXd full = root * root.transpose();  // [w; dt; 1; 1]
+  CalibrationUncertainty joint;
+  joint.extrinsics_covariance = full.topLeftCorner<6, 6>();
+  joint.left_lens_covariance = full.block(6, 6, 1, 1);
+  joint.right_lens_covariance = full.block(7, 7, 1, 1);
+  joint.extrinsics_lens_covariance = full.block(0, 6, 6, 2);
+  // (The lens-lens block is zero in the joint matrix: a correlation
+  // between the two lenses is not represented.)
+  Eigen::MatrixXd expected = full;
+  expected(6, 7) = expected(7, 6) = 0.0;
+  EXPECT_EQ(joint.JointCovariance(), expected);
+  joint.left_lens_covariance(0, 0) += 10.0;  // keeps it positive definite
+  joint.right_lens_covariance(0, 0) += 10.0;
+  EXPECT_TRUE(joint.Check(1, 1).ok()) << joint.Check(1, 1).message();
+
+  CalibrationUncertainty bad = joint;
+  bad.extrinsics_lens_covariance *= 1e3;
+  EXPECT_THAT(bad.Check(1, 1).message(),
+              HasSubstr("joint cam1_from_cam0 and lens covariance is not "
+                        "positive semi-definite"));
+  bad = joint;
+  bad.extrinsics_lens_covariance.conservativeResize(6, 1);
+  EXPECT_THAT(bad.Check(1, 1).message(), HasSubstr("is 6x1, not 6x2"));
+  bad = joint;
+  bad.right_lens_covariance.resize(0, 0);
+  EXPECT_THAT(bad.Check(1, 1).message(), HasSubstr("needs both lens"));
+}
+
 }  // namespace
 }  // namespace rcm

@@ -137,6 +137,62 @@ TEST(CalibrationCovarianceFile, BadFilesGiveOneLineErrors) {
   EXPECT_TRUE(ParseCalibrationCovariance(good, "side.yaml").ok());
 }
 
+// An underwater calibration's sidecar: the extrinsics' cross-covariance
+// with both lenses reads back bit for bit and reaches the pair's
+// uncertainty; one that cannot belong to a covariance is an error.
+TEST(CalibrationCovarianceFile, ExtrinsicsLensCrossCovariance) {
+  const Eigen::MatrixXd full = Covariance(22, 1e-3, 4);  // [w; dt; 8; 8]
+  CalibrationCovarianceFile file = SampleFile();
+  file.cameras[1].from_previous_covariance = full.topLeftCorner<6, 6>();
+  file.cameras[0].intrinsics_covariance = full.block(6, 6, 8, 8);
+  file.cameras[1].intrinsics_covariance = full.block(14, 14, 8, 8);
+  // The lens-lens block is left out of the file: keep the rest positive
+  // definite by a margin.
+  file.cameras[0].intrinsics_covariance += Eigen::MatrixXd::Identity(8, 8);
+  file.cameras[1].intrinsics_covariance += Eigen::MatrixXd::Identity(8, 8);
+  file.cameras[1].from_previous_intrinsics_covariance = full.block(0, 6, 6, 16);
+  const std::string text = FormatCalibrationCovariance(file);
+  EXPECT_THAT(text, HasSubstr("T_cn_cnm1_intrinsics_covariance:"));
+  const CalibrationCovarianceFile read =
+      ParseCalibrationCovariance(text, "c.yaml").value();
+  EXPECT_EQ(read.cameras[1].from_previous_intrinsics_covariance,
+            file.cameras[1].from_previous_intrinsics_covariance);
+  EXPECT_EQ(read.cameras[0].from_previous_intrinsics_covariance.size(), 0);
+  EXPECT_EQ(FormatCalibrationCovariance(read), text);
+  const CalibrationUncertainty pair =
+      PairCalibrationUncertainty(read, 0, 1, "c.yaml").value();
+  EXPECT_EQ(pair.extrinsics_lens_covariance,
+            file.cameras[1].from_previous_intrinsics_covariance);
+  EXPECT_TRUE(pair.Check(8, 8).ok());
+
+  const auto error = [](CalibrationCovarianceFile bad) {
+    return ParseCalibrationCovariance(FormatCalibrationCovariance(bad),
+                                      "side.yaml")
+        .status()
+        .message();
+  };
+  CalibrationCovarianceFile bad = file;
+  bad.cameras[1].from_previous_intrinsics_covariance *= 1e4;
+  EXPECT_THAT(error(bad), HasSubstr("not positive semi-definite"));
+  bad = file;
+  bad.cameras[1].from_previous_intrinsics_covariance.conservativeResize(6, 15);
+  EXPECT_THAT(error(bad), HasSubstr("is 6x15, not 6x16"));
+  bad = file;
+  bad.cameras[0].intrinsics_covariance.resize(0, 0);
+  EXPECT_THAT(error(bad), HasSubstr("needs T_cn_cnm1_covariance and both"));
+  const std::string rows =
+      "medium: water\ncam0: {}\ncam1:\n  T_cn_cnm1_intrinsics_covariance:\n"
+      "  - [1, 2]\n";
+  EXPECT_THAT(ParseCalibrationCovariance(rows, "side.yaml").status().message(),
+              HasSubstr("expected 6 rows"));
+  const std::string ragged =
+      "medium: water\ncam0: {}\ncam1:\n  T_cn_cnm1_intrinsics_covariance:\n"
+      "  - [1, 2]\n  - [1]\n  - [1]\n  - [1]\n  - [1]\n  - [1]\n";
+  EXPECT_THAT(
+      ParseCalibrationCovariance(ragged, "side.yaml").status().message(),
+      HasSubstr("expected 2 numbers, got 1"));
+}
+
 // ReadStereoRig attaches the sidecar when there is one, and the default
 // drift prior otherwise; a camera count that differs from the camchain's,
 // or a lens covariance of the wrong size, is an error naming the sidecar.

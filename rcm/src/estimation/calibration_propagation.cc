@@ -398,6 +398,17 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
                       layout.num_right_lens, layout.num_right_lens) =
         uncertainty.right_lens_covariance;
   }
+  // The extrinsics' correlation with the lenses (an underwater
+  // calibration's), when both lenses have columns.
+  const int num_lens = layout.num_left_lens + layout.num_right_lens;
+  if (layout.num_left_lens > 0 && layout.num_right_lens > 0 &&
+      uncertainty.extrinsics_lens_covariance.rows() == 6 &&
+      uncertainty.extrinsics_lens_covariance.cols() == num_lens) {
+    calibration.block(1, layout.LeftLens(), 6, num_lens) =
+        uncertainty.extrinsics_lens_covariance;
+    calibration.block(layout.LeftLens(), 1, num_lens, 6) =
+        uncertainty.extrinsics_lens_covariance.transpose();
+  }
   for (int k = 0; k < layout.NumSystematic(); ++k) {
     calibration(layout.Systematic() + k, layout.Systematic() + k) =
         layout.systematic_px * layout.systematic_px;
@@ -446,6 +457,16 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
   for (int r = 0; r < np; ++r) {
     for (int c = 0; c < np; ++c) sigma_p(r, c) = calibration(held[r], held[c]);
   }
+  // With the rotation estimated under its prior, the prior's deviation
+  // and the held parameters are jointly distributed: Sigma_pw, the held
+  // columns' covariance with w (zero unless the extrinsics are correlated
+  // with the lenses).
+  Eigen::MatrixXd sigma_pw = Eigen::MatrixXd::Zero(np, 3);
+  if (rotation_estimated) {
+    for (int r = 0; r < np; ++r) {
+      for (int k = 0; k < 3; ++k) sigma_pw(r, k) = calibration(held[r], 1 + k);
+    }
+  }
   Eigen::MatrixXd prior = Eigen::MatrixXd::Zero(nx, nx);
   if (mode == RotationMode::kPrior) {
     const Eigen::Matrix3d rotation_covariance = uncertainty.RotationCovariance();
@@ -475,12 +496,28 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
   const Eigen::MatrixXd from_n_prior =
       variance * variance * h_inverse * n_prior * h_inverse;
   const Eigen::MatrixXd s = h_inverse * b;
-  const Eigen::MatrixXd from_held = s * sigma_p * s.transpose();
+  // The estimate's error is H'^-1 (B dp - sigma^2 P_w dw) for held
+  // parameters off by dp and a rotation off its prior by dw (P_w the
+  // rotation prior's rows of x), so beside the two independent shares
+  //   from_held  = S Sigma_p S^T,   from_prior = sigma^4 H'^-1 P H'^-1,
+  // their correlation adds
+  //   cross = -sigma^2 (S Sigma_pw P_w^T H'^-1 + its transpose).
+  Eigen::MatrixXd cross = Eigen::MatrixXd::Zero(nx, nx);
+  if (mode == RotationMode::kPrior && !sigma_pw.isZero(0.0)) {
+    const Eigen::MatrixXd p_w = prior.rightCols(3);  // x = (n, w)
+    const Eigen::MatrixXd half =
+        -variance * s * sigma_pw * p_w.transpose() * h_inverse;
+    cross = half + half.transpose();
+  }
+  const Eigen::MatrixXd from_held = s * sigma_p * s.transpose() + cross;
 
   // The held parameters' share, split by kind for the report: rotation
   // (when held), translation, lenses; cross-covariances between kinds (a
   // measured covariance of rotation with translation) go with the
-  // translation.
+  // translation, except the lenses' with the extrinsics, which go with the
+  // lenses (so that the lenses' share is what they add with their
+  // correlation, negative when the extrinsics fitted through them cancel
+  // more than they add).
   const int systematic = layout.Systematic();
   const auto group_of = [systematic](int column) {
     return column <= 3 ? 0 : column <= 6 ? 1 : column < systematic ? 2 : 3;
@@ -490,13 +527,17 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
     Eigen::MatrixXd part = Eigen::MatrixXd::Zero(np, np);
     for (int r = 0; r < np; ++r) {
       for (int c = 0; c < np; ++c) {
-        if (group_of(held[r]) == g && group_of(held[c]) == g) {
+        const int gr = group_of(held[r]);
+        const int gc = group_of(held[c]);
+        if ((gr == g && gc == g) ||
+            (g == 2 && (gr == 2) != (gc == 2) && gr < 3 && gc < 3)) {
           part(r, c) = sigma_p(r, c);
         }
       }
     }
     shares[g] = (s.row(0) * part * s.row(0).transpose())(0, 0);
   }
+  shares[2] += cross(0, 0);
   result.variance_rotation = shares[0];
   result.variance_lenses = shares[2];
   result.variance_systematic = shares[3];

@@ -72,6 +72,23 @@ bool CalibrationUncertainty::IsZero() const {
           right_lens_covariance.isZero(0.0));
 }
 
+Eigen::MatrixXd CalibrationUncertainty::JointCovariance() const {
+  const int left = static_cast<int>(left_lens_covariance.rows());
+  const int right = static_cast<int>(right_lens_covariance.rows());
+  Eigen::MatrixXd joint = Eigen::MatrixXd::Zero(6 + left + right, 6 + left + right);
+  joint.topLeftCorner<6, 6>() = extrinsics_covariance;
+  if (left > 0) joint.block(6, 6, left, left) = left_lens_covariance;
+  if (right > 0) {
+    joint.block(6 + left, 6 + left, right, right) = right_lens_covariance;
+  }
+  if (extrinsics_lens_covariance.rows() == 6 &&
+      extrinsics_lens_covariance.cols() == left + right) {
+    joint.block(0, 6, 6, left + right) = extrinsics_lens_covariance;
+    joint.block(6, 0, left + right, 6) = extrinsics_lens_covariance.transpose();
+  }
+  return joint;
+}
+
 Status CalibrationUncertainty::Check(int left_num_params,
                                      int right_num_params) const {
   RCM_RETURN_IF_ERROR(
@@ -92,7 +109,22 @@ Status CalibrationUncertainty::Check(int left_num_params,
     }
     RCM_RETURN_IF_ERROR(CheckCovarianceMatrix(*lenses[c], name));
   }
-  return Status::Ok();
+  if (extrinsics_lens_covariance.size() == 0) return Status::Ok();
+  if (left_lens_covariance.size() == 0 || right_lens_covariance.size() == 0) {
+    return Status::Error(
+        "cam1_from_cam0-lens cross-covariance needs both lens covariances");
+  }
+  if (extrinsics_lens_covariance.rows() != 6 ||
+      extrinsics_lens_covariance.cols() != left_num_params + right_num_params) {
+    std::ostringstream message;
+    message << "cam1_from_cam0-lens cross-covariance is "
+            << extrinsics_lens_covariance.rows() << "x"
+            << extrinsics_lens_covariance.cols() << ", not 6x"
+            << left_num_params + right_num_params;
+    return Status::Error(message.str());
+  }
+  return CheckCovarianceMatrix(JointCovariance(),
+                               "joint cam1_from_cam0 and lens covariance");
 }
 
 }  // namespace rcm

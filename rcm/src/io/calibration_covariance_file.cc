@@ -46,6 +46,33 @@ StatusOr<Eigen::MatrixXd> ReadCovariance(const YamlReader& reader,
   return matrix;
 }
 
+// A 6-row matrix of any (equal) row length: a cross-covariance.
+StatusOr<Eigen::MatrixXd> ReadCrossCovariance(const YamlReader& reader,
+                                              const YAML::Node& node,
+                                              const std::string& field) {
+  if (!node.IsSequence() || node.size() != 6) {
+    return reader.Error(node, field,
+                        "expected 6 rows (of [w; dt]), got " +
+                            DescribeYamlNode(node));
+  }
+  Eigen::MatrixXd matrix;
+  for (int r = 0; r < 6; ++r) {
+    const std::string row_field = field + " row " + std::to_string(r + 1);
+    const StatusOr<std::vector<double>> row =
+        r == 0 ? reader.NumberList(node[r], row_field)
+               : reader.NumberList(node[r], row_field,
+                                   static_cast<int>(matrix.cols()));
+    if (!row.ok()) return row.status();
+    if (r == 0) {
+      if (row->empty()) return reader.Error(node[r], row_field, "is empty");
+      matrix.resize(6, static_cast<Eigen::Index>(row->size()));
+    }
+    for (size_t c = 0; c < row->size(); ++c) matrix(r, c) = (*row)[c];
+  }
+  if (!matrix.allFinite()) return reader.Error(node, field, "is not finite");
+  return matrix;
+}
+
 StatusOr<CalibrationCovarianceFile> ReadDocument(const YamlReader& reader,
                                                  const YAML::Node& root) {
   const StatusOr<YamlEntries> entries =
@@ -99,6 +126,7 @@ StatusOr<CalibrationCovarianceFile> ReadDocument(const YamlReader& reader,
     }
   }
   file.cameras.resize(num_cameras);
+  std::vector<YAML::Node> cross_nodes(num_cameras);
   for (int k = 0; k < num_cameras; ++k) {
     const std::string name = "cam" + std::to_string(k);
     const YamlEntry* camera = FindYamlEntry(*entries, name);
@@ -120,23 +148,52 @@ StatusOr<CalibrationCovarianceFile> ReadDocument(const YamlReader& reader,
             ReadCovariance(reader, entry.value, field, 6);
         if (!matrix.ok()) return matrix.status();
         file.cameras[k].from_previous_covariance = *matrix;
+      } else if (key == "T_cn_cnm1_intrinsics_covariance" && k > 0) {
+        StatusOr<Eigen::MatrixXd> matrix =
+            ReadCrossCovariance(reader, entry.value, field);
+        if (!matrix.ok()) return matrix.status();
+        file.cameras[k].from_previous_intrinsics_covariance =
+            std::move(matrix).value();
+        cross_nodes[k] = entry.value;
       } else {
         return reader.Error(entry.key, field,
                             k == 0 ? "unknown key (cam0 has "
                                      "intrinsics_covariance)"
                                    : "unknown key (expected "
                                      "intrinsics_covariance, "
-                                     "T_cn_cnm1_covariance)");
+                                     "T_cn_cnm1_covariance, "
+                                     "T_cn_cnm1_intrinsics_covariance)");
       }
     }
+  }
+  // The cross-covariances against the blocks they join.
+  for (int k = 1; k < num_cameras; ++k) {
+    const CalibrationCovarianceFile::Camera& camera = file.cameras[k];
+    if (camera.from_previous_intrinsics_covariance.size() == 0) continue;
+    const std::string field =
+        "cam" + std::to_string(k) + ".T_cn_cnm1_intrinsics_covariance";
+    const YAML::Node& node = cross_nodes[k];
+    const Eigen::MatrixXd& previous = file.cameras[k - 1].intrinsics_covariance;
+    if (!camera.from_previous_covariance || previous.size() == 0 ||
+        camera.intrinsics_covariance.size() == 0) {
+      return reader.Error(node, field,
+                          "needs T_cn_cnm1_covariance and both cameras' "
+                          "intrinsics_covariance");
+    }
+    CalibrationUncertainty joint;
+    joint.extrinsics_covariance = *camera.from_previous_covariance;
+    joint.left_lens_covariance = previous;
+    joint.right_lens_covariance = camera.intrinsics_covariance;
+    joint.extrinsics_lens_covariance = camera.from_previous_intrinsics_covariance;
+    const Status valid = joint.Check(static_cast<int>(previous.rows()),
+                                     static_cast<int>(
+                                         camera.intrinsics_covariance.rows()));
+    if (!valid.ok()) return reader.Error(node, field, valid.message());
   }
   return file;
 }
 
-// The rows of (M + M^T) / 2: a covariance computed as J C J^T is
-// symmetric only to rounding, and the file should be exactly.
-void AppendMatrix(const Eigen::MatrixXd& given, std::ostringstream* out) {
-  const Eigen::MatrixXd matrix = 0.5 * (given + given.transpose());
+void AppendRows(const Eigen::MatrixXd& matrix, std::ostringstream* out) {
   for (int r = 0; r < matrix.rows(); ++r) {
     *out << "    - [";
     for (int c = 0; c < matrix.cols(); ++c) {
@@ -144,6 +201,12 @@ void AppendMatrix(const Eigen::MatrixXd& given, std::ostringstream* out) {
     }
     *out << "]\n";
   }
+}
+
+// The rows of (M + M^T) / 2: a covariance computed as J C J^T is
+// symmetric only to rounding, and the file should be exactly.
+void AppendMatrix(const Eigen::MatrixXd& given, std::ostringstream* out) {
+  AppendRows(0.5 * (given + given.transpose()), out);
 }
 
 }  // namespace
@@ -177,6 +240,14 @@ std::string FormatCalibrationCovariance(const CalibrationCovarianceFile& file) {
          "T_cn_cnm1_covariance: of [w; dt],\n"
       << "# T_cn_cnm1 = (exp([w]x) R, exp([w]x) t + dt), w radians, dt "
          "meters, camn frame\n";
+  bool cross = false;
+  for (const CalibrationCovarianceFile::Camera& camera : file.cameras) {
+    cross |= camera.from_previous_intrinsics_covariance.size() > 0;
+  }
+  if (cross) {
+    out << "# T_cn_cnm1_intrinsics_covariance: of [w; dt] (rows) with the "
+           "intrinsics of cam(n-1), then camn (columns)\n";
+  }
   out << "medium: " << file.medium << "\n";
   out << "drift_prior:\n"
       << "  rotation_deg: " << FormatDouble(file.drift_rotation_sigma / kDegree)
@@ -199,6 +270,10 @@ std::string FormatCalibrationCovariance(const CalibrationCovarianceFile& file) {
     if (camera.from_previous_covariance && k > 0) {
       out << "  T_cn_cnm1_covariance:\n";
       AppendMatrix(*camera.from_previous_covariance, &out);
+    }
+    if (camera.from_previous_intrinsics_covariance.size() > 0 && k > 0) {
+      out << "  T_cn_cnm1_intrinsics_covariance:\n";
+      AppendRows(camera.from_previous_intrinsics_covariance, &out);
     }
   }
   return out.str();
@@ -228,6 +303,8 @@ StatusOr<CalibrationUncertainty> PairCalibrationUncertainty(
       file.cameras[right_index].from_previous_covariance) {
     uncertainty.extrinsics_covariance =
         *file.cameras[right_index].from_previous_covariance;
+    uncertainty.extrinsics_lens_covariance =
+        file.cameras[right_index].from_previous_intrinsics_covariance;
   }
   const auto [rotation, translation] = drift_override.value_or(
       std::pair<double, double>{file.drift_rotation_sigma,

@@ -278,6 +278,22 @@ struct UnderwaterCalibration {
   // the first-order propagation through the refit of every other unknown
   // (so the extrinsics fitted through those lenses move with them).
   std::optional<double> sigma_n_lenses;
+  // The same refits' moves of the extrinsics, when they were estimated:
+  // with de_{c,i} the move of [w; dt] (about the solution, the convention
+  // of StereoRig::WithCam1Moved) in the refit of camera c's lens moved by
+  // delta_{c,i} = sqrt(l_i) e_i, to first order
+  //   Cov([w; dt], lenses) = sum_{c,i} de_{c,i} [delta_{c,i} in camera
+  //                          c's columns]^T   6 x (p0 + p1), cam0's first,
+  //   Cov([w; dt]) from the lenses = sum_{c,i} de_{c,i} de_{c,i}^T,
+  // so that the lenses' covariance and the extrinsics' joint covariance is
+  // [extrinsics_covariance + the second, the first; its transpose, the
+  // lenses'] (CalibrationUncertainty::extrinsics_lens_covariance): what
+  // the covariance sidecar carries, so that a target-free estimate with
+  // this camchain moves the extrinsics with the lenses, as they were
+  // fitted. Empty (and zero) when not computed.
+  Eigen::MatrixXd extrinsics_lens_covariance;
+  Eigen::Matrix<double, 6, 6> extrinsics_covariance_from_lenses =
+      Eigen::Matrix<double, 6, 6>::Zero();
   // The air cameras (bit for bit), the underwater extrinsics and the ports
   // (with the estimated gaps and normals; none when the air rig had none
   // and nothing about the ports was estimated).

@@ -37,7 +37,16 @@
 //
 // (for a w drawn from the prior the first two sum to H^-1, the Bayesian
 // posterior covariance: MAP estimation, Kay, Fundamentals of Statistical
-// Signal Processing I, ch. 10-11). sigma_n is the square root of the (n, n)
+// Signal Processing I, ch. 10-11). When the calibration's extrinsics are
+// correlated with its lenses (CalibrationUncertainty::extrinsics_lens_
+// covariance, an underwater calibration's), Sigma_p is the joint
+// covariance of the held columns, and with w under its prior the error
+// H^-1 (B dp / sigma^2 - diag(0, P) dw) of a rotation off its prior by dw
+// adds the cross term
+//
+//            - H^-1 (B Sigma_pw diag(0, P) / sigma^2 + transpose) H^-1,
+//
+// Sigma_pw the held columns' covariance with w. sigma_n is the square root of the (n, n)
 // entry; sigma_n_noise of the first term's, sigma_n_calibration of the
 // other two. With w held (online estimators without self-calibration),
 // w is part of p.
@@ -254,7 +263,10 @@ struct CalibrationPropagation {
   double sigma_n_noise = 0.0;
   double sigma_n_calibration = 0.0;
   // Of sigma_n_calibration^2: the estimated rotation's prior share and the
-  // held parameters' (w when held, dt, lenses).
+  // held parameters' (w when held, dt, lenses). The lenses' share counts
+  // their correlation with the extrinsics, when the calibration measured
+  // one, and is then negative where the extrinsics fitted through the
+  // lenses cancel more than the lenses add.
   double variance_rotation = 0.0;
   double variance_translation = 0.0;
   double variance_lenses = 0.0;

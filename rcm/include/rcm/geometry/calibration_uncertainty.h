@@ -23,6 +23,19 @@
 //
 // Lens parameters in Camera::params() order, [fx, fy, cx, cy, d...] (px
 // and unitless); an empty matrix means the lens is taken as exact.
+//
+// The extrinsics and the lenses can be correlated: an underwater
+// calibration fits cam1_from_cam0 under water through the air lenses, so
+// that a lens error moves the fitted extrinsics with it
+// (calib/underwater_calibration.h, extrinsics_lens_covariance), and the
+// two errors largely cancel in what the rig says about n. The joint
+// covariance of x = [w; dt; left lens; right lens] is then
+//
+//   | Sigma_e      X_l      X_r   |
+//   | X_l^T    Sigma_l      0     |     X = extrinsics_lens_covariance
+//   | X_r^T       0     Sigma_r   |       = [X_l  X_r]  (6 x (p_l + p_r)),
+//
+// and without X (empty) the blocks are independent.
 #ifndef RCM_GEOMETRY_CALIBRATION_UNCERTAINTY_H_
 #define RCM_GEOMETRY_CALIBRATION_UNCERTAINTY_H_
 
@@ -44,6 +57,9 @@ struct CalibrationUncertainty {
   // Covariance of each camera's Camera::params(); empty = exact.
   Eigen::MatrixXd left_lens_covariance;
   Eigen::MatrixXd right_lens_covariance;
+  // Cov([w; dt], [left params; right params]), 6 x (p_l + p_r); empty =
+  // uncorrelated. Needs both lens covariances.
+  Eigen::MatrixXd extrinsics_lens_covariance;
   // Where the numbers come from, in words, for reports: e.g. "default drift
   // prior 0.1 deg, 0.1 mm per axis" or "camchain-covariance.yaml + drift
   // prior 0.1 deg, 0.1 mm per axis".
@@ -67,9 +83,15 @@ struct CalibrationUncertainty {
   }
   // True when nothing is uncertain (every entry zero, no lens covariance).
   bool IsZero() const;
+  // The joint covariance of [w; dt; left params; right params] above (the
+  // lens blocks of size 0 when empty; zero cross blocks without
+  // extrinsics_lens_covariance).
+  Eigen::MatrixXd JointCovariance() const;
 
   // Finite, symmetric (to a relative 1e-9) and positive semi-definite
-  // matrices; lens covariances empty or of the cameras' parameter counts.
+  // matrices; lens covariances empty or of the cameras' parameter counts;
+  // extrinsics_lens_covariance empty, or 6 x (p_l + p_r) with both lens
+  // covariances given and the joint covariance positive semi-definite.
   // Errors name the matrix: "cam1_from_cam0 covariance is not positive
   // semi-definite".
   Status Check(int left_num_params, int right_num_params) const;

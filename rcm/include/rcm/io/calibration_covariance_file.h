@@ -19,9 +19,18 @@
 //     T_cn_cnm1_covariance:      # 6x6, of [w; dt] of T_cn_cnm1 = cam1_from_cam0:
 //     - [...]                    # (exp([w]x) R, exp([w]x) t + dt), w in
 //     ...                        # radians and dt in meters, cam1 frame
+//     T_cn_cnm1_intrinsics_covariance:  # 6 rows: [w; dt] against
+//     - [...]                    # [cam0's intrinsics, cam1's] (p0 + p1
+//     ...                        # columns), written by an underwater
+//                                # calibration (the extrinsics fitted through
+//                                # the air lenses move with them)
 //
 // Every key but `medium` is optional (a camera without intrinsics_covariance
-// has lenses taken as exact; cam0 never has T_cn_cnm1_covariance). Numbers
+// has lenses taken as exact; cam0 never has T_cn_cnm1_covariance). A
+// camera's T_cn_cnm1_intrinsics_covariance needs its T_cn_cnm1_covariance
+// and both cameras' intrinsics_covariance, and the joint covariance they
+// make (CalibrationUncertainty::JointCovariance) must be positive
+// semi-definite. Numbers
 // are written as the shortest text that reads back to the same double, so
 // that a file reads back bit for bit; matrices are written symmetrized,
 // (M + M^T) / 2. Reading never throws; errors are one
@@ -45,6 +54,9 @@ struct CalibrationCovarianceFile {
     Eigen::MatrixXd intrinsics_covariance;
     // Of [w; dt] of T_cn_cnm1; absent on cam0.
     std::optional<Eigen::Matrix<double, 6, 6>> from_previous_covariance;
+    // Cov([w; dt] of T_cn_cnm1, [previous camera's params; this camera's
+    // params]), 6 x (p_prev + p); empty when absent (always on cam0).
+    Eigen::MatrixXd from_previous_intrinsics_covariance;
   };
   // "air" or "water".
   std::string medium = "air";
@@ -76,8 +88,9 @@ Status WriteCalibrationCovariance(const std::string& path,
 
 // The uncertainty of the stereo pair (cam<left_index>, cam<right_index>):
 // the two cameras' intrinsics covariances, and the extrinsics' covariance
-// of T_cn_cnm1 when right_index = left_index + 1 (other pairs chain several
-// transforms: their extrinsics get the drift prior alone), plus the file's
+// of T_cn_cnm1 and its cross-covariance with the intrinsics when
+// right_index = left_index + 1 (other pairs chain several transforms:
+// their extrinsics get the drift prior alone), plus the file's
 // drift prior, or `drift_override` (rotation, translation sigmas) when
 // given. `source` names the file in CalibrationUncertainty::source.
 // Fails on an index beyond the file's cameras.
