@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds, and runs every test (ctest, two jobs):
-# the Release build (build/); the installed package (scripts/test_install.sh:
-# a consumer project, the Python package and its pytest suite, the docs'
-# snippets); then the same suite built with clang
-# under AddressSanitizer and UndefinedBehaviorSanitizer, followed by a
-# short run of each fuzz target (scripts/test_sanitizers.sh,
-# build-sanitize/). Each step's wall time is printed when it ends (CI must
-# stay under 40 minutes on 2 cores).
+# the Release build (build/) and its statistical and accuracy tests; the
+# installed package (scripts/test_install.sh: a consumer project, the
+# Python package and its pytest suite, the docs' snippets); then the
+# suite built with clang under AddressSanitizer and
+# UndefinedBehaviorSanitizer, every test the Release pass did not run
+# (scripts/test_passes.sh says which pass runs what), followed by a short
+# run of each fuzz target (scripts/test_sanitizers.sh, build-sanitize/).
+# Each step's wall time is printed when it ends (CI must stay under 40
+# minutes on 2 cores).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 start=$SECONDS
@@ -21,6 +23,17 @@ step() {
 # entry per test (ctest -R NAME), configure build/ with -DRCM_TEST_SHARDS=0.
 export RCM_TEST_SHARDS=6
 step ./scripts/build.sh -DRCM_TEST_SHARDS="$RCM_TEST_SHARDS"
-step ctest --test-dir build --output-on-failure -j2
+# The Release pass runs the tests whose statistics or accuracy only it
+# checks (release_only, budgeted: scripts/test_passes.sh) and the node's
+# test; every other test runs once, in the sanitizer pass, which catches
+# more with the same checks.
+# shellcheck source=scripts/test_passes.sh
+source scripts/test_passes.sh
+check_test_passes build
+release_ctest() {
+  GTEST_FILTER="$(join_patterns "${release_only[@]}" "${budgeted[@]}")" \
+    ctest --test-dir build --output-on-failure -j2
+}
+step release_ctest
 step ./scripts/test_install.sh
 step ./scripts/test_sanitizers.sh

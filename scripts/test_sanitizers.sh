@@ -46,86 +46,21 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 if [[ -x /usr/lib/llvm-14/bin/llvm-symbolizer ]]; then
   export ASAN_SYMBOLIZER_PATH=/usr/lib/llvm-14/bin/llvm-symbolizer
 fi
-# Every test runs here but these, whose code other tests run here too and
-# whose own value is a statistic, an accuracy on rendered images or a
-# byte-for-byte equality, which the Release pass checks. In brackets, the
-# sanitized tests that run the same code. gtest filter patterns (a whole
-# test name, or a prefix and *), one per entry; the check below requires
-# each to match at least one test.
-skipped=(
-  # [RectifiedRigN1333, UnrectifiedRigN1345]: the same pipeline at other n
-  'StereoFrontEndAcceptance.RectifiedRigN1345'
-  'StereoFrontEndAcceptance.UnrectifiedRigN1333'
-  # [VirtualPinholeRig.*, UndistortCli.*]: corrected images, 3 rigs x 20 frames
-  'VirtualPinholeRig.CorrectedImagesSatisfyPinholeEpipolarGeometry'
-  # [ThickPortRefinement exact tests, EstimateCli.SimulatedThickPort...]
-  'ThickPortRefinement.WithinOneAndAHalfCramerRaoBoundsWhereThinPortIsBiased'
-  'ThickPortRefinement.MonteCarloJointAirGapSigmaIsHonest'
-  # [StereoCalibration.*, UnderwaterCalibration.*, CrossValidation.*]: Monte Carlo
-  'StereoCalibration.MonteCarloSigmaIsHonest'
-  'UnderwaterCalibration.MonteCarloSigmaIsHonest'
-  'OpenCvSampleStereo.LeaveOneOutIsStable'
-  # [BoardWarp.Exact*, MeanFramesProjection.JacobianMatchesCentralDifferences]:
-  # Monte Carlo of the warp's sigma and of the mean-frames projection spread
-  'BoardWarp.MonteCarloWarpSigmaIsHonest'
-  'MeanFramesProjection.MonteCarloSpreadIsThePredictedOne'
-  # [CalibrationPropagation.MonteCarloRefine*, .MonteCarloFreeRotation*,
-  # OnlineEstimator.*, SlidingWindowEstimator.*]: the drift Monte Carlo of
-  # the online and window estimators (32 s of the Release pass's CPU)
-  'CalibrationPropagation.MonteCarloOnlineSigma*'
-  'CalibrationPropagation.MonteCarloWindowSigma*'
-  # [BoardWarp.Exact*, BoardRendering.*]: the bow and focal lengths on renders
-  'BoardWarpOnRenders.BowRecoveredAndFocalLengthsUnbiased'
-  # [BoardRendering.PixelsAreTheExactPixelIntegral, CalibrateCli.*, UnderwaterCli.*]:
-  # the accuracy of a calibration, and of the detected corners, on renders
-  'CalibrationOnRenders.ChessboardEquidistantDatasetRig'
-  'CalibrationOnRenders.ChessboardEucmRecoversTheTruth'
-  'BoardRendering.NarrowRigCornersAreDetectedWhereTheyProject'
-  'BoardRendering.AlphasenseCornersAreDetectedWhereTheyProject'
-  'BoardRendering.BorderCornersAreNotPulledOutward'
-  # [OpenCvSampleStereo.EveryPairIsDetectedConsistently]: the RMS against OpenCV's
-  'OpenCvSampleStereo.RmsNoWorseThanStereoCalibrate'
-  'OpenCvSampleStereo.RationalRmsAtOrBelowRadTan'
-  # [StereoFrontEnd.*, FeatureDetector.*]: n within 2e-3 with SIFT and AKAZE
-  'StereoFrontEnd.SiftGivesTheIndexWithin2e3'
-  'StereoFrontEnd.AkazeGivesTheIndexWithin2e3'
-  # [SequenceSimulator.*, StereoRenderer.*, SimulateCli.*]: determinism
-  'SequenceSimulator.SameSeedSameFrames'
-  'SequenceSimulator.SameSeedSameFramesWithABoard'
-  'StereoRenderer.SameInputsGiveTheSameBytes'
-  'SimulateCli.SameSeedSameBytes'
-  # [ThinPortBias.*]: the table of docs/thin_port_bias.md, recomputed
-  'ThinPortBias.DocsTableIsCurrent'
-  # [UnderwaterCli.OneCameraGivesN, .TooFewViews, .NPinnedAtTheUpperBound,
-  # UnderwaterCalibration.*, EstimateCli.*]: the two dives' accuracy end to end
-  'UnderwaterCli.DatasetRigThatDriftedHalfADegree'
-  'UnderwaterCli.NarrowRigThatDriftedHalfADegree'
-  # [OpenCvSampleStereo.*, CalibrateCli.Corners*]: rcm against mrcal on the
-  # sample pairs, a comparison of two solvers' numbers
-  'MrcalPeer.*'
-  # [EstimateImagesCli.FoldersGiveNAndThePictures, ...]: each estimator on images
-  'EstimateImagesCli.EveryEstimatorRunsOnImages'
-)
+# The tests of the Release pass only are left out (scripts/test_passes.sh).
+# shellcheck source=scripts/test_passes.sh
+source scripts/test_passes.sh
 # Each test suite runs as RCM_TEST_SHARDS processes (tests/CMakeLists.txt),
-# the skipped tests filtered out by gtest itself.
-suites=$(ctest --test-dir build-sanitize -N | sed -n 's|^ *Test *#[0-9]*: \([a-z_]*_tests\)/shard[0-9]*$|\1|p' | sort -u)
-[[ -n $suites ]] || { echo "test_sanitizers: no sharded test suites in build-sanitize" >&2; exit 1; }
-tests=$(for suite in $suites; do
-  build-sanitize/bin/$suite --gtest_list_tests | awk '/^[^ ]/ {s = $1} /^  / {print s $1}'
-done)
-for pattern in "${skipped[@]}"; do
-  found=0
-  while read -r name; do
-    # shellcheck disable=SC2053  # the pattern is a glob on purpose
-    [[ $name == $pattern ]] && { found=1; break; }
-  done <<<"$tests"
-  ((found)) || { echo "test_sanitizers: skip entry '$pattern' matches no test" >&2; exit 1; }
-done
+# the Release pass's tests filtered out by gtest itself.
+check_test_passes build-sanitize
+tests=$(list_tests build-sanitize)
 total=$(grep -c . <<<"$tests")
-export GTEST_FILTER="-$(IFS=':'; echo "${skipped[*]}")"
-kept=$(for suite in $suites; do build-sanitize/bin/$suite --gtest_list_tests; done | grep -c '^  ')
-echo "test_sanitizers: $kept of $total tests in $(wc -w <<<"$suites") suites," \
-  "each in $shards processes (the Release pass runs the rest)"
+GTEST_FILTER="-$(join_patterns "${release_only[@]}")"
+export GTEST_FILTER
+kept=$(grep -c . < <(while read -r name; do
+  matches_any "$name" "${release_only[@]}" || echo "$name"
+done <<<"$tests"))
+echo "test_sanitizers: $kept of $total tests," \
+  "each suite in $shards processes (the Release pass runs the rest)"
 ctest --test-dir build-sanitize --output-on-failure -j2
 # A fixed seed: CI replays the same draw (scripts/fuzz.sh); the seed
 # corpus holds every earlier finding.
