@@ -29,7 +29,7 @@ step ./scripts/build.sh -DRCM_TEST_SHARDS="$RCM_TEST_SHARDS"
 # more with the same checks.
 # shellcheck source=scripts/test_passes.sh
 source scripts/test_passes.sh
-check_test_passes build
+check_test_passes "$(list_tests build)"
 release_ctest() {
   GTEST_FILTER="$(join_patterns "${release_only[@]}" "${budgeted[@]}")" \
     ctest --test-dir build --output-on-failure -j2

@@ -51,8 +51,8 @@ fi
 source scripts/test_passes.sh
 # Each test suite runs as RCM_TEST_SHARDS processes (tests/CMakeLists.txt),
 # the Release pass's tests filtered out by gtest itself.
-check_test_passes build-sanitize
 tests=$(list_tests build-sanitize)
+check_test_passes "$tests"
 total=$(grep -c . <<<"$tests")
 GTEST_FILTER="-$(join_patterns "${release_only[@]}")"
 export GTEST_FILTER

@@ -222,6 +222,29 @@ TEST(UnderwaterModelSelection, WithoutFoldsEveryCandidateIsPlausible) {
   EXPECT_GT(selection->sigma_n_model, 0.5 * std::abs(difference));
 }
 
+// The rig `air` with each camera's lens moved by root * z, z a draw of
+// independent unit normals from `normal` and `rng` (root: a factor of the
+// lens covariance, L L^T).
+StereoRig DrawnLenses(const StereoRig& air, const Eigen::MatrixXd& root,
+                      std::mt19937* rng,
+                      std::normal_distribution<double>* normal) {
+  Camera cameras[2] = {air.left(), air.right()};
+  for (Camera& camera : cameras) {
+    Eigen::VectorXd unit(camera.num_params());
+    for (int i = 0; i < unit.size(); ++i) unit[i] = (*normal)(*rng);
+    const Eigen::VectorXd delta = root * unit;
+    std::vector<double> params(camera.params(),
+                               camera.params() + camera.num_params());
+    for (int i = 0; i < unit.size(); ++i) params[i] += delta[i];
+    camera = Camera::Create(camera.model(), camera.width(), camera.height(),
+                            {params[0], params[1], params[2], params[3]},
+                            {params.begin() + 4, params.end()})
+                 .value();
+  }
+  return StereoRig::Create(cameras[0], cameras[1], air.right_from_left())
+      .value();
+}
+
 // The air lenses' covariance reaches n through the refits: first order, so
 // a covariance 4 times larger doubles sigma_n_lenses; and it matches the
 // spread of n over air rigs drawn from that covariance (noise-free corners
@@ -277,22 +300,7 @@ TEST(UnderwaterCalibration, LensCovarianceReachesN) {
   const int kDraws = rcm::test::Trials(40);
   std::vector<double> n;
   for (int draw = 0; draw < kDraws; ++draw) {
-    Camera cameras[2] = {dive.air.left(), dive.air.right()};
-    for (Camera& camera : cameras) {
-      Eigen::VectorXd z(camera.num_params());
-      for (int i = 0; i < z.size(); ++i) z[i] = normal(rng);
-      const Eigen::VectorXd delta = root * z;
-      std::vector<double> params(camera.params(),
-                                 camera.params() + camera.num_params());
-      for (int i = 0; i < z.size(); ++i) params[i] += delta[i];
-      camera = Camera::Create(camera.model(), camera.width(), camera.height(),
-                              {params[0], params[1], params[2], params[3]},
-                              {params.begin() + 4, params.end()})
-                   .value();
-    }
-    const StereoRig drawn =
-        StereoRig::Create(cameras[0], cameras[1], dive.air.right_from_left())
-            .value();
+    const StereoRig drawn = DrawnLenses(dive.air, root, &rng, &normal);
     const StatusOr<UnderwaterCalibration> result = CalibrateUnderwater(
         Checkerboard(), dive.views, size, size, drawn, lean);
     ASSERT_TRUE(result.ok()) << result.status().message();
@@ -378,22 +386,7 @@ TEST(UnderwaterCalibration, LensCorrelationKeepsTargetFreeSigmaHonest) {
   std::vector<double> z;
   std::vector<double> z_independent;
   for (int draw = 0; draw < kDraws; ++draw) {
-    Camera cameras[2] = {dive.air.left(), dive.air.right()};
-    for (Camera& camera : cameras) {
-      Eigen::VectorXd unit(camera.num_params());
-      for (int i = 0; i < unit.size(); ++i) unit[i] = normal(rng);
-      const Eigen::VectorXd delta = root * unit;
-      std::vector<double> params(camera.params(),
-                                 camera.params() + camera.num_params());
-      for (int i = 0; i < unit.size(); ++i) params[i] += delta[i];
-      camera = Camera::Create(camera.model(), camera.width(), camera.height(),
-                              {params[0], params[1], params[2], params[3]},
-                              {params.begin() + 4, params.end()})
-                   .value();
-    }
-    const StereoRig drawn =
-        StereoRig::Create(cameras[0], cameras[1], dive.air.right_from_left())
-            .value();
+    const StereoRig drawn = DrawnLenses(dive.air, root, &rng, &normal);
     const StatusOr<UnderwaterCalibration> water = CalibrateUnderwater(
         Checkerboard(), dive.views, image, image, drawn, lean);
     ASSERT_TRUE(water.ok()) << water.status().message();

@@ -51,6 +51,22 @@ wait_for_topic() {
     sleep 0.2
   done
 }
+# Whether a node whose name contains NAME subscribes to every TOPIC after
+# it (waits at most 10 s).
+wait_for_subscriber() {
+  local name=$1 topic subscribed
+  shift
+  for _ in $(seq 1 100); do
+    subscribed=1
+    for topic in "$@"; do
+      rostopic info "$topic" 2>/dev/null | sed -n '/^Subscribers:/,$p' |
+        grep -q -- "$name" || subscribed=0
+    done
+    ((subscribed)) && return 0
+    sleep 0.1
+  done
+  return 1
+}
 # Plays BAG while rosbag record writes the depth topics (depth_topics,
 # below) to OUT. rosbag record closes its bag on SIGINT: its Python front
 # end returns at once, the recorder it started renames OUT.active to OUT
@@ -60,29 +76,13 @@ play_recording_depth() {
   local recorder=$!
   pids+=($recorder)
   # Played only once the recorder subscribes to every depth topic (a fixed
-  # 1 s sleep lost the first pair on a loaded machine); at most 10 s.
-  local topic subscribed
-  for _ in $(seq 1 100); do
-    subscribed=1
-    for topic in "${depth_topics[@]}"; do
-      rostopic info "$topic" 2>/dev/null | sed -n '/^Subscribers:/,$p' |
-        grep -q '/record_' || subscribed=0
-    done
-    ((subscribed)) && break
-    sleep 0.1
-  done
-  ((subscribed)) || fail "rosbag record did not subscribe to ${depth_topics[*]}"
-  # ... and stereo_image_proc, which subscribes lazily, to the node's pair.
-  for _ in $(seq 1 100); do
-    subscribed=1
-    for topic in /stereo/rcm/left/image_rect /stereo/rcm/right/image_rect; do
-      rostopic info "$topic" 2>/dev/null | sed -n '/^Subscribers:/,$p' |
-        grep -q 'stereo_image_proc' || subscribed=0
-    done
-    ((subscribed)) && break
-    sleep 0.1
-  done
-  ((subscribed)) || fail "stereo_image_proc did not subscribe to the node's rectified pair"
+  # 1 s sleep lost the first pair on a loaded machine), and
+  # stereo_image_proc, which subscribes lazily, to the node's pair.
+  wait_for_subscriber /record_ "${depth_topics[@]}" ||
+    fail "rosbag record did not subscribe to ${depth_topics[*]}"
+  wait_for_subscriber stereo_image_proc /stereo/rcm/left/image_rect \
+    /stereo/rcm/right/image_rect ||
+    fail "stereo_image_proc did not subscribe to the node's rectified pair"
   rosbag play -q "$1" >/dev/null 2>&1 || fail "rosbag play $1 failed"
   sleep 2
   kill -INT "$recorder"
