@@ -35,6 +35,7 @@ release_only=(
   # [StereoCalibration.*, UnderwaterCalibration.*, CrossValidation.*]: Monte Carlo
   'StereoCalibration.MonteCarloSigmaIsHonest'
   'UnderwaterCalibration.MonteCarloSigmaIsHonest'
+  'JointAirWaterCalibration.MonteCarloSigmaIsHonest'
   'OpenCvSampleStereo.LeaveOneOutIsStable'
   # [BoardWarp.Exact*, MeanFramesProjection.JacobianMatchesCentralDifferences]:
   # Monte Carlo of the warp's sigma and of the mean-frames projection spread

@@ -49,11 +49,22 @@ const double kMaxTiltParameter =
     std::tan(FlatPort::kMaxTiltDegrees * M_PI / 180.0);
 
 // What the problem holds fixed: the target, the lenses and the glass.
+// With air views (joint), views [0, num_water_views) are under water and
+// the rest in air, and the water residuals take the lens as a block.
 struct Model {
   std::vector<Eigen::Vector3d> target_points;
   std::vector<Eigen::Vector2d> warp_basis;  // per point (board_warp.h)
   std::array<LensModelId, 2> lens_models{};
   std::array<UnderwaterCameraConstants, 2> constants{};
+  bool joint = false;
+  int num_water_views = 0;
+  std::vector<Eigen::Vector3d> air_target_points;
+  std::vector<Eigen::Vector2d> air_warp_basis;
+  bool same_board = false;
+
+  bool InAir(const Corner& corner) const {
+    return joint && corner.view >= num_water_views;
+  }
 };
 
 // The unknowns, as Ceres sees them.
@@ -62,8 +73,22 @@ struct Parameters {
   Pose cam1_from_cam0{};
   std::array<double, 2> air_gap{};              // per camera
   std::array<std::array<double, 2>, 2> tilt{};  // per camera: (a, b)
-  std::vector<Pose> cam0_from_target;           // per input view
-  std::array<double, 2> board_warp{};           // [warp_x, warp_y] (m)
+  std::vector<Pose> cam0_from_target;  // per input view (water, then air)
+  std::array<double, 2> board_warp{};  // [warp_x, warp_y] (m)
+  // The joint calibration's (Model::joint): the lenses (Camera::params()
+  // order), the air extrinsics and the air board's warp.
+  std::array<std::array<double, kMaxLensParams>, 2> lens{};
+  Pose air_cam1_from_cam0{};
+  std::array<double, 2> air_board_warp{};
+
+  // The warp block of the board a corner lies on.
+  double* WarpOf(const Model& model, const Corner& corner) {
+    return model.InAir(corner) && !model.same_board ? air_board_warp.data()
+                                                    : board_warp.data();
+  }
+  const double* WarpOf(const Model& model, const Corner& corner) const {
+    return const_cast<Parameters*>(this)->WarpOf(model, corner);
+  }
 };
 
 // Which of them are estimated (the poses always are).
@@ -72,6 +97,10 @@ struct FreeParameters {
   std::array<bool, 2> air_gap{};
   std::array<bool, 2> tilt{};
   bool board_warp = false;
+  // The joint calibration's.
+  std::array<bool, 2> lens{};
+  bool air_extrinsics = false;
+  bool air_board_warp = false;
 };
 
 template <typename LensModel>
@@ -87,11 +116,45 @@ ceres::CostFunction* MakeCost(const Model& model, const Corner& corner) {
       constants, point, basis, corner.pixel);
 }
 
+// The joint calibration's costs: a water corner with the lens as a block,
+// an air corner (board_reprojection_error.h).
+template <typename LensModel>
+ceres::CostFunction* MakeJointCost(const Model& model, const Corner& corner) {
+  if (model.InAir(corner)) {
+    const Eigen::Vector3d& point = model.air_target_points[corner.point_id];
+    const Eigen::Vector2d& basis = model.air_warp_basis[corner.point_id];
+    if (corner.camera == 0) {
+      return Cam0WarpedBoardReprojectionError<LensModel>::Create(point, basis,
+                                                                 corner.pixel);
+    }
+    return Cam1WarpedBoardReprojectionError<LensModel>::Create(point, basis,
+                                                               corner.pixel);
+  }
+  const UnderwaterCameraConstants& constants = model.constants[corner.camera];
+  const Eigen::Vector3d& point = model.target_points[corner.point_id];
+  const Eigen::Vector2d& basis = model.warp_basis[corner.point_id];
+  if (corner.camera == 0) {
+    return Cam0UnderwaterLensReprojectionError<LensModel>::Create(
+        constants, point, basis, corner.pixel);
+  }
+  return Cam1UnderwaterLensReprojectionError<LensModel>::Create(
+      constants, point, basis, corner.pixel);
+}
+
 ceres::CostFunction* CostFor(const Model& model, const Corner& corner) {
   RCM_LENS_MODEL_SWITCH(model.lens_models[corner.camera],
-                        return MakeCost<LensModel>(model, corner);)
+                        return model.joint
+                                   ? MakeJointCost<LensModel>(model, corner)
+                                   : MakeCost<LensModel>(model, corner);)
   LOG(FATAL) << "unknown lens model";
   return nullptr;
+}
+
+// Holds `block` constant unless `free` (when the problem has it).
+void HoldUnlessFree(bool free, double* block, ceres::Problem* problem) {
+  if (!free && problem->HasParameterBlock(block)) {
+    problem->SetParameterBlockConstant(block);
+  }
 }
 
 // Adds the inliers' residuals to `problem` (Huber at huber_px, none for 0),
@@ -105,22 +168,46 @@ void AddResiduals(const Model& model, const std::vector<Corner>& corners,
         huber_px > 0.0 ? new ceres::HuberLoss(huber_px) : nullptr;
     const int c = corner.camera;
     double* pose = parameters->cam0_from_target[corner.view].data();
-    if (c == 0) {
+    double* warp = parameters->WarpOf(model, corner);
+    double* lens = parameters->lens[c].data();
+    if (model.InAir(corner)) {
+      if (c == 0) {
+        problem->AddResidualBlock(CostFor(model, corner), loss, lens, pose,
+                                  warp);
+      } else {
+        problem->AddResidualBlock(CostFor(model, corner), loss, lens, pose,
+                                  parameters->air_cam1_from_cam0.data(), warp);
+      }
+    } else if (model.joint) {
+      if (c == 0) {
+        problem->AddResidualBlock(CostFor(model, corner), loss, lens,
+                                  &parameters->n, pose,
+                                  &parameters->air_gap[0],
+                                  parameters->tilt[0].data(), warp);
+      } else {
+        problem->AddResidualBlock(
+            CostFor(model, corner), loss, lens, &parameters->n, pose,
+            parameters->cam1_from_cam0.data(), &parameters->air_gap[1],
+            parameters->tilt[1].data(), warp);
+      }
+    } else if (c == 0) {
       problem->AddResidualBlock(CostFor(model, corner), loss, &parameters->n,
                                 pose, &parameters->air_gap[0],
-                                parameters->tilt[0].data(),
-                                parameters->board_warp.data());
+                                parameters->tilt[0].data(), warp);
     } else {
       problem->AddResidualBlock(CostFor(model, corner), loss, &parameters->n,
                                 pose, parameters->cam1_from_cam0.data(),
                                 &parameters->air_gap[1],
-                                parameters->tilt[1].data(),
-                                parameters->board_warp.data());
+                                parameters->tilt[1].data(), warp);
     }
   }
-  if (problem->HasParameterBlock(parameters->board_warp.data()) &&
-      !free.board_warp) {
-    problem->SetParameterBlockConstant(parameters->board_warp.data());
+  HoldUnlessFree(free.board_warp, parameters->board_warp.data(), problem);
+  HoldUnlessFree(free.air_board_warp, parameters->air_board_warp.data(),
+                 problem);
+  HoldUnlessFree(free.air_extrinsics, parameters->air_cam1_from_cam0.data(),
+                 problem);
+  for (int c = 0; c < 2; ++c) {
+    HoldUnlessFree(free.lens[c], parameters->lens[c].data(), problem);
   }
   if (!problem->HasParameterBlock(&parameters->n)) return;
   problem->SetParameterLowerBound(&parameters->n, 0, kMinIndex);
@@ -159,20 +246,45 @@ template <typename LensModel>
 bool EvaluateResidual(const Model& model, const Corner& corner,
                       const Parameters& parameters, double* residual) {
   const UnderwaterCameraConstants& constants = model.constants[corner.camera];
+  const double* pose = parameters.cam0_from_target[corner.view].data();
+  const double* warp = parameters.WarpOf(model, corner);
+  const double* lens = parameters.lens[corner.camera].data();
+  if (model.InAir(corner)) {
+    const Eigen::Vector3d& point = model.air_target_points[corner.point_id];
+    const Eigen::Vector2d& basis = model.air_warp_basis[corner.point_id];
+    if (corner.camera == 0) {
+      return Cam0WarpedBoardReprojectionError<LensModel>(point, basis,
+                                                         corner.pixel)(
+          lens, pose, warp, residual);
+    }
+    return Cam1WarpedBoardReprojectionError<LensModel>(point, basis,
+                                                       corner.pixel)(
+        lens, pose, parameters.air_cam1_from_cam0.data(), warp, residual);
+  }
   const Eigen::Vector3d& point = model.target_points[corner.point_id];
   const Eigen::Vector2d& basis = model.warp_basis[corner.point_id];
-  const double* pose = parameters.cam0_from_target[corner.view].data();
+  if (model.joint) {
+    if (corner.camera == 0) {
+      return Cam0UnderwaterLensReprojectionError<LensModel>(
+          constants, point, basis, corner.pixel)(
+          lens, &parameters.n, pose, &parameters.air_gap[0],
+          parameters.tilt[0].data(), warp, residual);
+    }
+    return Cam1UnderwaterLensReprojectionError<LensModel>(
+        constants, point, basis, corner.pixel)(
+        lens, &parameters.n, pose, parameters.cam1_from_cam0.data(),
+        &parameters.air_gap[1], parameters.tilt[1].data(), warp, residual);
+  }
   if (corner.camera == 0) {
     return Cam0UnderwaterReprojectionError<LensModel>(constants, point, basis,
                                                       corner.pixel)(
         &parameters.n, pose, &parameters.air_gap[0], parameters.tilt[0].data(),
-        parameters.board_warp.data(), residual);
+        warp, residual);
   }
   return Cam1UnderwaterReprojectionError<LensModel>(constants, point, basis,
                                                     corner.pixel)(
       &parameters.n, pose, parameters.cam1_from_cam0.data(),
-      &parameters.air_gap[1], parameters.tilt[1].data(),
-      parameters.board_warp.data(), residual);
+      &parameters.air_gap[1], parameters.tilt[1].data(), warp, residual);
 }
 
 // The same; NaN when the port cannot image the corner.
@@ -226,8 +338,12 @@ struct CovarianceLayout {
   }
 };
 
+std::string CameraName(int c) { return "cam" + std::to_string(c); }
+
+// lens_sizes: each camera's Camera::num_params() (the lens blocks' sizes).
 CovarianceLayout LayoutOf(const FreeParameters& free,
-                          const Parameters& parameters) {
+                          const Parameters& parameters,
+                          const std::array<int, 2>& lens_sizes) {
   CovarianceLayout layout;
   layout.Add("n", &parameters.n, 1);
   if (free.extrinsics) {
@@ -248,6 +364,12 @@ CovarianceLayout LayoutOf(const FreeParameters& free,
   if (free.board_warp) {
     layout.Add("board_warp", parameters.board_warp.data(), 2);
   }
+  for (int c = 0; c < 2; ++c) {
+    if (free.lens[c]) {
+      layout.Add(CameraName(c) + " lens", parameters.lens[c].data(),
+                 lens_sizes[c]);
+    }
+  }
   return layout;
 }
 
@@ -255,8 +377,9 @@ CovarianceLayout LayoutOf(const FreeParameters& free,
 // rotation as the left perturbation w = log(R R_reference^T).
 Eigen::VectorXd ParameterVector(const FreeParameters& free,
                                 const Parameters& parameters,
+                                const std::array<int, 2>& lens_sizes,
                                 const Eigen::Matrix3d& reference_rotation) {
-  const CovarianceLayout layout = LayoutOf(free, parameters);
+  const CovarianceLayout layout = LayoutOf(free, parameters, lens_sizes);
   Eigen::VectorXd x(layout.size);
   for (size_t b = 0; b < layout.blocks.size(); ++b) {
     const UnderwaterParameterBlock& block = layout.blocks[b];
@@ -336,8 +459,6 @@ Eigen::VectorXd JackknifeSigma(const std::vector<Eigen::VectorXd>& samples) {
   }
   return ((g - 1.0) / g * sum).cwiseSqrt();
 }
-
-std::string CameraName(int c) { return "cam" + std::to_string(c); }
 
 // One refit of sigma_n_lenses (header): camera `camera`'s lens moved by
 // `delta` = sqrt(l_i) e_i.
@@ -456,26 +577,42 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     const CalibrationTarget& target, const std::vector<StereoView>& views,
     const ImageSize& cam0_size, const ImageSize& cam1_size,
     const StereoRig& air_rig, const UnderwaterCalibrationOptions& options,
-    const std::function<void(int, int)>& progress) {
+    const std::function<void(int, int)>& progress, const AirTargetViews* air) {
   RCM_RETURN_IF_ERROR(options.Check());
   const Camera* cameras[2] = {&air_rig.left(), &air_rig.right()};
-  const ImageSize sizes[2] = {cam0_size, cam1_size};
   const int num_views = static_cast<int>(views.size());
-  for (int c = 0; c < 2; ++c) {
-    bool seen = false;
-    for (const StereoView& view : views) {
-      seen |= (c == 0 ? view.left : view.right).has_value();
+  // Each medium's images must be the air rig's cameras'.
+  const auto check_sizes = [&](const std::vector<StereoView>& medium_views,
+                               const ImageSize& size0, const ImageSize& size1,
+                               const std::string& what) {
+    const ImageSize sizes[2] = {size0, size1};
+    for (int c = 0; c < 2; ++c) {
+      bool seen = false;
+      for (const StereoView& view : medium_views) {
+        seen |= (c == 0 ? view.left : view.right).has_value();
+      }
+      const bool none = sizes[c].width == 0 && sizes[c].height == 0;
+      if ((seen || !none) && (sizes[c].width != cameras[c]->width() ||
+                              sizes[c].height != cameras[c]->height())) {
+        return Status::Error(
+            CameraName(c) + what + " images are " +
+            std::to_string(sizes[c].width) + "x" +
+            std::to_string(sizes[c].height) + " but the air calibration's " +
+            CameraName(c) + " is " + std::to_string(cameras[c]->width()) +
+            "x" + std::to_string(cameras[c]->height()) +
+            ": the air rig is not these cameras' (or the images were scaled)");
+      }
     }
-    const bool none = sizes[c].width == 0 && sizes[c].height == 0;
-    if ((seen || !none) && (sizes[c].width != cameras[c]->width() ||
-                            sizes[c].height != cameras[c]->height())) {
+    return Status::Ok();
+  };
+  RCM_RETURN_IF_ERROR(check_sizes(views, cam0_size, cam1_size, ""));
+  if (air != nullptr) {
+    RCM_RETURN_IF_ERROR(
+        check_sizes(air->views, air->cam0_size, air->cam1_size, " air"));
+    if (air->same_board && !SameTarget(target, air->target)) {
       return Status::Error(
-          CameraName(c) + " images are " + std::to_string(sizes[c].width) +
-          "x" + std::to_string(sizes[c].height) +
-          " but the air calibration's " + CameraName(c) + " is " +
-          std::to_string(cameras[c]->width()) + "x" +
-          std::to_string(cameras[c]->height()) +
-          ": the air rig is not these cameras' (or the images were scaled)");
+          "same board: the air board (" + DescribeTarget(air->target) +
+          ") is not the water board (" + DescribeTarget(target) + ")");
     }
   }
 
@@ -492,7 +629,9 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
   // The ports: the air rig's blocks, or thin ports.
   std::array<FlatPort, 2> ports = {FlatPort(), FlatPort()};
   if (air_rig.ports()) ports = {air_rig.ports()->left, air_rig.ports()->right};
+  std::array<int, 2> lens_sizes{};
   for (int c = 0; c < 2; ++c) {
+    lens_sizes[c] = cameras[c]->num_params();
     model.lens_models[c] = cameras[c]->model();
     std::copy(cameras[c]->params(),
               cameras[c]->params() + cameras[c]->num_params(),
@@ -510,6 +649,10 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     parameters.air_gap[c] = ports[c].air_gap;
     const Eigen::Vector3d normal = ports[c].normal.normalized();
     parameters.tilt[c] = {normal.x() / normal.z(), normal.y() / normal.z()};
+  }
+  for (int c = 0; c < 2; ++c) {
+    std::copy(cameras[c]->params(), cameras[c]->params() + lens_sizes[c],
+              parameters.lens[c].begin());
   }
   parameters.cam0_from_target.resize(num_views);
   std::vector<Corner> corners;
@@ -542,6 +685,61 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
   }
   const int num_views_used =
       static_cast<int>(std::count(view_used.begin(), view_used.end(), true));
+
+  // The air views (joint): posed through the air lenses, their corners
+  // after the water's, views num_views + a.
+  int num_air_views_used = 0;
+  int num_air_stereo_views = 0;
+  std::array<bool, 2> camera_in_air = {false, false};
+  if (air != nullptr) {
+    model.joint = true;
+    model.num_water_views = num_views;
+    model.air_target_points = TargetPoints(air->target);
+    model.air_warp_basis = BoardWarpBasis(air->target);
+    model.same_board = air->same_board;
+    parameters.air_cam1_from_cam0 = PoseFromRigid(air_extrinsics);
+    StatusOr<internal::UsedObservations> air_used =
+        internal::SelectObservations(
+            air->views, static_cast<int>(model.air_target_points.size()),
+            options.min_corners_per_view, options.use_single_camera_views);
+    if (!air_used.ok()) return air_used.status().WithContext("air views");
+    const int num_air_views = static_cast<int>(air->views.size());
+    parameters.cam0_from_target.resize(num_views + num_air_views);
+    for (int a = 0; a < num_air_views; ++a) {
+      const std::array<const TargetObservation*, 2>& observed = (*air_used)[a];
+      std::optional<Rigid3d> camera_from_target[2];
+      for (int c = 0; c < 2; ++c) {
+        if (observed[c] == nullptr) continue;
+        camera_from_target[c] = ThinPortTargetPose(
+            *cameras[c], /*n0=*/1.0, model.air_target_points, *observed[c]);
+      }
+      std::optional<Rigid3d> cam0_from_target = camera_from_target[0];
+      if (!cam0_from_target && camera_from_target[1]) {
+        cam0_from_target = air_extrinsics.Inverse() * *camera_from_target[1];
+      }
+      if (!cam0_from_target) continue;
+      ++num_air_views_used;
+      parameters.cam0_from_target[num_views + a] =
+          PoseFromRigid(*cam0_from_target);
+      for (int c = 0; c < 2; ++c) {
+        if (observed[c] == nullptr) continue;
+        camera_in_air[c] = true;
+        for (int k = 0; k < observed[c]->size(); ++k) {
+          corners.push_back({num_views + a, c, observed[c]->point_ids[k],
+                             observed[c]->pixels[k], true});
+        }
+      }
+      if (observed[0] != nullptr && observed[1] != nullptr) {
+        ++num_air_stereo_views;
+      }
+    }
+    if (num_air_views_used == 0) {
+      return Status::Error(
+          "no air view shows the target with at least " +
+          std::to_string(options.min_corners_per_view) + " corners (and a "
+          "pose)");
+    }
+  }
   if (num_views_used == 0) {
     return Status::Error("no view shows the target with at least " +
                          std::to_string(options.min_corners_per_view) +
@@ -563,8 +761,17 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     free.tilt[c] = options.estimate_port_tilt && camera_used[c];
   }
   free.board_warp = options.estimate_board_warp;
-  const CovarianceLayout layout = LayoutOf(free, parameters);
-  const int num_parameters = layout.size + 6 * num_views_used;
+  if (model.joint) {
+    for (int c = 0; c < 2; ++c) {
+      free.lens[c] = camera_used[c] || camera_in_air[c];
+    }
+    free.air_extrinsics = num_air_stereo_views > 0;
+    free.air_board_warp = !air->same_board && air->estimate_board_warp;
+  }
+  const CovarianceLayout layout = LayoutOf(free, parameters, lens_sizes);
+  const int num_parameters =
+      layout.size + 6 * (num_views_used + num_air_views_used) +
+      (free.air_extrinsics ? 6 : 0) + (free.air_board_warp ? 2 : 0);
 
   const auto residual = [&](const Corner& corner) {
     return Residual(model, corner, parameters);
@@ -650,8 +857,20 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     }
   }
   {
+    std::array<Camera, 2> lenses = {air_rig.left(), air_rig.right()};
+    for (int c = 0; c < 2; ++c) {
+      if (!free.lens[c]) continue;
+      StatusOr<Camera> lens =
+          cameras[c]->WithParams(parameters.lens[c].data());
+      if (!lens.ok()) {
+        return Status::Error("the joint fit's " + CameraName(c) +
+                             " lens is not a valid camera: " +
+                             lens.status().message());
+      }
+      lenses[c] = *std::move(lens);
+    }
     StatusOr<StereoRig> rig =
-        StereoRig::Create(air_rig.left(), air_rig.right(), water_extrinsics);
+        StereoRig::Create(lenses[0], lenses[1], water_extrinsics);
     if (!rig.ok()) {
       return Status::Error("bundle adjustment diverged: " +
                            rig.status().message());
@@ -665,12 +884,38 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     result.rig = *rig;
   }
 
-  result.cam0_from_target =
-      internal::UsedViewPoses(parameters.cam0_from_target, view_used);
+  result.cam0_from_target = internal::UsedViewPoses(
+      std::vector<Pose>(parameters.cam0_from_target.begin(),
+                        parameters.cam0_from_target.begin() + num_views),
+      view_used);
+  // The statistics of the water corners; the air corners' beside them,
+  // and both in the pixel noise.
+  std::vector<Corner> water_corners;
+  std::vector<Corner> air_corners;
+  for (const Corner& corner : corners) {
+    (model.InAir(corner) ? air_corners : water_corners).push_back(corner);
+  }
   internal::ResidualStatistics statistics =
-      internal::SummarizeResiduals(corners, residual);
-  const double inlier_ssr = statistics.inlier_ssr;
+      internal::SummarizeResiduals(water_corners, residual);
+  double inlier_ssr = statistics.inlier_ssr;
+  int num_all_inliers = statistics.num_inliers;
   internal::StoreResidualStatistics(std::move(statistics), &result);
+  if (model.joint) {
+    const internal::ResidualStatistics air_statistics =
+        internal::SummarizeResiduals(air_corners, residual);
+    inlier_ssr += air_statistics.inlier_ssr;
+    num_all_inliers += air_statistics.num_inliers;
+    result.air_rms_px = air_statistics.rms_px;
+    result.num_air_views_used = num_air_views_used;
+    result.air_cam1_from_cam0 =
+        free.air_extrinsics
+            ? RigidFromPose(parameters.air_cam1_from_cam0.data())
+            : air_extrinsics;
+    const std::array<double, 2>& air_warp = air->same_board
+                                                ? parameters.board_warp
+                                                : parameters.air_board_warp;
+    result.air_board_warp = Eigen::Vector2d(air_warp[0], air_warp[1]);
+  }
   result.initial_rms_px =
       num_initial == 0 ? 0.0 : std::sqrt(initial_sum / num_initial);
   result.num_views_used = num_views_used;
@@ -696,19 +941,19 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
   // A fit that leaves many corners out is not a calibration of these
   // cameras: said, not refused (the residuals show it too).
   constexpr double kSuspectOutlierFraction = 0.1;
-  if (result.num_outliers > kSuspectOutlierFraction * corners.size()) {
+  if (result.num_outliers > kSuspectOutlierFraction * water_corners.size()) {
     result.notes.push_back(
-        FormatFixed(100.0 * result.num_outliers / corners.size(), 0) +
+        FormatFixed(100.0 * result.num_outliers / water_corners.size(), 0) +
         " % of the corners are outliers (" +
         std::to_string(result.num_outliers) + " of " +
-        std::to_string(corners.size()) +
+        std::to_string(water_corners.size()) +
         "): the air calibration may not describe these cameras, or the "
         "detector confused corners");
   }
-  const int redundancy = 2 * result.num_inliers - num_parameters;
+  const int redundancy = 2 * num_all_inliers - num_parameters;
   if (redundancy <= 0) {
     return Status::Error(
-        "too few corners: " + std::to_string(result.num_inliers) +
+        "too few corners: " + std::to_string(num_all_inliers) +
         " inlier corners for " + std::to_string(num_parameters) +
         " unknowns (2 per corner must exceed them)");
   }
@@ -743,6 +988,39 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
         "negative or non-finite variance");
   }
   result.sigma_n = std::sqrt(result.covariance.matrix(0, 0));
+  // The joint calibration: the lenses' share of n's variance (header).
+  std::vector<int> lens_rows;
+  for (int c = 0; c < 2; ++c) {
+    if (const UnderwaterParameterBlock* block =
+            result.covariance.Find(CameraName(c) + " lens")) {
+      for (int i = 0; i < block->size; ++i) {
+        lens_rows.push_back(block->offset + i);
+      }
+    }
+  }
+  if (!lens_rows.empty()) {
+    const int k = static_cast<int>(lens_rows.size());
+    Eigen::MatrixXd c_ll(k, k);
+    Eigen::VectorXd c_ln(k);
+    for (int i = 0; i < k; ++i) {
+      c_ln[i] = result.covariance.matrix(lens_rows[i], 0);
+      for (int j = 0; j < k; ++j) {
+        c_ll(i, j) = result.covariance.matrix(lens_rows[i], lens_rows[j]);
+      }
+    }
+    const double share =
+        std::max(0.0, c_ln.dot(c_ll.ldlt().solve(c_ln)));
+    const double total = result.covariance.matrix(0, 0);
+    result.sigma_n_lenses = std::sqrt(std::min(share, total));
+    result.sigma_n = std::sqrt(std::max(0.0, total - share));
+    result.lenses_estimated = true;
+    for (int c = 0; c < 2; ++c) {
+      const std::string name = CameraName(c) + " lens";
+      if (result.covariance.Find(name) != nullptr) {
+        result.lens_covariance[c] = result.covariance.Block(name, name);
+      }
+    }
+  }
   // Within one sigma of the upper bound is the bound too: the data cannot
   // tell the estimate from 2.
   if (parameters.n >= kMaxIndex - result.sigma_n) return upper_bound_error();
@@ -797,6 +1075,15 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     out.translation_mm = reported.tail<3>();
     out.covariance =
         jacobian * result.extrinsics_covariance * jacobian.transpose();
+    // The joint calibration: the change's covariance with the lenses.
+    if (free.lens[0] && free.lens[1]) {
+      result.extrinsics_lens_covariance =
+          jacobian * (Eigen::MatrixXd(6, lens_sizes[0] + lens_sizes[1])
+                          << result.covariance.Block("cam1_from_cam0",
+                                                     "cam0 lens"),
+                      result.covariance.Block("cam1_from_cam0", "cam1 lens"))
+                         .finished();
+    }
     for (int i = 0; i < 3; ++i) {
       out.rotation_sigma_deg[i] =
           kDegreesPerRadian * std::sqrt(out.covariance(i, i));
@@ -850,6 +1137,8 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
   FreeParameters refit_free = free;
   for (int c = 0; c < 2; ++c) {
     refit_free.air_gap[c] &= parameters.air_gap[c] > kOnBound;
+    // (Joint: the leave-out replicates hold the lenses, header.)
+    refit_free.lens[c] = false;
   }
 
   // Leave views out (header): each replicate re-solves the inliers' least
@@ -862,7 +1151,7 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
   // The lens refits (header, sigma_n_lenses): one per eigenpair of each
   // used camera's air lens covariance that carries variance.
   std::vector<LensPerturbation> lens_steps;
-  if (options.propagate_lens_covariance) {
+  if (options.propagate_lens_covariance && !model.joint) {
     lens_steps = LensPerturbations(air_rig, camera_used);
   }
   const int fold_steps = groups >= 2 ? groups : 0;
@@ -873,7 +1162,7 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     result.notes.push_back("leave-out: fewer than 2 views to leave out");
   }
   if (groups >= 2) {
-    std::vector<int> group_of(num_views, -1);
+    std::vector<int> group_of(parameters.cam0_from_target.size(), -1);
     for (size_t k = 0; k < used_views.size(); ++k) {
       group_of[used_views[k]] = static_cast<int>(k) % groups;
     }
@@ -891,6 +1180,9 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
       bool stereo_kept = false;
       for (const Corner& corner : corners) {
         if (group_of[corner.view] == k || !corner.inlier) continue;
+        // With the lenses held, only a shared board ties the air corners
+        // to the water's unknowns.
+        if (model.InAir(corner) && !model.same_board) continue;
         kept.push_back(corner);
         camera_kept[corner.camera] = true;
       }
@@ -918,7 +1210,8 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
       } else {
         HeldOutErrors(model, corners, group_of, k, replicate, solver_options,
                       &leave_out);
-        samples.push_back(ParameterVector(free, replicate, reference));
+        samples.push_back(
+            ParameterVector(free, replicate, lens_sizes, reference));
         if (free.extrinsics) {
           changes.push_back(ReportedChange(ChangeFromAir(
               air_extrinsics, RigidFromPose(replicate.cam1_from_cam0.data()))));
@@ -1033,6 +1326,14 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     }
   }
   return result;
+}
+
+bool SameTarget(const CalibrationTarget& a, const CalibrationTarget& b) {
+  return a.type == b.type && a.cols == b.cols && a.rows == b.rows &&
+         a.row_spacing == b.row_spacing && a.col_spacing == b.col_spacing &&
+         a.tag_size == b.tag_size && a.tag_spacing == b.tag_spacing &&
+         a.square_size == b.square_size && a.marker_size == b.marker_size &&
+         a.dictionary == b.dictionary;
 }
 
 bool IsIndexOnBoundError(const Status& status) {

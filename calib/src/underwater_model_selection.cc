@@ -226,7 +226,7 @@ StatusOr<UnderwaterModelSelection> SelectUnderwaterModel(
     const CalibrationTarget& target, const std::vector<StereoView>& views,
     const ImageSize& cam0_size, const ImageSize& cam1_size,
     const StereoRig& air_rig, const UnderwaterModelSelectionOptions& options,
-    const std::function<void(int, int)>& progress) {
+    const std::function<void(int, int)>& progress, const AirTargetViews* air) {
   RCM_RETURN_IF_ERROR(options.Check());
   const int num_candidates = static_cast<int>(options.candidates.size());
   // The candidates are independent: they share the threads, each fit on
@@ -237,7 +237,8 @@ StatusOr<UnderwaterModelSelection> SelectUnderwaterModel(
   // The lens refits (sigma_n_lenses) only count for the chosen candidate:
   // they run once, after the choice, as one more candidate's worth of steps.
   const bool lens_refits = options.fit.propagate_lens_covariance &&
-                           air_rig.calibration_uncertainty().has_value();
+                           air_rig.calibration_uncertainty().has_value() &&
+                           air == nullptr;
   const int total_steps = (num_candidates + (lens_refits ? 1 : 0)) * kSteps;
   UnderwaterModelSelection selection;
   selection.candidates.resize(num_candidates);
@@ -269,7 +270,8 @@ StatusOr<UnderwaterModelSelection> SelectUnderwaterModel(
           target, views, cam0_size, cam1_size, air_rig, fit,
           [&](int steps, int total) {
             report(k, steps * kSteps / std::max(total, 1));
-          });
+          },
+          air);
       if (result.ok()) {
         candidate.sigma_n_noise = NoiseSigma(*result);
         candidate.fit = *std::move(result);

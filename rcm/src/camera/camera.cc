@@ -250,6 +250,12 @@ StatusOr<Camera> Camera::Create(LensModelId model, int width, int height,
   return camera;
 }
 
+StatusOr<Camera> Camera::WithParams(const double* params) const {
+  return Create(model_, width_, height_,
+                {params[0], params[1], params[2], params[3]},
+                std::vector<double>(params + 4, params + num_params()));
+}
+
 std::vector<double> Camera::Distortion() const {
   return std::vector<double>(params_.begin() + 4,
                              params_.begin() + num_params());

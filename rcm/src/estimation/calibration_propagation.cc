@@ -42,10 +42,7 @@ std::optional<Camera> MovedCamera(const Camera& camera, int index,
   std::vector<double> params(camera.params(),
                              camera.params() + camera.num_params());
   params[index] += step;
-  StatusOr<Camera> moved = Camera::Create(
-      camera.model(), camera.width(), camera.height(),
-      {params[0], params[1], params[2], params[3]},
-      std::vector<double>(params.begin() + 4, params.end()));
+  StatusOr<Camera> moved = camera.WithParams(params.data());
   if (!moved.ok()) return std::nullopt;
   return *moved;
 }

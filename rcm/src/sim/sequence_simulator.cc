@@ -74,15 +74,11 @@ StatusOr<StereoRig> LensChange::Apply(const StereoRig& rig) const {
   RCM_RETURN_IF_ERROR(Check());
   std::array<Camera, 2> cameras = {rig.left(), rig.right()};
   for (int c = 0; c < 2; ++c) {
-    const double* params = cameras[c].params();
-    const std::array<double, 4> intrinsics = {
-        params[0] * (1.0 + focal_scale[c]), params[1] * (1.0 + focal_scale[c]),
-        params[2], params[3]};
-    const std::vector<double> distortion(params + 4,
-                                         params + cameras[c].num_params());
-    StatusOr<Camera> changed =
-        Camera::Create(cameras[c].model(), cameras[c].width(),
-                       cameras[c].height(), intrinsics, distortion);
+    std::vector<double> params(cameras[c].params(),
+                               cameras[c].params() + cameras[c].num_params());
+    params[0] *= 1.0 + focal_scale[c];
+    params[1] *= 1.0 + focal_scale[c];
+    StatusOr<Camera> changed = cameras[c].WithParams(params.data());
     if (!changed.ok()) return changed.status().WithContext("lens change");
     cameras[c] = *std::move(changed);
   }

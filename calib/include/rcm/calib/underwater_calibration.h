@@ -114,6 +114,22 @@ namespace rcm::calib {
 // cross-check need a few.
 inline constexpr int kMinUnderwaterViews = 3;
 
+// The air side of a joint calibration: views of a target in air taken by
+// the same two cameras (the air calibration's images, or others), so that
+// one bundle adjustment estimates the lenses from both media (header of
+// CalibrateUnderwater, "Air and water together").
+struct AirTargetViews {
+  CalibrationTarget target;  // the board shown in air
+  std::vector<StereoView> views;
+  ImageSize cam0_size;  // {0, 0} for a camera with no air view
+  ImageSize cam1_size;
+  // The air and water boards are one board: one warp for both media (the
+  // targets must then be equal). Otherwise the air board has its own warp,
+  // estimated when estimate_board_warp.
+  bool same_board = false;
+  bool estimate_board_warp = true;
+};
+
 struct UnderwaterCalibrationOptions {
   // n at which the target poses are initialized (thin-port PnP), and the
   // start of the solve: seawater ~1.34 (fresh water 1.333).
@@ -165,7 +181,8 @@ struct UnderwaterParameterBlock {
   // "n"; "cam1_from_cam0" [w (rad, cam1 frame, left perturbation),
   // t_10 (m)]; "cam0 air_gap", "cam1 air_gap" (m); "cam0 port_tilt",
   // "cam1 port_tilt" [N_x / N_z, N_y / N_z]; "board_warp" [warp_x,
-  // warp_y] (m).
+  // warp_y] (m); with air views, "cam0 lens", "cam1 lens"
+  // (Camera::params() order).
   std::string name;
   int offset = 0;
   int size = 0;
@@ -294,6 +311,27 @@ struct UnderwaterCalibration {
   Eigen::MatrixXd extrinsics_lens_covariance;
   Eigen::Matrix<double, 6, 6> extrinsics_covariance_from_lenses =
       Eigen::Matrix<double, 6, 6>::Zero();
+  // With air views (the joint calibration): the lenses were estimated from
+  // both media, rig holds them, and each camera's lens covariance is the
+  // joint covariance's block (empty for a camera no view saw). sigma_n,
+  // extrinsics_covariance and extrinsic_change.covariance are then the
+  // joint covariance's, less the lenses' share for sigma_n: with L the
+  // lens blocks,
+  //   sigma_n_lenses^2 = C_nL C_LL^-1 C_Ln,
+  //   sigma_n^2        = C_nn - sigma_n_lenses^2  (n's variance were the
+  //                                                lenses known),
+  // extrinsics_lens_covariance = J C_{[w; t], L} (J the Jacobian of the
+  // change [w; dt] in [w; t]) and extrinsics_covariance_from_lenses is
+  // zero (the extrinsics' covariance already counts the lenses).
+  bool lenses_estimated = false;
+  std::array<Eigen::MatrixXd, 2> lens_covariance;
+  // The air side of the joint fit: views used, the RMS of their corners
+  // (as rms_px), the air extrinsics and the air board's warp (the water
+  // board's under same_board).
+  int num_air_views_used = 0;
+  double air_rms_px = 0.0;
+  Rigid3d air_cam1_from_cam0;
+  Eigen::Vector2d air_board_warp = Eigen::Vector2d::Zero();
   // The air cameras (bit for bit), the underwater extrinsics and the ports
   // (with the estimated gaps and normals; none when the air rig had none
   // and nothing about the ports was estimated).
@@ -350,11 +388,31 @@ struct UnderwaterCalibration {
 // set, is called with (done, total) after the main fit and each leave-out
 // replicate, and then after each lens refit (sigma_n_lenses). Fails with
 // one line (header).
+//
+// Air and water together (`air` given): the air views' corners join the
+// same bundle adjustment,
+//   cam0:  e = pi(lens_0, R_a X(w_a) + t_a) - u
+//   cam1:  e = pi(lens_1, R_10air (R_a X(w_a) + t_a) + t_10air) - u
+// (board_reprojection_error.h) with their own poses (R_a, t_a), their own
+// extrinsics cam1_from_cam0 in air (a housing may turn between the air
+// calibration and the dive) and the air board's warp w_a (the water
+// board's under same_board), and the lenses of both cameras become
+// unknowns of both media (started from air_rig's). The robust fit, the
+// covariance and the leave-out run over the whole problem; the leave-out
+// groups are the water views, refitted with the lenses held (what their
+// spread measures is the water views' share; the lenses' is the
+// covariance's, sigma_n_lenses). No lens refits run. Errors beyond the
+// above: an air image size that differs from the air rig's camera,
+// same_board with targets that differ, no air view with a pose.
 StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     const CalibrationTarget& target, const std::vector<StereoView>& views,
     const ImageSize& cam0_size, const ImageSize& cam1_size,
     const StereoRig& air_rig, const UnderwaterCalibrationOptions& options = {},
-    const std::function<void(int, int)>& progress = nullptr);
+    const std::function<void(int, int)>& progress = nullptr,
+    const AirTargetViews* air = nullptr);
+
+// Whether two targets are the same board (type, counts and sizes).
+bool SameTarget(const CalibrationTarget& a, const CalibrationTarget& b);
 
 // Whether `status` is CalibrateUnderwater's refusal of an n that ends on a
 // bound of [1, 2] (the upper bound, or the lower one with the corners

@@ -154,11 +154,15 @@ struct UnderwaterModelSelection {
 // advance (the lens refits count as one more candidate), one call at a
 // time but from any of those threads. Fails with the simplest
 // candidate's error when no candidate can be fitted, or on bad options.
+// With `air` (the joint calibration of air and water, CalibrateUnderwater)
+// every candidate is the joint fit, whose covariance carries the lenses:
+// no lens refits run.
 StatusOr<UnderwaterModelSelection> SelectUnderwaterModel(
     const CalibrationTarget& target, const std::vector<StereoView>& views,
     const ImageSize& cam0_size, const ImageSize& cam1_size,
     const StereoRig& air_rig, const UnderwaterModelSelectionOptions& options,
-    const std::function<void(int, int)>& progress = nullptr);
+    const std::function<void(int, int)>& progress = nullptr,
+    const AirTargetViews* air = nullptr);
 
 }  // namespace rcm::calib
 

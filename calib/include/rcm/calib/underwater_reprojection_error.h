@@ -59,8 +59,9 @@ namespace underwater_internal {
 // pi(lens, port(n, d, N(tilt), P)) - pixel for a point P in the camera
 // frame; false where the port cannot image P.
 template <typename LensModel, typename T>
-bool ProjectThroughPort(const UnderwaterCameraConstants& constants, const T& n,
-                        const T& air_gap, const T* port_tilt, const T point[3],
+bool ProjectThroughPort(const UnderwaterCameraConstants& constants,
+                        const T* lens, const T& n, const T& air_gap,
+                        const T* port_tilt, const T point[3],
                         const Eigen::Vector2d& pixel, T* residuals) {
   using std::sqrt;
   const T norm =
@@ -72,13 +73,22 @@ bool ProjectThroughPort(const UnderwaterCameraConstants& constants, const T& n,
           normal, point, normalized)) {
     return false;
   }
+  board_internal::NormalizedPointResidual<LensModel>(
+      lens, normalized[0], normalized[1], pixel, residuals);
+  return true;
+}
+
+// The same with the constants' lens.
+template <typename LensModel, typename T>
+bool ProjectThroughPort(const UnderwaterCameraConstants& constants, const T& n,
+                        const T& air_gap, const T* port_tilt, const T point[3],
+                        const Eigen::Vector2d& pixel, T* residuals) {
   T lens[LensModel::kNumParams];
   for (int i = 0; i < LensModel::kNumParams; ++i) {
     lens[i] = T(constants.lens[i]);
   }
-  board_internal::NormalizedPointResidual<LensModel>(
-      lens, normalized[0], normalized[1], pixel, residuals);
-  return true;
+  return ProjectThroughPort<LensModel>(constants, lens, n, air_gap, port_tilt,
+                                       point, pixel, residuals);
 }
 
 }  // namespace underwater_internal
@@ -158,6 +168,96 @@ struct Cam1UnderwaterReprojectionError {
                                            1, 6, 6, 1, 2, 2>(
         new Cam1UnderwaterReprojectionError(constants, point_in_target,
                                             warp_basis, pixel));
+  }
+
+  const UnderwaterCameraConstants constants;
+  const Eigen::Vector3d point_in_target;
+  const Eigen::Vector2d warp_basis;
+  const Eigen::Vector2d pixel;
+};
+
+// The joint calibration of air and water (underwater_calibration.h,
+// AirTargetViews) estimates the lenses too: the same residuals with the
+// lens as the first block, [fx, fy, cx, cy, d...] (lens_models.h order,
+// LensModel::kNumParams); constants.lens is not used.
+
+// A corner seen by cam0: blocks (lens, n, cam0_from_target, air_gap,
+// port_tilt, board_warp).
+template <typename LensModel>
+struct Cam0UnderwaterLensReprojectionError {
+  Cam0UnderwaterLensReprojectionError(
+      const UnderwaterCameraConstants& constants,
+      const Eigen::Vector3d& point_in_target,
+      const Eigen::Vector2d& warp_basis, const Eigen::Vector2d& pixel)
+      : constants(constants),
+        point_in_target(point_in_target),
+        warp_basis(warp_basis),
+        pixel(pixel) {}
+
+  template <typename T>
+  bool operator()(const T* lens, const T* n, const T* cam0_from_target,
+                  const T* air_gap, const T* port_tilt, const T* board_warp,
+                  T* residuals) const {
+    T point_in_cam0[3];
+    board_internal::WarpedPointInCam0(point_in_target, warp_basis, board_warp,
+                                      cam0_from_target, point_in_cam0);
+    return underwater_internal::ProjectThroughPort<LensModel>(
+        constants, lens, n[0], air_gap[0], port_tilt, point_in_cam0, pixel,
+        residuals);
+  }
+
+  static ceres::CostFunction* Create(const UnderwaterCameraConstants& constants,
+                                     const Eigen::Vector3d& point_in_target,
+                                     const Eigen::Vector2d& warp_basis,
+                                     const Eigen::Vector2d& pixel) {
+    return new ceres::AutoDiffCostFunction<Cam0UnderwaterLensReprojectionError,
+                                           2, LensModel::kNumParams, 1, 6, 1,
+                                           2, 2>(
+        new Cam0UnderwaterLensReprojectionError(constants, point_in_target,
+                                                warp_basis, pixel));
+  }
+
+  const UnderwaterCameraConstants constants;
+  const Eigen::Vector3d point_in_target;
+  const Eigen::Vector2d warp_basis;
+  const Eigen::Vector2d pixel;
+};
+
+// A corner seen by cam1: blocks (lens, n, cam0_from_target, cam1_from_cam0,
+// air_gap, port_tilt, board_warp).
+template <typename LensModel>
+struct Cam1UnderwaterLensReprojectionError {
+  Cam1UnderwaterLensReprojectionError(
+      const UnderwaterCameraConstants& constants,
+      const Eigen::Vector3d& point_in_target,
+      const Eigen::Vector2d& warp_basis, const Eigen::Vector2d& pixel)
+      : constants(constants),
+        point_in_target(point_in_target),
+        warp_basis(warp_basis),
+        pixel(pixel) {}
+
+  template <typename T>
+  bool operator()(const T* lens, const T* n, const T* cam0_from_target,
+                  const T* cam1_from_cam0, const T* air_gap, const T* port_tilt,
+                  const T* board_warp, T* residuals) const {
+    T point_in_cam1[3];
+    board_internal::WarpedPointInCam1(point_in_target, warp_basis, board_warp,
+                                      cam0_from_target, cam1_from_cam0,
+                                      point_in_cam1);
+    return underwater_internal::ProjectThroughPort<LensModel>(
+        constants, lens, n[0], air_gap[0], port_tilt, point_in_cam1, pixel,
+        residuals);
+  }
+
+  static ceres::CostFunction* Create(const UnderwaterCameraConstants& constants,
+                                     const Eigen::Vector3d& point_in_target,
+                                     const Eigen::Vector2d& warp_basis,
+                                     const Eigen::Vector2d& pixel) {
+    return new ceres::AutoDiffCostFunction<Cam1UnderwaterLensReprojectionError,
+                                           2, LensModel::kNumParams, 1, 6, 6,
+                                           1, 2, 2>(
+        new Cam1UnderwaterLensReprojectionError(constants, point_in_target,
+                                                warp_basis, pixel));
   }
 
   const UnderwaterCameraConstants constants;

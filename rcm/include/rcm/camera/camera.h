@@ -119,6 +119,9 @@ class Camera {
   const double* params() const { return params_.data(); }
   int num_params() const { return 4 + NumDistortionParams(model_); }
   std::vector<double> Distortion() const;
+  // This camera (model, image size) with other parameters `params`
+  // (num_params() entries, the order of params()), checked as Create.
+  StatusOr<Camera> WithParams(const double* params) const;
 
   // Pixel of a normalized point (z = 1 plane, before distortion).
   template <typename T>
