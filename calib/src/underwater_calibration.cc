@@ -181,8 +181,7 @@ void AddResiduals(const Model& model, const std::vector<Corner>& corners,
     } else if (model.joint) {
       if (c == 0) {
         problem->AddResidualBlock(CostFor(model, corner), loss, lens,
-                                  &parameters->n, pose,
-                                  &parameters->air_gap[0],
+                                  &parameters->n, pose, &parameters->air_gap[0],
                                   parameters->tilt[0].data(), warp);
       } else {
         problem->AddResidualBlock(
@@ -253,9 +252,8 @@ bool EvaluateResidual(const Model& model, const Corner& corner,
     const Eigen::Vector3d& point = model.air_target_points[corner.point_id];
     const Eigen::Vector2d& basis = model.air_warp_basis[corner.point_id];
     if (corner.camera == 0) {
-      return Cam0WarpedBoardReprojectionError<LensModel>(point, basis,
-                                                         corner.pixel)(
-          lens, pose, warp, residual);
+      return Cam0WarpedBoardReprojectionError<LensModel>(
+          point, basis, corner.pixel)(lens, pose, warp, residual);
     }
     return Cam1WarpedBoardReprojectionError<LensModel>(point, basis,
                                                        corner.pixel)(
@@ -270,8 +268,8 @@ bool EvaluateResidual(const Model& model, const Corner& corner,
           lens, &parameters.n, pose, &parameters.air_gap[0],
           parameters.tilt[0].data(), warp, residual);
     }
-    return Cam1UnderwaterLensReprojectionError<LensModel>(
-        constants, point, basis, corner.pixel)(
+    return Cam1UnderwaterLensReprojectionError<LensModel>(constants, point,
+                                                          basis, corner.pixel)(
         lens, &parameters.n, pose, parameters.cam1_from_cam0.data(),
         &parameters.air_gap[1], parameters.tilt[1].data(), warp, residual);
   }
@@ -477,8 +475,8 @@ std::vector<LensPerturbation> LensPerturbations(
       air_rig.calibration_uncertainty();
   if (!uncertainty) return steps;
   const Camera* cameras[2] = {&air_rig.left(), &air_rig.right()};
-  const Eigen::MatrixXd* covariances[2] = {
-      &uncertainty->left_lens_covariance, &uncertainty->right_lens_covariance};
+  const Eigen::MatrixXd* covariances[2] = {&uncertainty->left_lens_covariance,
+                                           &uncertainty->right_lens_covariance};
   for (int c = 0; c < 2; ++c) {
     const Eigen::MatrixXd& covariance = *covariances[c];
     const int size = cameras[c]->num_params();
@@ -598,8 +596,8 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
             CameraName(c) + what + " images are " +
             std::to_string(sizes[c].width) + "x" +
             std::to_string(sizes[c].height) + " but the air calibration's " +
-            CameraName(c) + " is " + std::to_string(cameras[c]->width()) +
-            "x" + std::to_string(cameras[c]->height()) +
+            CameraName(c) + " is " + std::to_string(cameras[c]->width()) + "x" +
+            std::to_string(cameras[c]->height()) +
             ": the air rig is not these cameras' (or the images were scaled)");
       }
     }
@@ -734,10 +732,10 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
       }
     }
     if (num_air_views_used == 0) {
-      return Status::Error(
-          "no air view shows the target with at least " +
-          std::to_string(options.min_corners_per_view) + " corners (and a "
-          "pose)");
+      return Status::Error("no air view shows the target with at least " +
+                           std::to_string(options.min_corners_per_view) +
+                           " corners (and a "
+                           "pose)");
     }
   }
   if (num_views_used == 0) {
@@ -860,12 +858,11 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     std::array<Camera, 2> lenses = {air_rig.left(), air_rig.right()};
     for (int c = 0; c < 2; ++c) {
       if (!free.lens[c]) continue;
-      StatusOr<Camera> lens =
-          cameras[c]->WithParams(parameters.lens[c].data());
+      StatusOr<Camera> lens = cameras[c]->WithParams(parameters.lens[c].data());
       if (!lens.ok()) {
-        return Status::Error("the joint fit's " + CameraName(c) +
-                             " lens is not a valid camera: " +
-                             lens.status().message());
+        return Status::Error(
+            "the joint fit's " + CameraName(c) +
+            " lens is not a valid camera: " + lens.status().message());
       }
       lenses[c] = *std::move(lens);
     }
@@ -911,9 +908,8 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
         free.air_extrinsics
             ? RigidFromPose(parameters.air_cam1_from_cam0.data())
             : air_extrinsics;
-    const std::array<double, 2>& air_warp = air->same_board
-                                                ? parameters.board_warp
-                                                : parameters.air_board_warp;
+    const std::array<double, 2>& air_warp =
+        air->same_board ? parameters.board_warp : parameters.air_board_warp;
     result.air_board_warp = Eigen::Vector2d(air_warp[0], air_warp[1]);
   }
   result.initial_rms_px =
@@ -952,10 +948,10 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
   }
   const int redundancy = 2 * num_all_inliers - num_parameters;
   if (redundancy <= 0) {
-    return Status::Error(
-        "too few corners: " + std::to_string(num_all_inliers) +
-        " inlier corners for " + std::to_string(num_parameters) +
-        " unknowns (2 per corner must exceed them)");
+    return Status::Error("too few corners: " + std::to_string(num_all_inliers) +
+                         " inlier corners for " +
+                         std::to_string(num_parameters) +
+                         " unknowns (2 per corner must exceed them)");
   }
   result.pixel_sigma = std::sqrt(inlier_ssr / redundancy);
 
@@ -1008,8 +1004,7 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
         c_ll(i, j) = result.covariance.matrix(lens_rows[i], lens_rows[j]);
       }
     }
-    const double share =
-        std::max(0.0, c_ln.dot(c_ll.ldlt().solve(c_ln)));
+    const double share = std::max(0.0, c_ln.dot(c_ll.ldlt().solve(c_ln)));
     const double total = result.covariance.matrix(0, 0);
     result.sigma_n_lenses = std::sqrt(std::min(share, total));
     result.sigma_n = std::sqrt(std::max(0.0, total - share));
@@ -1039,8 +1034,7 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     // in air give 1e-13 against a sigma_n of 1e-16.)
     if (step < -kMaxPullBelowAir * result.sigma_n && step < -kOnBound) {
       return Status::Error(
-          std::string(kLowerBoundText) +
-          " and the corners pull it below by " +
+          std::string(kLowerBoundText) + " and the corners pull it below by " +
           FormatFixed(-step / result.sigma_n, 1) +
           " sigma, which no medium does: the air calibration probably does "
           "not describe these cameras (focal lengths too long, another "
@@ -1075,14 +1069,33 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     out.translation_mm = reported.tail<3>();
     out.covariance =
         jacobian * result.extrinsics_covariance * jacobian.transpose();
-    // The joint calibration: the change's covariance with the lenses.
+    // The joint calibration: the change's covariance with the lenses, and
+    // the correction that keeps a joint matrix without the cam0-cam1 lens
+    // block (the sidecar's) positive semi-definite (header).
     if (free.lens[0] && free.lens[1]) {
-      result.extrinsics_lens_covariance =
-          jacobian * (Eigen::MatrixXd(6, lens_sizes[0] + lens_sizes[1])
-                          << result.covariance.Block("cam1_from_cam0",
-                                                     "cam0 lens"),
-                      result.covariance.Block("cam1_from_cam0", "cam1 lens"))
-                         .finished();
+      const int size = lens_sizes[0] + lens_sizes[1];
+      const Eigen::MatrixXd cross =
+          (Eigen::MatrixXd(6, size)
+               << result.covariance.Block("cam1_from_cam0", "cam0 lens"),
+           result.covariance.Block("cam1_from_cam0", "cam1 lens"))
+              .finished();
+      Eigen::MatrixXd lenses(size, size);
+      lenses << result.covariance.Block("cam0 lens", "cam0 lens"),
+          result.covariance.Block("cam0 lens", "cam1 lens"),
+          result.covariance.Block("cam1 lens", "cam0 lens"),
+          result.covariance.Block("cam1 lens", "cam1 lens");
+      Eigen::MatrixXd per_camera = Eigen::MatrixXd::Zero(size, size);
+      per_camera.topLeftCorner(lens_sizes[0], lens_sizes[0]) =
+          lenses.topLeftCorner(lens_sizes[0], lens_sizes[0]);
+      per_camera.bottomRightCorner(lens_sizes[1], lens_sizes[1]) =
+          lenses.bottomRightCorner(lens_sizes[1], lens_sizes[1]);
+      const Eigen::MatrixXd correction =
+          cross * (per_camera.ldlt().solve(cross.transpose()) -
+                   lenses.ldlt().solve(cross.transpose()));
+      result.extrinsics_lens_covariance = jacobian * cross;
+      result.extrinsics_covariance_from_lenses =
+          jacobian * (0.5 * (correction + correction.transpose())) *
+          jacobian.transpose();
     }
     for (int i = 0; i < 3; ++i) {
       out.rotation_sigma_deg[i] =
@@ -1155,8 +1168,7 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     lens_steps = LensPerturbations(air_rig, camera_used);
   }
   const int fold_steps = groups >= 2 ? groups : 0;
-  const int total_steps =
-      1 + fold_steps + static_cast<int>(lens_steps.size());
+  const int total_steps = 1 + fold_steps + static_cast<int>(lens_steps.size());
   if (progress) progress(1, total_steps);
   if (options.folds > 0 && groups < 2) {
     result.notes.push_back("leave-out: fewer than 2 views to leave out");

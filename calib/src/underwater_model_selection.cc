@@ -29,8 +29,7 @@ double HeldOut(const UnderwaterCandidate& candidate, int v) {
 // Evidence and plausibility of the fitted candidates (header); returns
 // the number of common views.
 int WeighEvidence(double evidence_sigmas,
-                  std::vector<UnderwaterCandidate>* candidates,
-                  int num_views) {
+                  std::vector<UnderwaterCandidate>* candidates, int num_views) {
   std::vector<int> fitted;
   for (size_t k = 0; k < candidates->size(); ++k) {
     if ((*candidates)[k].fit) fitted.push_back(static_cast<int>(k));
@@ -78,16 +77,16 @@ int WeighEvidence(double evidence_sigmas,
     const double mean = (sum_log[k] - sum_log[best]) / num_common;
     std::vector<double> d;
     for (int v : common) {
-      d.push_back(std::log(std::max(HeldOut(candidate, v), kTinySsr) /
-                           std::max(HeldOut((*candidates)[best], v), kTinySsr)));
+      d.push_back(
+          std::log(std::max(HeldOut(candidate, v), kTinySsr) /
+                   std::max(HeldOut((*candidates)[best], v), kTinySsr)));
     }
     double sum = 0.0;
     for (const double x : d) sum += (x - mean) * (x - mean);
     const double se = std::sqrt(sum / (num_common - 1.0) / num_common);
     candidate.evidence =
         se > 0.0 ? mean / se
-                 : (mean > 0.0 ? std::numeric_limits<double>::infinity()
-                               : 0.0);
+                 : (mean > 0.0 ? std::numeric_limits<double>::infinity() : 0.0);
     candidate.plausible = candidate.evidence <= evidence_sigmas;
   }
   return static_cast<int>(common.size());
@@ -118,14 +117,15 @@ std::string Advice(const UnderwaterModelSelection& selection,
   double near = std::numeric_limits<double>::infinity();
   double far = 0.0;
   double tilt = 0.0;
-  for (const std::optional<Rigid3d>& pose : selection.Chosen().cam0_from_target) {
+  for (const std::optional<Rigid3d>& pose :
+       selection.Chosen().cam0_from_target) {
     if (!pose) continue;
     const double distance = pose->translation.norm();
     near = std::min(near, distance);
     far = std::max(far, distance);
     const double cosine = std::abs(pose->rotation.col(2).z());
-    tilt = std::max(tilt,
-                    kDegreesPerRadian * std::acos(std::clamp(cosine, 0.0, 1.0)));
+    tilt = std::max(
+        tilt, kDegreesPerRadian * std::acos(std::clamp(cosine, 0.0, 1.0)));
   }
   std::string what;
   std::string help;
@@ -194,11 +194,11 @@ std::vector<UnderwaterCandidateModel> UnderwaterCandidates(bool flat_board,
       candidates.push_back(port);
     }
   }
-  std::stable_sort(candidates.begin(), candidates.end(),
-                   [](const UnderwaterCandidateModel& a,
-                      const UnderwaterCandidateModel& b) {
-                     return a.ExtraParameters() < b.ExtraParameters();
-                   });
+  std::stable_sort(
+      candidates.begin(), candidates.end(),
+      [](const UnderwaterCandidateModel& a, const UnderwaterCandidateModel& b) {
+        return a.ExtraParameters() < b.ExtraParameters();
+      });
   return candidates;
 }
 
@@ -344,9 +344,9 @@ StatusOr<UnderwaterModelSelection> SelectUnderwaterModel(
         }
       }
     } else {
-      chosen.fit->notes.push_back(
-          "lens uncertainty: the refit failed (" + lenses.status().message() +
-          "); sigma_n leaves the lenses out");
+      chosen.fit->notes.push_back("lens uncertainty: the refit failed (" +
+                                  lenses.status().message() +
+                                  "); sigma_n leaves the lenses out");
     }
     report(num_candidates, kSteps);
   }
@@ -370,9 +370,9 @@ StatusOr<UnderwaterModelSelection> SelectUnderwaterModel(
             ? std::exp(-0.5 * candidate.evidence * candidate.evidence)
             : 1.0;
     const double difference = candidate.fit->n - selection.n;
-    const double noise = std::abs(candidate.sigma_n_noise *
-                                      candidate.sigma_n_noise -
-                                  chosen.sigma_n_noise * chosen.sigma_n_noise);
+    const double noise =
+        std::abs(candidate.sigma_n_noise * candidate.sigma_n_noise -
+                 chosen.sigma_n_noise * chosen.sigma_n_noise);
     const double bias2 = std::max(0.0, difference * difference - noise);
     weighted += weight * bias2;
     total_weight += weight;
@@ -382,19 +382,20 @@ StatusOr<UnderwaterModelSelection> SelectUnderwaterModel(
     }
   }
   selection.sigma_n_model = std::sqrt(weighted / total_weight);
-  selection.sigma_n = std::sqrt(selection.sigma_n_noise * selection.sigma_n_noise +
-                                selection.sigma_n_lenses * selection.sigma_n_lenses +
-                                selection.sigma_n_model * selection.sigma_n_model);
+  selection.sigma_n =
+      std::sqrt(selection.sigma_n_noise * selection.sigma_n_noise +
+                selection.sigma_n_lenses * selection.sigma_n_lenses +
+                selection.sigma_n_model * selection.sigma_n_model);
   selection.pinned = selection.sigma_n <= options.max_sigma_n;
   if (!selection.pinned) {
     if (spreading >= 0) {
-      selection.advice = Advice(selection, candidates[spreading].model,
-                                options.max_sigma_n);
+      selection.advice =
+          Advice(selection, candidates[spreading].model, options.max_sigma_n);
     } else {
       selection.advice =
           "this dive cannot pin n to " + FormatFixed(options.max_sigma_n, 4) +
-          ": sigma_n " + FormatFixed(selection.sigma_n, 4) +
-          " (noise " + FormatFixed(selection.sigma_n_noise, 4) + ", lenses " +
+          ": sigma_n " + FormatFixed(selection.sigma_n, 4) + " (noise " +
+          FormatFixed(selection.sigma_n_noise, 4) + ", lenses " +
           FormatFixed(selection.sigma_n_lenses, 4) +
           "): more views, at several distances and tilts, and a sharper "
           "air calibration would help";

@@ -17,12 +17,14 @@
 
 #include "air_flag.h"
 #include "air_gap_flag.h"
+#include "air_views_flags.h"
 #include "calibrate_underwater.h"
 #include "calibration_input.h"
 #include "calibration_run.h"
 #include "command.h"
 #include "image_input_flags.h"
 #include "lens_model_flag.h"
+#include "medium_flag.h"
 #include "progress.h"
 #include "rcm/calib/calibration_covariance.h"
 #include "rcm/calib/calibration_report.h"
@@ -37,7 +39,6 @@
 #include "rcm/io/camchain.h"
 #include "rcm/io/number_format.h"
 #include "target_flags.h"
-#include "medium_flag.h"
 
 DEFINE_string(report, "",
               "folder of the report (pictures, per-view CSV, JSON); default: "
@@ -103,7 +104,14 @@ constexpr char kUsage[] =
     "the air lenses' uncertainty in sigma_n; --left alone: one camera. It\n"
     "writes the camchain with the underwater extrinsics, which rcm estimate,\n"
     "undistort and export take as they are, and a report (underwater.json,\n"
-    "residual and coverage pictures, per-view RMS).\n\n"
+    "residual and coverage pictures, per-view RMS).\n"
+    "With the air views too (--air-left DIR --air-right DIR, or\n"
+    "--air-corners FILE with --air-left/--air-right naming its rows), one\n"
+    "bundle adjustment estimates the lenses from air and water together\n"
+    "(started from --air's), with n, both media's extrinsics and every pose;\n"
+    "--same-board: one board, one bow in both media (--air-target FILE: the\n"
+    "air board, when it is another). The camchain then holds those lenses\n"
+    "and its sidecar their joint covariance with the extrinsics.\n\n"
     "Boards: chessboard (OpenCV's "
     "findChessboardCornersSB;\n"
     "--cols/--rows count inner corners), aprilgrid (Kalibr's, AprilTag "
@@ -132,8 +140,8 @@ extern const Subcommand kCalibrateCommand = {
     "air stereo calibration from target images (folders or a ROS1 bag)",
     kUsage,
     {__FILE__, kImageInputFlagsSource, kCalibrationInputFlagsSource,
-     kTargetFlagsSource,
-     kLensModelFlagSource, kUnderwaterFlagsSource, kAirGapFlagSource, kAirFlagSource,
+     kTargetFlagsSource, kLensModelFlagSource, kUnderwaterFlagsSource,
+     kAirGapFlagSource, kAirFlagSource, kAirViewsFlagsSource,
      kMediumFlagSource},
     RunCalibrate};
 
@@ -221,10 +229,12 @@ int RunCalibrate() {
     return RunCalibrateUnderwater(command, *target, paths, underwater);
   }
   if (!FLAGS_air.empty() || FLAGS_estimate_air_gap ||
-      FLAGS_estimate_port_tilt || FLAGS_thin_port || !FLAGS_medium.empty()) {
+      FLAGS_estimate_port_tilt || FLAGS_thin_port || !FLAGS_medium.empty() ||
+      AirViewsGiven() || FLAGS_same_board || !FLAGS_air_target.empty()) {
     PrintError(command,
-               "--air, --estimate-air-gap, --estimate-port-tilt, --thin-port "
-               "and --medium go with --underwater");
+               "--air, --air-left/--air-right/--air-corners, --air-target, "
+               "--same-board, --estimate-air-gap, --estimate-port-tilt, "
+               "--thin-port and --medium go with --underwater");
     return kExitUsage;
   }
 
@@ -303,10 +313,9 @@ int RunCalibrate() {
             p.name + ": the leave-out spread (sigma " +
             (p.name == "board bowl"
                  ? FormatFixed(1e3 * p.jackknife_sigma, 3) + " mm"
-                 : FormatFixed(p.jackknife_sigma, p.unit == "m" ? 6 : 3) +
-                       " " + p.unit) +
-            ") is " +
-            FormatFixed(p.jackknife_sigma / p.reported_sigma, 1) +
+                 : FormatFixed(p.jackknife_sigma, p.unit == "m" ? 6 : 3) + " " +
+                       p.unit) +
+            ") is " + FormatFixed(p.jackknife_sigma / p.reported_sigma, 1) +
             "x the covariance's; corner errors are correlated within views "
             "(board flatness, blur, lens model): trust the leave-out figure");
         break;
@@ -485,15 +494,14 @@ int RunCalibrate() {
         s.intrinsics_only_uncertainty_median_px);
   }
   std::printf("%s\n", BoardFlatnessText(calibration->board_warp_estimated,
-                                         calibration->board_warp,
-                                         calibration->board_warp_covariance,
-                                         jackknife("board bowl"))
-                           .c_str());
+                                        calibration->board_warp,
+                                        calibration->board_warp_covariance,
+                                        jackknife("board bowl"))
+                          .c_str());
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();
-  std::printf("wrote %s (with %s) and %s/ in %.1f s\n",
-              paths.camchain.c_str(),
+  std::printf("wrote %s (with %s) and %s/ in %.1f s\n", paths.camchain.c_str(),
               CovarianceSidecarPath(paths.camchain).c_str(),
               paths.report.c_str(), seconds);
   return kExitOk;

@@ -10,18 +10,19 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
-#include <optional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "air_flag.h"
 #include "air_gap_flag.h"
+#include "air_views_flags.h"
 #include "calibration_input.h"
 #include "calibration_run.h"
 #include "image_input_flags.h"
-#include "progress.h"
 #include "medium_flag.h"
+#include "progress.h"
 #include "rcm/calib/calibration_report.h"
 #include "rcm/calib/underwater_calibration.h"
 #include "rcm/calib/underwater_model_selection.h"
@@ -55,7 +56,6 @@ using calib::StereoView;
 using calib::UnderwaterCalibration;
 using calib::UnderwaterCandidate;
 using calib::UnderwaterModelSelection;
-
 
 std::string SizeText(int width, int height) {
   return std::to_string(width) + "x" + std::to_string(height);
@@ -110,8 +110,13 @@ CalibrationCovarianceFile UnderwaterCovarianceFile(
   CalibrationCovarianceFile file;
   file.medium = "water";
   file.cameras.resize(2);
-  if (const std::optional<CalibrationUncertainty>& air =
-          air_rig.calibration_uncertainty()) {
+  if (result.lenses_estimated) {
+    // The joint fit's lenses and their covariance (it counts the air views
+    // and the water's).
+    file.cameras[0].intrinsics_covariance = result.lens_covariance[0];
+    file.cameras[1].intrinsics_covariance = result.lens_covariance[1];
+  } else if (const std::optional<CalibrationUncertainty>& air =
+                 air_rig.calibration_uncertainty()) {
     file.cameras[0].intrinsics_covariance = air->left_lens_covariance;
     file.cameras[1].intrinsics_covariance = air->right_lens_covariance;
     if (!result.extrinsics_estimated) {
@@ -124,9 +129,9 @@ CalibrationCovarianceFile UnderwaterCovarianceFile(
         scale * scale * result.extrinsic_change.covariance;
     // The extrinsics were fitted through the air lenses: their covariance
     // with the lenses, and the lenses' share of their own.
-    const int lens_size = static_cast<int>(
-        file.cameras[0].intrinsics_covariance.rows() +
-        file.cameras[1].intrinsics_covariance.rows());
+    const int lens_size =
+        static_cast<int>(file.cameras[0].intrinsics_covariance.rows() +
+                         file.cameras[1].intrinsics_covariance.rows());
     if (file.cameras[0].intrinsics_covariance.size() > 0 &&
         file.cameras[1].intrinsics_covariance.size() > 0 &&
         result.extrinsics_lens_covariance.cols() == lens_size) {
@@ -230,8 +235,8 @@ std::string CandidateTable(const UnderwaterModelSelection& selection) {
       std::to_string(selection.num_evidence_views) +
       " views; plausible within 2):\n";
   char line[256];
-  std::snprintf(line, sizeof(line), "  %-40s %-19s %8s %9s %9s\n", "model",
-                "n", "rms px", "held-out", "evidence");
+  std::snprintf(line, sizeof(line), "  %-40s %-19s %8s %9s %9s\n", "model", "n",
+                "rms px", "held-out", "evidence");
   table += line;
   for (size_t k = 0; k < selection.candidates.size(); ++k) {
     const UnderwaterCandidate& candidate = selection.candidates[k];
@@ -242,15 +247,13 @@ std::string CandidateTable(const UnderwaterModelSelection& selection) {
       table += "  " + name + ": " + candidate.error + "\n";
       continue;
     }
-    const std::string held_out =
-        std::isfinite(candidate.held_out_rms_px)
-            ? FormatFixed(candidate.held_out_rms_px, 4)
-            : std::string("-");
-    const std::string evidence =
-        std::isfinite(candidate.evidence)
-            ? FormatFixed(candidate.evidence, 1) +
-                  (candidate.plausible ? "" : " x")
-            : std::string("-");
+    const std::string held_out = std::isfinite(candidate.held_out_rms_px)
+                                     ? FormatFixed(candidate.held_out_rms_px, 4)
+                                     : std::string("-");
+    const std::string evidence = std::isfinite(candidate.evidence)
+                                     ? FormatFixed(candidate.evidence, 1) +
+                                           (candidate.plausible ? "" : " x")
+                                     : std::string("-");
     std::snprintf(
         line, sizeof(line), "  %-40s %-19s %8.4f %9s %9s\n", name.c_str(),
         WithSigma(candidate.fit->n, candidate.sigma_n_noise, 5, std::nullopt)
@@ -312,6 +315,22 @@ int RunCalibrateUnderwater(const Subcommand& command,
       return kExitFailure;
     }
   }
+  // The air views of the joint calibration, read before anything is
+  // written.
+  std::optional<AirViewsInput> air_views;
+  if (AirViewsGiven() || FLAGS_same_board || !FLAGS_air_target.empty()) {
+    StatusOr<AirViewsInput> read =
+        ReadAirViews(target, run.estimate_board_warp);
+    if (!read.ok()) {
+      PrintError(command, read.status().message());
+      return kExitFailure;
+    }
+    air_views = *std::move(read);
+    if (!FLAGS_json) {
+      std::cout << "rcm calibrate --underwater: " << air_views->description
+                << " (lenses from air and water together)" << std::endl;
+    }
+  }
   StatusOr<CalibrationInput> input = ReadCalibrationInput(
       target, /*allow_left_only=*/true, paths,
       [&target](const std::string& description) {
@@ -327,9 +346,8 @@ int RunCalibrateUnderwater(const Subcommand& command,
   }
   const Detections* detections = &input->detections;
   const bool one_camera = !detections->sizes[1].has_value() &&
-                          detections->right_only == 0 &&
-                          FLAGS_right.empty() && FLAGS_pairs.empty() &&
-                          FLAGS_bag.empty();
+                          detections->right_only == 0 && FLAGS_right.empty() &&
+                          FLAGS_pairs.empty() && FLAGS_bag.empty();
   if (const Status status = CheckDetections(*detections, one_camera);
       !status.ok()) {
     PrintError(command, "under water: " + status.message());
@@ -363,16 +381,18 @@ int RunCalibrateUnderwater(const Subcommand& command,
   // The selection reports hundredths of a candidate; the bar counts
   // candidates, with the percentage of the one being fitted.
   const size_t num_candidates = options.candidates.size();
-  std::optional<Progress> solving(
-      std::in_place, "rcm calibrate: underwater candidate models",
-      num_candidates);
+  std::optional<Progress> solving(std::in_place,
+                                  "rcm calibrate: underwater candidate models",
+                                  num_candidates);
   const StatusOr<UnderwaterModelSelection> selection =
       calib::SelectUnderwaterModel(
           target, views, sizes[0], one_camera ? ImageSize{0, 0} : sizes[1],
-          *air_rig, options, [&solving](int done, int) {
+          *air_rig, options,
+          [&solving](int done, int) {
             solving->Update(static_cast<size_t>(done / 100),
                             std::to_string(done % 100) + " % of the next");
-          });
+          },
+          air_views ? &air_views->views : nullptr);
   solving.reset();
   if (!selection.ok()) {
     PrintError(command, selection.status().message());
@@ -393,13 +413,17 @@ int RunCalibrateUnderwater(const Subcommand& command,
 
   // The report first, the camchain last.
   calib::CalibrationReport report;
-  if (const Status status = WriteUnderwaterReport(
-          paths.report, *result, views, sizes, one_camera, &report);
+  if (const Status status = WriteUnderwaterReport(paths.report, *result, views,
+                                                  sizes, one_camera, &report);
       !status.ok()) {
     PrintError(command, status.message());
     return kExitFailure;
   }
   std::vector<std::string> warnings = result->notes;
+  if (air_views) {
+    warnings.insert(warnings.begin(), air_views->warnings.begin(),
+                    air_views->warnings.end());
+  }
   if (!selection->pinned) warnings.push_back(selection->advice);
   // The medium (--medium): n against its physics.
   nlohmann::json medium_json = nullptr;
@@ -415,8 +439,7 @@ int RunCalibrateUnderwater(const Subcommand& command,
   }
   if (conventional.ok && conventional.pixel_sigma < 0.9 * result->pixel_sigma) {
     warnings.push_back(
-        "a conventional " +
-        std::string(LensModelName(conventional.model)) +
+        "a conventional " + std::string(LensModelName(conventional.model)) +
         " model fitted freely to the same corners fits them better (pixel "
         "noise " +
         FormatFixed(conventional.pixel_sigma, 3) + " px against " +
@@ -426,7 +449,8 @@ int RunCalibrateUnderwater(const Subcommand& command,
         "--estimate-port-tilt), or the lenses changed since the air "
         "calibration");
   }
-  for (const std::string& warning : report.warnings) warnings.push_back(warning);
+  for (const std::string& warning : report.warnings)
+    warnings.push_back(warning);
 
   const calib::ExtrinsicChange& change = result->extrinsic_change;
   nlohmann::json json;
@@ -465,7 +489,8 @@ int RunCalibrateUnderwater(const Subcommand& command,
     json["extrinsic_change"] = {
         {"angle_deg", change.angle_deg},
         {"angle_sigma_deg", change.angle_sigma_deg},
-        {"angle_leave_out_sigma_deg", JsonNumber(change.angle_leave_out_sigma_deg)},
+        {"angle_leave_out_sigma_deg",
+         JsonNumber(change.angle_leave_out_sigma_deg)},
         {"rotation_deg", Vector3Json(change.rotation_deg)},
         {"rotation_sigma_deg", Vector3Json(change.rotation_sigma_deg)},
         {"translation_mm", Vector3Json(change.translation_mm)},
@@ -493,6 +518,18 @@ int RunCalibrateUnderwater(const Subcommand& command,
   json["board_flatness"] =
       BoardFlatnessJson(result->board_warp_estimated, result->board_warp,
                         result->board_warp_covariance);
+  if (air_views) {
+    json["air_views"] = {
+        {"source", air_views->description},
+        {"views_used", result->num_air_views_used},
+        {"rms_px", result->air_rms_px},
+        {"same_board", air_views->views.same_board},
+        {"board_warp_mm",
+         {1e3 * result->air_board_warp.x(), 1e3 * result->air_board_warp.y()}}};
+  } else {
+    json["air_views"] = nullptr;
+  }
+  json["lenses_estimated"] = result->lenses_estimated;
   json["warnings"] = warnings;
   if (Status status = WriteFileAtomically(
           (std::filesystem::path(paths.report) / "underwater.json").string(),
@@ -529,6 +566,13 @@ int RunCalibrateUnderwater(const Subcommand& command,
   std::printf("%d views used (%d stereo), %d corners, %d outliers\n",
               result->num_views_used, result->num_stereo_views,
               result->num_inliers + result->num_outliers, result->num_outliers);
+  if (air_views) {
+    std::printf(
+        "air views: %d used, rms %.4f px; the lenses estimated from air and "
+        "water together%s\n",
+        result->num_air_views_used, result->air_rms_px,
+        air_views->views.same_board ? ", one board (one bow) in both" : "");
+  }
   std::printf(
       "refractive model: rms %.4f px (inliers %.4f px), pixel noise %.4f px "
       "per axis\n",
@@ -544,15 +588,18 @@ int RunCalibrateUnderwater(const Subcommand& command,
   }
   std::printf("%s", CandidateTable(*selection).c_str());
   std::printf(
-      "n %s (%s)\n  sigma_n: noise %.5f (covariance %.5f%s), air lenses "
+      "n %s (%s)\n  sigma_n: noise %.5f (covariance %.5f%s), %s "
       "%.5f%s, models the data cannot tell apart %.5f\n",
       WithSigma(selection->n, selection->sigma_n, 5, std::nullopt).c_str(),
       model.Name().c_str(), selection->sigma_n_noise, result->sigma_n,
       result->sigma_n_leave_out
-          ? (", leave-out " + FormatFixed(*result->sigma_n_leave_out, 5)).c_str()
+          ? (", leave-out " + FormatFixed(*result->sigma_n_leave_out, 5))
+                .c_str()
           : "",
+      result->lenses_estimated ? "lenses (joint fit)" : "air lenses",
       selection->sigma_n_lenses,
-      result->sigma_n_lenses ? "" : " (the air camchain has no lens covariance)",
+      result->sigma_n_lenses ? ""
+                             : " (the air camchain has no lens covariance)",
       selection->sigma_n_model);
   std::printf("below: +- covariance sigma%s\n",
               result->sigma_n_leave_out ? " (leave-out sigma)" : "");
@@ -574,9 +621,9 @@ int RunCalibrateUnderwater(const Subcommand& command,
     std::printf("board flatness: flat in the chosen model\n");
   } else {
     std::printf("%s\n", BoardFlatnessText(result->board_warp_estimated,
-                                           result->board_warp,
-                                           result->board_warp_covariance)
-                             .c_str());
+                                          result->board_warp,
+                                          result->board_warp_covariance)
+                            .c_str());
   }
   for (int c = 0; c < (one_camera ? 1 : 2); ++c) {
     const calib::PortEstimate& port = result->ports[c];

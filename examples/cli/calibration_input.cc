@@ -78,18 +78,18 @@ StatusOr<NamePattern> PatternFromFlag(const std::string& flag,
   return NamePattern{pattern.substr(0, at), pattern.substr(at + 1)};
 }
 
-StatusOr<calib::ImageSize> ImageSizeFromFlag() {
-  const StatusOr<std::vector<double>> numbers =
-      ParseNumberList(FLAGS_image_size);
+StatusOr<calib::ImageSize> ImageSizeFromFlag(const std::string& value) {
+  const StatusOr<std::vector<double>> numbers = ParseNumberList(value);
   const auto side = [](double value) {
     return value >= 1.0 && value <= Camera::kMaxImageSide &&
            value == std::floor(value);
   };
   if (!numbers.ok() || numbers->size() != 2 || !side((*numbers)[0]) ||
       !side((*numbers)[1])) {
-    return Status::Error("--image-size " + FLAGS_image_size +
+    return Status::Error("--image-size " + value +
                          ": expected W,H in pixels, e.g. 640,480 (each in "
-                         "[1, " + std::to_string(Camera::kMaxImageSide) + "])");
+                         "[1, " +
+                         std::to_string(Camera::kMaxImageSide) + "])");
   }
   return calib::ImageSize{static_cast<int>((*numbers)[0]),
                           static_cast<int>((*numbers)[1])};
@@ -114,26 +114,27 @@ std::string Count(int n, const std::string& what) {
   return std::to_string(n) + " " + what + (n == 1 ? "" : "s");
 }
 
+}  // namespace
+
 StatusOr<CalibrationInput> ReadCornersInput(
-    const calib::CalibrationTarget& target, bool allow_left_only) {
-  if (!FLAGS_pairs.empty() || !FLAGS_bag.empty()) {
+    const calib::CalibrationTarget& target, bool allow_left_only,
+    const CornersSource& source) {
+  if (source.left.empty() || (source.right.empty() && !allow_left_only)) {
     return Status::Error(
-        "--corners takes --left and --right (the images' names in the file), "
-        "not --pairs or --bag");
-  }
-  if (FLAGS_left.empty() || (FLAGS_right.empty() && !allow_left_only)) {
-    return Status::Error(
-        "--corners needs --left and --right: each camera's images as named in "
+        source.flags.file + " needs " + source.flags.left + " and " +
+        source.flags.right +
+        ": each camera's images as named in "
         "the file, a folder or a pattern with one '*' (e.g. --left "
         "'data/left*.jpg' --right 'data/right*.jpg')");
   }
   StatusOr<std::vector<CornersFileImage>> images =
-      calib::ReadCornersFile(FLAGS_corners, calib::NumTargetPoints(target));
+      calib::ReadCornersFile(source.file, calib::NumTargetPoints(target));
   if (!images.ok()) return images.status();
-  StatusOr<NamePattern> patterns[2] = {PatternFromFlag("--left", FLAGS_left),
-                                       NamePattern{}};
-  const bool two_cameras = !FLAGS_right.empty();
-  if (two_cameras) patterns[1] = PatternFromFlag("--right", FLAGS_right);
+  StatusOr<NamePattern> patterns[2] = {
+      PatternFromFlag(source.flags.left, source.left), NamePattern{}};
+  const bool two_cameras = !source.right.empty();
+  if (two_cameras)
+    patterns[1] = PatternFromFlag(source.flags.right, source.right);
   for (const StatusOr<NamePattern>& pattern : patterns) {
     if (!pattern.ok()) return pattern.status();
   }
@@ -160,10 +161,12 @@ StatusOr<CalibrationInput> ReadCornersInput(
     StereoView& view = detections.views[it->second];
     std::string& name = camera == 0 ? view.left_name : view.right_name;
     if (!name.empty()) {
-      return Status::Error(FLAGS_corners + ": " + name + " and " +
+      return Status::Error(source.file + ": " + name + " and " +
                            image.filename + " both pair as '" + *key +
                            "' for the " + (camera == 0 ? "left" : "right") +
-                           " camera: give --left/--right patterns that tell "
+                           " camera: give " + source.flags.left + "/" +
+                           source.flags.right +
+                           " patterns that tell "
                            "the images apart");
     }
     name = image.filename;
@@ -171,17 +174,18 @@ StatusOr<CalibrationInput> ReadCornersInput(
     (camera == 0 ? view.left : view.right) = std::move(image.observation);
   }
   if (detections.views.empty()) {
-    return Status::Error(FLAGS_corners + ": none of its " +
-                         Count(static_cast<int>(images->size()), "image") +
-                         " matches --left " + FLAGS_left +
-                         (two_cameras ? " or --right " + FLAGS_right : "") +
-                         " (the first is " + first_unmatched + ")");
+    return Status::Error(
+        source.file + ": none of its " +
+        Count(static_cast<int>(images->size()), "image") + " matches " +
+        source.flags.left + " " + source.left +
+        (two_cameras ? " or " + source.flags.right + " " + source.right : "") +
+        " (the first is " + first_unmatched + ")");
   }
   if (unmatched > 0) {
     detections.warnings.push_back(
-        FLAGS_corners + ": " + Count(unmatched, "image") +
-        " match neither --left nor --right and are not used (the first is " +
-        first_unmatched + ")");
+        source.file + ": " + Count(unmatched, "image") + " match neither " +
+        source.flags.left + " nor " + source.flags.right +
+        " and are not used (the first is " + first_unmatched + ")");
   }
   for (StereoView& view : detections.views) {
     if (!two_cameras) {
@@ -207,30 +211,32 @@ StatusOr<CalibrationInput> ReadCornersInput(
   CountViews(&detections);
 
   std::optional<calib::ImageSize> given;
-  if (!FLAGS_image_size.empty()) {
-    StatusOr<calib::ImageSize> size = ImageSizeFromFlag();
+  if (!source.image_size.empty()) {
+    StatusOr<calib::ImageSize> size = ImageSizeFromFlag(source.image_size);
     if (!size.ok()) return size.status();
     given = *size;
   }
-  const fs::path folder = fs::path(FLAGS_corners).parent_path();
+  const fs::path folder = fs::path(source.file).parent_path();
   for (int c = 0; c < (two_cameras ? 2 : 1); ++c) {
     if (names[c].empty()) continue;
     detections.sizes[c] = given ? given : SizeOfFirstReadable(names[c], folder);
     if (!detections.sizes[c]) {
       return Status::Error(
-          FLAGS_corners + ": none of the " + (c == 0 ? "left" : "right") +
+          source.file + ": none of the " + (c == 0 ? "left" : "right") +
           " images it names can be read for their size (the first is " +
           names[c].front() + "): give --image-size W,H");
     }
   }
   input.description =
-      "corners file " + FLAGS_corners + ": " +
+      "corners file " + source.file + ": " +
       Count(static_cast<int>(images->size()) - unmatched, "image") +
       (two_cameras ? ", " + Count(detections.stereo, "pair") +
                          " with the target in both"
                    : "");
   return input;
 }
+
+namespace {
 
 // A name the corners file can hold: a bag's "topic @ stamp" without blanks.
 std::string CornersFileName(std::string name) {
@@ -268,8 +274,8 @@ Status CheckCornersOut() {
     return Status::Error("--corners-out " + FLAGS_corners_out +
                          ": is a folder, expected the file to write");
   }
-  const fs::path folder = path.parent_path().empty() ? fs::path(".")
-                                                      : path.parent_path();
+  const fs::path folder =
+      path.parent_path().empty() ? fs::path(".") : path.parent_path();
   if (!fs::is_directory(folder, error)) {
     return Status::Error("--corners-out " + FLAGS_corners_out + ": folder " +
                          folder.string() + " does not exist");
@@ -288,7 +294,14 @@ StatusOr<CalibrationInput> ReadCalibrationInput(
   RCM_RETURN_IF_ERROR(CheckCornersOut());
   CalibrationInput input;
   if (CornersInputGiven()) {
-    StatusOr<CalibrationInput> read = ReadCornersInput(target, allow_left_only);
+    if (!FLAGS_pairs.empty() || !FLAGS_bag.empty()) {
+      return Status::Error(
+          "--corners takes --left and --right (the images' names in the "
+          "file), not --pairs or --bag");
+    }
+    StatusOr<CalibrationInput> read = ReadCornersInput(
+        target, allow_left_only,
+        {FLAGS_corners, FLAGS_left, FLAGS_right, FLAGS_image_size, {}});
     if (!read.ok()) return read.status();
     input = std::move(read).value();
     RCM_RETURN_IF_ERROR(CheckCalibrationOutputPaths(paths));

@@ -35,12 +35,34 @@ extern const char kCalibrationInputFlagsSource[];
 // --corners is given (the images are not read, only their sizes).
 bool CornersInputGiven();
 
+// A corners file and the names of its images per camera: --corners with
+// --left/--right (--image-size), or the air views' --air-corners with
+// --air-left/--air-right.
+struct CornersSource {
+  std::string file;
+  std::string left;        // a folder or a pattern with one '*'
+  std::string right;       // empty: one camera (when allowed)
+  std::string image_size;  // "W,H" or empty
+  // The flags the values came from, for messages.
+  struct Flags {
+    std::string file = "--corners";
+    std::string left = "--left";
+    std::string right = "--right";
+  } flags;
+};
+
 struct CalibrationInput {
   Detections detections;
   // "folders L and R: 13 pairs, paired by name", "corners file F: 26
   // images, 13 pairs".
   std::string description;
 };
+
+// The views of a corners file, paired by name (header). Every failure is
+// one line naming the flags.
+StatusOr<CalibrationInput> ReadCornersInput(
+    const calib::CalibrationTarget& target, bool allow_left_only,
+    const CornersSource& source);
 
 // Opens the input (corners file or images), checks that the outputs can be
 // written (CheckCalibrationOutputPaths), calls `started(description)`, then

@@ -71,16 +71,15 @@ Camera Moved(const Camera& camera, double scale, double shift, double dk1) {
 // since), and an air calibration whose lenses are off (the start).
 struct Rigs {
   StereoRig air = NarrowRadTanRig();
-  StereoRig water = air.WithCam1Moved(0.5 * kDegree *
-                                          Eigen::Vector3d(0.3, -1.0, 0.2)
-                                              .normalized(),
-                                      Eigen::Vector3d(3e-4, -1e-4, 2e-4))
-                        .value();
-  StereoRig start =
-      StereoRig::Create(Moved(air.left(), 0.004, 1.5, 0.004),
-                        Moved(air.right(), -0.003, -2.0, -0.003),
-                        air.right_from_left())
+  StereoRig water =
+      air.WithCam1Moved(
+             0.5 * kDegree * Eigen::Vector3d(0.3, -1.0, 0.2).normalized(),
+             Eigen::Vector3d(3e-4, -1e-4, 2e-4))
           .value();
+  StereoRig start = StereoRig::Create(Moved(air.left(), 0.004, 1.5, 0.004),
+                                      Moved(air.right(), -0.003, -2.0, -0.003),
+                                      air.right_from_left())
+                        .value();
 };
 
 struct Case {
@@ -151,9 +150,9 @@ TEST(JointAirWaterCalibration, ExactRecoversLensesNAndBothExtrinsics) {
              c.rigs.water.right_from_left().translation)
                 .norm(),
             kExact);
-  EXPECT_LT(RotationError(result->air_cam1_from_cam0,
-                          c.rigs.air.right_from_left()),
-            kExact);
+  EXPECT_LT(
+      RotationError(result->air_cam1_from_cam0, c.rigs.air.right_from_left()),
+      kExact);
   EXPECT_LT((result->air_cam1_from_cam0.translation -
              c.rigs.air.right_from_left().translation)
                 .norm(),
@@ -223,11 +222,22 @@ TEST(JointAirWaterCalibration, LensShareSplitsTheJointVariance) {
   }
   ASSERT_EQ(result->extrinsics_lens_covariance.rows(), 6);
   ASSERT_EQ(result->extrinsics_lens_covariance.cols(), 16);
-  EXPECT_EQ(result->extrinsics_covariance_from_lenses,
-            (Eigen::Matrix<double, 6, 6>::Zero()));
-  std::printf("joint: sigma_n %.6f (noise %.6f, lenses %.6f), sigma_fx0 %.3f px\n",
-              std::sqrt(c_nn), result->sigma_n, *result->sigma_n_lenses,
-              std::sqrt(result->lens_covariance[0](0, 0)));
+  // The sidecar's joint matrix (no cam0-cam1 lens block) with the
+  // correction is positive semi-definite.
+  Eigen::MatrixXd sidecar = Eigen::MatrixXd::Zero(22, 22);
+  sidecar.topLeftCorner<6, 6>() = result->extrinsic_change.covariance +
+                                  result->extrinsics_covariance_from_lenses;
+  sidecar.block(0, 6, 6, 16) = result->extrinsics_lens_covariance;
+  sidecar.block(6, 0, 16, 6) = result->extrinsics_lens_covariance.transpose();
+  sidecar.block(6, 6, 8, 8) = result->lens_covariance[0];
+  sidecar.block(14, 14, 8, 8) = result->lens_covariance[1];
+  const Eigen::VectorXd eigenvalues =
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(sidecar).eigenvalues();
+  EXPECT_GE(eigenvalues.minCoeff(), -1e-12 * eigenvalues.maxCoeff());
+  std::printf(
+      "joint: sigma_n %.6f (noise %.6f, lenses %.6f), sigma_fx0 %.3f px\n",
+      std::sqrt(c_nn), result->sigma_n, *result->sigma_n_lenses,
+      std::sqrt(result->lens_covariance[0](0, 0)));
 }
 
 TEST(JointAirWaterCalibration, MonteCarloSigmaIsHonest) {
@@ -256,9 +266,10 @@ TEST(JointAirWaterCalibration, MonteCarloSigmaIsHonest) {
   }
   const rcm::test::SampleMoments n = rcm::test::Moments(z_n);
   const rcm::test::SampleMoments lens = rcm::test::Moments(z_lens);
-  std::printf("joint Monte Carlo: z(n) mean %.3f sd %.3f; z(fx, cx) mean %.3f "
-              "sd %.3f\n",
-              n.mean, n.stddev, lens.mean, lens.stddev);
+  std::printf(
+      "joint Monte Carlo: z(n) mean %.3f sd %.3f; z(fx, cx) mean %.3f "
+      "sd %.3f\n",
+      n.mean, n.stddev, lens.mean, lens.stddev);
   EXPECT_GT(n.stddev, 0.8);
   EXPECT_LT(n.stddev, 1.3);
   EXPECT_LT(std::abs(n.mean), 3.0 / std::sqrt(kTrials));

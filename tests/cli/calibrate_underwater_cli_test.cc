@@ -435,6 +435,88 @@ TEST(UnderwaterCli, NPinnedAtTheUpperBound) {
                 "upper bound");
 }
 
+// The joint calibration of air and water: the dive of the narrow rig and
+// 12 views of the same board in air (rcm simulate --n 1), one bundle
+// adjustment (flat board, thin ports: one candidate). n within 3 sigma
+// of the truth (and 2e-3, as the water-only fit above), the lenses no
+// longer the air camchain's bits, their covariance in the sidecar (the
+// joint fit's) with the extrinsics' correlation, and the air views in the
+// JSON.
+TEST(UnderwaterCli, JointAirAndWater) {
+  const std::string dive = Folder("dive");
+  Simulate(dive, DriftedDive("narrow", 0.03));
+  const std::string air = Folder("air");
+  Simulate(air, "--rig narrow --frame-rate 1 --n 1 --frames " +
+                    std::to_string(test::kSanitizerBuild ? 4 : 12) + " " +
+                    Board(0.03));
+  const std::string water = Folder("water");
+  const nlohmann::json json = Json(CalibrateUnderwater(
+      dive, water, 0.03,
+      Folds() + " --flat-board --thin-port --same-board --air-left " + air +
+          "/left --air-right " + air + "/right"));
+  std::printf("joint: n %.5f +- %.5f (noise %.5f, lenses %.5f), air views %d "
+              "rms %.3f px\n",
+              json["n"].get<double>(), json["sigma_n"].get<double>(),
+              json["sigma_n_noise"].get<double>(),
+              json["sigma_n_lenses"].get<double>(),
+              json["air_views"]["views_used"].get<int>(),
+              json["air_views"]["rms_px"].get<double>());
+  EXPECT_TRUE(json["lenses_estimated"].get<bool>());
+  EXPECT_TRUE(json["air_views"]["same_board"].get<bool>());
+  EXPECT_GE(json["air_views"]["views_used"].get<int>(),
+            test::kSanitizerBuild ? 3 : 10);
+  EXPECT_GT(json["sigma_n_lenses"].get<double>(), 0.0);
+  const double error = json["n"].get<double>() - kTrueN;
+  // (The lenses are unknowns now: 12 air views leave them a share of
+  // sigma_n, 0.0025 of 0.0028 on this dive, that the water-only fit with
+  // the true lenses above does not have.)
+  if (test::ChecksStatistics()) {
+    EXPECT_LE(std::abs(error), 3.0 * json["sigma_n"].get<double>());
+  }
+  const CalibrationCovarianceFile written =
+      ReadCalibrationCovariance(water + "/camchain-covariance.yaml").value();
+  for (int c = 0; c < 2; ++c) {
+    EXPECT_EQ(written.cameras[c].intrinsics_covariance.rows(), 8) << c;
+  }
+  EXPECT_EQ(written.cameras[1].from_previous_intrinsics_covariance.rows(), 6);
+  EXPECT_EQ(written.cameras[1].from_previous_intrinsics_covariance.cols(), 16);
+  const Camchain air_chain = ReadCamchain(dive + "/camchain.yaml").value();
+  const Camchain water_chain = ReadCamchain(water + "/camchain.yaml").value();
+  EXPECT_FALSE(air_chain.cameras[0].camera == water_chain.cameras[0].camera);
+  const double fx = water_chain.cameras[0].camera.fx();
+  EXPECT_NEAR(fx, air_chain.cameras[0].camera.fx(),
+              5.0 * std::sqrt(written.cameras[0].intrinsics_covariance(0, 0)) +
+                  1e-6 * fx);
+
+  // Bad input: air images of another size, --same-board with another air
+  // board, --air-left alone: one line, exit 1 (2 for flags), nothing
+  // written.
+  const std::string other = Folder("other");
+  Simulate(other, "--frames 3 --frame-rate 1 --n 1 " + Board(0.03));
+  const std::string refused = Folder("refused");
+  ExpectRefused(CalibrateUnderwater(dive, refused, 0.03,
+                                    "--folds 0 --air-left " + other +
+                                        "/left --air-right " + other +
+                                        "/right"),
+                refused, "cam0 air images are ");
+  const std::string board = test::TempFilePath("air-board.yaml");
+  {
+    std::ofstream file(board);
+    file << "target_type: 'checkerboard'\ntargetCols: 9\ntargetRows: 6\n"
+            "rowSpacingMeters: 0.025\ncolSpacingMeters: 0.025\n";
+  }
+  ExpectRefused(CalibrateUnderwater(dive, refused, 0.03,
+                                    "--folds 0 --same-board --air-target " +
+                                        board + " --air-left " + air +
+                                        "/left --air-right " + air + "/right"),
+                refused, "is not the water board");
+  ExpectRefused(CalibrateUnderwater(dive, refused, 0.03,
+                                    "--folds 0 --air-left " + air + "/left"),
+                refused, "--air-left and --air-right go together");
+  ExpectRefused(CalibrateUnderwater(dive, refused, 0.03, "--same-board"),
+                refused, "--same-board goes with air views");
+}
+
 TEST(UnderwaterCli, FlagsThatNeedUnderwater) {
   const std::string water = Folder("water");
   ExpectRefused(Rcm(Words("calibrate --air a.yaml --left l --right r --out " +

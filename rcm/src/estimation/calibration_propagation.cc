@@ -54,8 +54,8 @@ struct Difference {
   double step = 0.0;
 };
 
-std::vector<Difference> LensDifferences(const StereoRig& rig,
-                                        const CalibrationParameterLayout& layout) {
+std::vector<Difference> LensDifferences(
+    const StereoRig& rig, const CalibrationParameterLayout& layout) {
   std::vector<Difference> differences;
   for (int c = 0; c < 2; ++c) {
     const Camera& camera = c == 0 ? rig.left() : rig.right();
@@ -68,8 +68,9 @@ std::vector<Difference> LensDifferences(const StereoRig& rig,
             MovedCamera(camera, j, sign * difference.step);
         if (!moved) continue;
         StatusOr<StereoRig> moved_rig =
-            c == 0 ? StereoRig::Create(*moved, rig.right(), rig.right_from_left())
-                   : StereoRig::Create(rig.left(), *moved, rig.right_from_left());
+            c == 0
+                ? StereoRig::Create(*moved, rig.right(), rig.right_from_left())
+                : StereoRig::Create(rig.left(), *moved, rig.right_from_left());
         if (!moved_rig.ok()) continue;
         (sign > 0.0 ? difference.plus : difference.minus) = *moved_rig;
       }
@@ -128,11 +129,11 @@ class LocusResidualModel {
                 double* dr_dn) const {
     using Jet = ceres::Jet<double, 1>;
     Jet residual;
-    const bool ok =
-        thick_ ? GeneralizedEpipolarResidual<Jet>(stereo_, match, Jet(n, 0),
-                                                  Jet(0.0), &residual)
-               : SampsonCoplanarityResidual<Jet>(essential_, match, Jet(n, 0),
-                                                 nullptr, &residual);
+    const bool ok = thick_
+                        ? GeneralizedEpipolarResidual<Jet>(
+                              stereo_, match, Jet(n, 0), Jet(0.0), &residual)
+                        : SampsonCoplanarityResidual<Jet>(
+                              essential_, match, Jet(n, 0), nullptr, &residual);
     if (!ok || !ceres::isfinite(residual)) return false;
     *r = residual.a;
     if (dr_dn != nullptr) *dr_dn = residual.v[0];
@@ -168,8 +169,8 @@ void AccumulateLocusNormalEquations(
     for (int s = 0; s < 2; ++s) {
       Eigen::Vector3d w = rotation;
       Eigen::Vector3d dt = Eigen::Vector3d::Zero();
-      const double step = (s == 0 ? 1.0 : -1.0) *
-                          (k < 3 ? kRotationStep : kTranslationStep);
+      const double step =
+          (s == 0 ? 1.0 : -1.0) * (k < 3 ? kRotationStep : kTranslationStep);
       (k < 3 ? w[k] : dt[k - 3]) += step;
       const StatusOr<StereoRig> shifted = rig.WithCam1Moved(w, dt);
       if (shifted.ok()) {
@@ -278,9 +279,9 @@ QuadraticSelfCalibration SelfCalibrateQuadratic(
       x.tail<3>() = -h.bottomRightCorner<3, 3>().ldlt().solve(
           intercept.tail<3>() + m.block<3, 1>(1, 0) * x[0]);
     }
-    const double data = std::max(
-        0.0, equations.intercept_squares + 2.0 * intercept.dot(x) +
-                 x.dot(m * x));
+    const double data =
+        std::max(0.0, equations.intercept_squares + 2.0 * intercept.dot(x) +
+                          x.dot(m * x));
     const double updated = data / dof;
     result.n = x[0];
     result.rotation = x.tail<3>();
@@ -298,8 +299,8 @@ double ChiSquaredUpperTail(double chi_squared, int dof) {
   if (!(chi_squared > 0.0)) return 1.0;
   const double k = static_cast<double>(dof);
   const double scale = 2.0 / (9.0 * k);
-  const double z = (std::cbrt(chi_squared / k) - (1.0 - scale)) /
-                   std::sqrt(scale);
+  const double z =
+      (std::cbrt(chi_squared / k) - (1.0 - scale)) / std::sqrt(scale);
   return 0.5 * std::erfc(z / std::sqrt(2.0));
 }
 
@@ -317,7 +318,8 @@ std::optional<FrameConsistency> Finish(FrameConsistency consistency,
       ChiSquaredUpperTail(consistency.chi_squared, consistency.dof);
   if (consistency.p_value < FrameConsistency::kInflationP &&
       consistency.chi_squared > consistency.dof) {
-    consistency.inflation = std::sqrt(consistency.chi_squared / consistency.dof);
+    consistency.inflation =
+        std::sqrt(consistency.chi_squared / consistency.dof);
   }
   return consistency;
 }
@@ -364,8 +366,8 @@ std::optional<FrameConsistency> FrameConsistencyOf(
   FrameConsistency consistency;
   consistency.frames = sums.frames;
   // Rounding can take the difference of large sums a little below zero.
-  consistency.chi_squared = std::max(0.0, sums.WeightedSquares(n, rotation)) /
-                            (sigma_px * sigma_px);
+  consistency.chi_squared =
+      std::max(0.0, sums.WeightedSquares(n, rotation)) / (sigma_px * sigma_px);
   return Finish(consistency, sigma_px);
 }
 
@@ -466,7 +468,8 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
   }
   Eigen::MatrixXd prior = Eigen::MatrixXd::Zero(nx, nx);
   if (mode == RotationMode::kPrior) {
-    const Eigen::Matrix3d rotation_covariance = uncertainty.RotationCovariance();
+    const Eigen::Matrix3d rotation_covariance =
+        uncertainty.RotationCovariance();
     const Eigen::LDLT<Eigen::Matrix3d> ldlt(rotation_covariance);
     if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) {
       return Status::Error(
@@ -475,7 +478,8 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
     prior.bottomRightCorner<3, 3>() = ldlt.solve(Eigen::Matrix3d::Identity());
   }
   Eigen::MatrixXd n_prior = Eigen::MatrixXd::Zero(nx, nx);
-  if (n_prior_sigma > 0.0) n_prior(0, 0) = 1.0 / (n_prior_sigma * n_prior_sigma);
+  if (n_prior_sigma > 0.0)
+    n_prior(0, 0) = 1.0 / (n_prior_sigma * n_prior_sigma);
   prior += n_prior;
   // In the sigma^2-scaled form, stable down to exact data (sigma = 0):
   // H' = sigma^2 H = A + sigma^2 P, S = H'^-1 B.
@@ -543,8 +547,7 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
   result.variance_medium = from_n_prior(0, 0);
   result.variance_rotation += from_prior(0, 0) - from_n_prior(0, 0);
 
-  const double noise_variance =
-      noise(0, 0) * noise_inflation * noise_inflation;
+  const double noise_variance = noise(0, 0) * noise_inflation * noise_inflation;
   const double calibration_variance = std::max(
       0.0, from_prior(0, 0) + from_held(0, 0) - result.variance_systematic);
   result.sigma_n_noise = std::sqrt(std::max(0.0, noise_variance));

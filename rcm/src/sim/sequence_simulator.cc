@@ -198,8 +198,7 @@ std::vector<StereoCorrespondence> SequenceSimulator::SampleMatches(
   const Camera& left_camera = true_rig_.left();
   const Camera& right_camera = true_rig_.right();
 
-  std::mt19937_64 rng(
-      DeriveSeed(DeriveSeed(options_.seed, kMatchSeed), index));
+  std::mt19937_64 rng(DeriveSeed(DeriveSeed(options_.seed, kMatchSeed), index));
   std::uniform_real_distribution<double> u(-0.5, left_camera.width() - 0.5);
   std::uniform_real_distribution<double> v(-0.5, left_camera.height() - 0.5);
 
@@ -207,9 +206,8 @@ std::vector<StereoCorrespondence> SequenceSimulator::SampleMatches(
   matches.reserve(options_.matches_per_frame);
   const int64_t max_draws =
       static_cast<int64_t>(kDrawsPerMatch) * options_.matches_per_frame;
-  for (int64_t draw = 0; draw < max_draws &&
-                         static_cast<int>(matches.size()) <
-                             options_.matches_per_frame;
+  for (int64_t draw = 0; draw < max_draws && static_cast<int>(matches.size()) <
+                                                 options_.matches_per_frame;
        ++draw) {
     // v before u, in a statement of its own: arguments are evaluated in an
     // unspecified order (gcc right to left, clang left to right), and seeded

@@ -321,8 +321,15 @@ struct UnderwaterCalibration {
   //   sigma_n^2        = C_nn - sigma_n_lenses^2  (n's variance were the
   //                                                lenses known),
   // extrinsics_lens_covariance = J C_{[w; t], L} (J the Jacobian of the
-  // change [w; dt] in [w; t]) and extrinsics_covariance_from_lenses is
-  // zero (the extrinsics' covariance already counts the lenses).
+  // change [w; dt] in [w; t]). The extrinsics' covariance already counts
+  // the lenses; a sidecar holds each camera's lens covariance but not the
+  // cam0-cam1 block, and the joint matrix without it need not be positive
+  // semi-definite, so extrinsics_covariance_from_lenses is the correction
+  //   J C_eL (D^-1 - C_LL^-1) C_Le J^T,   D = the per-camera blocks of
+  //                                         C_LL,
+  // with which the sidecar's extrinsics covariance is their covariance
+  // given the lenses plus C_eL D^-1 C_Le: the written joint matrix is then
+  // positive semi-definite, its cross block the true one.
   bool lenses_estimated = false;
   std::array<Eigen::MatrixXd, 2> lens_covariance;
   // The air side of the joint fit: views used, the RMS of their corners

@@ -86,8 +86,8 @@ struct UnderwaterCandidateModel {
 // The candidates: the board flat and, unless `flat_board`, bowed; the
 // ports thin when `thin_port`, else as `air_gap` / `port_tilt` say when
 // either is set, else all four (thin, with an air gap, tilted, both).
-// Simplest first. (thin_port with air_gap or port_tilt is the caller's to refuse:
-// thin_port wins here.)
+// Simplest first. (thin_port with air_gap or port_tilt is the caller's to
+// refuse: thin_port wins here.)
 std::vector<UnderwaterCandidateModel> UnderwaterCandidates(
     bool flat_board, bool air_gap, bool port_tilt, bool thin_port = false);
 
@@ -143,7 +143,9 @@ struct UnderwaterModelSelection {
   // When not pinned: one line, what limits n and what views would help.
   std::string advice;
 
-  const UnderwaterCalibration& Chosen() const { return *candidates[chosen].fit; }
+  const UnderwaterCalibration& Chosen() const {
+    return *candidates[chosen].fit;
+  }
 };
 
 // Fits every candidate and chooses (header). The candidates are fitted

@@ -108,8 +108,7 @@ struct Cam0UnderwaterReprojectionError {
 
   template <typename T>
   bool operator()(const T* n, const T* cam0_from_target, const T* air_gap,
-                  const T* port_tilt, const T* board_warp,
-                  T* residuals) const {
+                  const T* port_tilt, const T* board_warp, T* residuals) const {
     T point_in_cam0[3];
     board_internal::WarpedPointInCam0(point_in_target, warp_basis, board_warp,
                                       cam0_from_target, point_in_cam0);
@@ -187,8 +186,8 @@ template <typename LensModel>
 struct Cam0UnderwaterLensReprojectionError {
   Cam0UnderwaterLensReprojectionError(
       const UnderwaterCameraConstants& constants,
-      const Eigen::Vector3d& point_in_target,
-      const Eigen::Vector2d& warp_basis, const Eigen::Vector2d& pixel)
+      const Eigen::Vector3d& point_in_target, const Eigen::Vector2d& warp_basis,
+      const Eigen::Vector2d& pixel)
       : constants(constants),
         point_in_target(point_in_target),
         warp_basis(warp_basis),
@@ -211,8 +210,8 @@ struct Cam0UnderwaterLensReprojectionError {
                                      const Eigen::Vector2d& warp_basis,
                                      const Eigen::Vector2d& pixel) {
     return new ceres::AutoDiffCostFunction<Cam0UnderwaterLensReprojectionError,
-                                           2, LensModel::kNumParams, 1, 6, 1,
-                                           2, 2>(
+                                           2, LensModel::kNumParams, 1, 6, 1, 2,
+                                           2>(
         new Cam0UnderwaterLensReprojectionError(constants, point_in_target,
                                                 warp_basis, pixel));
   }
@@ -229,8 +228,8 @@ template <typename LensModel>
 struct Cam1UnderwaterLensReprojectionError {
   Cam1UnderwaterLensReprojectionError(
       const UnderwaterCameraConstants& constants,
-      const Eigen::Vector3d& point_in_target,
-      const Eigen::Vector2d& warp_basis, const Eigen::Vector2d& pixel)
+      const Eigen::Vector3d& point_in_target, const Eigen::Vector2d& warp_basis,
+      const Eigen::Vector2d& pixel)
       : constants(constants),
         point_in_target(point_in_target),
         warp_basis(warp_basis),
@@ -254,8 +253,8 @@ struct Cam1UnderwaterLensReprojectionError {
                                      const Eigen::Vector2d& warp_basis,
                                      const Eigen::Vector2d& pixel) {
     return new ceres::AutoDiffCostFunction<Cam1UnderwaterLensReprojectionError,
-                                           2, LensModel::kNumParams, 1, 6, 6,
-                                           1, 2, 2>(
+                                           2, LensModel::kNumParams, 1, 6, 6, 1,
+                                           2, 2>(
         new Cam1UnderwaterLensReprojectionError(constants, point_in_target,
                                                 warp_basis, pixel));
   }
