@@ -1015,6 +1015,10 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
         result.lens_covariance[c] = result.covariance.Block(name, name);
       }
     }
+    if (free.lens[0] && free.lens[1]) {
+      result.lens_cross_covariance =
+          result.covariance.Block("cam0 lens", "cam1 lens");
+    }
   }
   // Within one sigma of the upper bound is the bound too: the data cannot
   // tell the estimate from 2.
@@ -1069,33 +1073,14 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     out.translation_mm = reported.tail<3>();
     out.covariance =
         jacobian * result.extrinsics_covariance * jacobian.transpose();
-    // The joint calibration: the change's covariance with the lenses, and
-    // the correction that keeps a joint matrix without the cam0-cam1 lens
-    // block (the sidecar's) positive semi-definite (header).
+    // The joint calibration: the change's covariance with the lenses.
     if (free.lens[0] && free.lens[1]) {
-      const int size = lens_sizes[0] + lens_sizes[1];
-      const Eigen::MatrixXd cross =
-          (Eigen::MatrixXd(6, size)
+      result.extrinsics_lens_covariance =
+          jacobian *
+          (Eigen::MatrixXd(6, lens_sizes[0] + lens_sizes[1])
                << result.covariance.Block("cam1_from_cam0", "cam0 lens"),
            result.covariance.Block("cam1_from_cam0", "cam1 lens"))
               .finished();
-      Eigen::MatrixXd lenses(size, size);
-      lenses << result.covariance.Block("cam0 lens", "cam0 lens"),
-          result.covariance.Block("cam0 lens", "cam1 lens"),
-          result.covariance.Block("cam1 lens", "cam0 lens"),
-          result.covariance.Block("cam1 lens", "cam1 lens");
-      Eigen::MatrixXd per_camera = Eigen::MatrixXd::Zero(size, size);
-      per_camera.topLeftCorner(lens_sizes[0], lens_sizes[0]) =
-          lenses.topLeftCorner(lens_sizes[0], lens_sizes[0]);
-      per_camera.bottomRightCorner(lens_sizes[1], lens_sizes[1]) =
-          lenses.bottomRightCorner(lens_sizes[1], lens_sizes[1]);
-      const Eigen::MatrixXd correction =
-          cross * (per_camera.ldlt().solve(cross.transpose()) -
-                   lenses.ldlt().solve(cross.transpose()));
-      result.extrinsics_lens_covariance = jacobian * cross;
-      result.extrinsics_covariance_from_lenses =
-          jacobian * (0.5 * (correction + correction.transpose())) *
-          jacobian.transpose();
     }
     for (int i = 0; i < 3; ++i) {
       out.rotation_sigma_deg[i] =

@@ -115,6 +115,8 @@ CalibrationCovarianceFile UnderwaterCovarianceFile(
     // and the water's).
     file.cameras[0].intrinsics_covariance = result.lens_covariance[0];
     file.cameras[1].intrinsics_covariance = result.lens_covariance[1];
+    file.cameras[1].previous_intrinsics_covariance =
+        result.lens_cross_covariance;
   } else if (const std::optional<CalibrationUncertainty>& air =
                  air_rig.calibration_uncertainty()) {
     file.cameras[0].intrinsics_covariance = air->left_lens_covariance;

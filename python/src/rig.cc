@@ -90,6 +90,7 @@ py::object UncertaintyDict(const StereoRig& rig) {
   result["left_lens_covariance"] = ToNumpy(u.left_lens_covariance);
   result["right_lens_covariance"] = ToNumpy(u.right_lens_covariance);
   result["extrinsics_lens_covariance"] = ToNumpy(u.extrinsics_lens_covariance);
+  result["lens_cross_covariance"] = ToNumpy(u.lens_cross_covariance);
   return std::move(result);
 }
 
@@ -212,7 +213,9 @@ exact); one read from a file carries the default drift prior (0.1 degree,
                              "in rad and m), left_lens_covariance, "
                              "right_lens_covariance, "
                              "extrinsics_lens_covariance (6 x (p_l + p_r), "
-                             "empty when uncorrelated)) or None (exact).")
+                             "empty when uncorrelated), lens_cross_covariance "
+                             "(p_l x p_r, of a joint calibration; empty when "
+                             "uncorrelated)) or None (exact).")
       .def(
           "with_ports",
           [](const StereoRig& r, const FlatPort& left, const FlatPort& right) {

@@ -38,6 +38,7 @@ def test_reads_the_demo_camchain(demo_rig_path):
         np.diag(uncertainty["extrinsics_covariance"])[:3], sigma**2, rtol=1e-12)
     # No lens covariance, so no correlation of the extrinsics with one.
     assert uncertainty["extrinsics_lens_covariance"].size == 0
+    assert uncertainty["lens_cross_covariance"].size == 0
 
 
 def test_write_reads_back_identical(tmp_path, demo_rig_path):

@@ -222,18 +222,22 @@ TEST(JointAirWaterCalibration, LensShareSplitsTheJointVariance) {
   }
   ASSERT_EQ(result->extrinsics_lens_covariance.rows(), 6);
   ASSERT_EQ(result->extrinsics_lens_covariance.cols(), 16);
-  // The sidecar's joint matrix (no cam0-cam1 lens block) with the
-  // correction is positive semi-definite.
-  Eigen::MatrixXd sidecar = Eigen::MatrixXd::Zero(22, 22);
-  sidecar.topLeftCorner<6, 6>() = result->extrinsic_change.covariance +
-                                  result->extrinsics_covariance_from_lenses;
-  sidecar.block(0, 6, 6, 16) = result->extrinsics_lens_covariance;
-  sidecar.block(6, 0, 16, 6) = result->extrinsics_lens_covariance.transpose();
-  sidecar.block(6, 6, 8, 8) = result->lens_covariance[0];
-  sidecar.block(14, 14, 8, 8) = result->lens_covariance[1];
-  const Eigen::VectorXd eigenvalues =
-      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(sidecar).eigenvalues();
-  EXPECT_GE(eigenvalues.minCoeff(), -1e-12 * eigenvalues.maxCoeff());
+  EXPECT_EQ(result->extrinsics_covariance_from_lenses,
+            (Eigen::Matrix<double, 6, 6>::Zero()));
+  // The lenses' joint block, and the calibration uncertainty a target-free
+  // estimate reads from the sidecar is positive semi-definite and holds
+  // the joint covariance's blocks.
+  ASSERT_EQ(result->lens_cross_covariance.rows(), 8);
+  ASSERT_EQ(result->lens_cross_covariance.cols(), 8);
+  EXPECT_EQ(result->lens_cross_covariance,
+            result->covariance.Block("cam0 lens", "cam1 lens"));
+  CalibrationUncertainty sidecar;
+  sidecar.extrinsics_covariance = result->extrinsic_change.covariance;
+  sidecar.left_lens_covariance = result->lens_covariance[0];
+  sidecar.right_lens_covariance = result->lens_covariance[1];
+  sidecar.extrinsics_lens_covariance = result->extrinsics_lens_covariance;
+  sidecar.lens_cross_covariance = result->lens_cross_covariance;
+  EXPECT_TRUE(sidecar.Check(8, 8).ok()) << sidecar.Check(8, 8).message();
   std::printf(
       "joint: sigma_n %.6f (noise %.6f, lenses %.6f), sigma_fx0 %.3f px\n",
       std::sqrt(c_nn), result->sigma_n, *result->sigma_n_lenses,

@@ -193,6 +193,53 @@ TEST(CalibrationCovarianceFile, ExtrinsicsLensCrossCovariance) {
       HasSubstr("expected 2 numbers, got 1"));
 }
 
+// The cam0-cam1 lens block of a joint calibration (intrinsics_cross_
+// covariance on cam1): written, read back bit for bit, handed to the
+// pair's uncertainty, and checked with the rest of the joint matrix.
+TEST(CalibrationCovarianceFile, LensCrossCovariance) {
+  const Eigen::MatrixXd full = Covariance(22, 1e-3, 4);  // [w; dt; 8; 8]
+  CalibrationCovarianceFile file = SampleFile();
+  file.cameras[1].from_previous_covariance = full.topLeftCorner<6, 6>();
+  file.cameras[0].intrinsics_covariance = full.block(6, 6, 8, 8);
+  file.cameras[1].intrinsics_covariance = full.block(14, 14, 8, 8);
+  file.cameras[1].from_previous_intrinsics_covariance = full.block(0, 6, 6, 16);
+  file.cameras[1].previous_intrinsics_covariance = full.block(6, 14, 8, 8);
+  const std::string text = FormatCalibrationCovariance(file);
+  EXPECT_THAT(text, HasSubstr("intrinsics_cross_covariance:"));
+  const CalibrationCovarianceFile read =
+      ParseCalibrationCovariance(text, "c.yaml").value();
+  EXPECT_EQ(read.cameras[1].previous_intrinsics_covariance,
+            file.cameras[1].previous_intrinsics_covariance);
+  EXPECT_EQ(FormatCalibrationCovariance(read), text);
+  const CalibrationUncertainty pair =
+      PairCalibrationUncertainty(read, 0, 1, "c.yaml").value();
+  EXPECT_EQ(pair.lens_cross_covariance,
+            file.cameras[1].previous_intrinsics_covariance);
+  EXPECT_TRUE(pair.Check(8, 8).ok());
+  // The joint matrix's lens rows are the full one's (to the rounding of
+  // a * a^T's symmetry; the extrinsics block has the file's drift prior
+  // added).
+  EXPECT_LT((pair.JointCovariance() - full).bottomRows(16).norm(),
+            1e-14 * full.norm());
+
+  const auto error = [](CalibrationCovarianceFile bad) {
+    return ParseCalibrationCovariance(FormatCalibrationCovariance(bad),
+                                      "side.yaml")
+        .status()
+        .message();
+  };
+  CalibrationCovarianceFile bad = file;
+  bad.cameras[1].previous_intrinsics_covariance *= 1e3;
+  EXPECT_THAT(error(bad), HasSubstr("not positive semi-definite"));
+  bad = file;
+  bad.cameras[1].previous_intrinsics_covariance.conservativeResize(8, 7);
+  EXPECT_THAT(error(bad), HasSubstr("is 8x7, not 8x8"));
+  bad = file;
+  bad.cameras[1].from_previous_intrinsics_covariance.resize(0, 0);
+  bad.cameras[0].intrinsics_covariance.resize(0, 0);
+  EXPECT_THAT(error(bad), HasSubstr("needs both cameras' intrinsics"));
+}
+
 // ReadStereoRig attaches the sidecar when there is one, and the default
 // drift prior otherwise; a camera count that differs from the camchain's,
 // or a lens covariance of the wrong size, is an error naming the sidecar.

@@ -408,6 +408,17 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
     calibration.block(layout.LeftLens(), 1, num_lens, 6) =
         uncertainty.extrinsics_lens_covariance.transpose();
   }
+  // The lenses' correlation with each other (a joint calibration's).
+  if (uncertainty.lens_cross_covariance.rows() == layout.num_left_lens &&
+      uncertainty.lens_cross_covariance.cols() == layout.num_right_lens &&
+      layout.num_left_lens > 0 && layout.num_right_lens > 0) {
+    calibration.block(layout.LeftLens(), layout.RightLens(),
+                      layout.num_left_lens, layout.num_right_lens) =
+        uncertainty.lens_cross_covariance;
+    calibration.block(layout.RightLens(), layout.LeftLens(),
+                      layout.num_right_lens, layout.num_left_lens) =
+        uncertainty.lens_cross_covariance.transpose();
+  }
   for (int k = 0; k < layout.NumSystematic(); ++k) {
     calibration(layout.Systematic() + k, layout.Systematic() + k) =
         layout.systematic_px * layout.systematic_px;

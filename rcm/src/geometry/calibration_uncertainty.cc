@@ -86,6 +86,11 @@ Eigen::MatrixXd CalibrationUncertainty::JointCovariance() const {
     joint.block(0, 6, 6, left + right) = extrinsics_lens_covariance;
     joint.block(6, 0, left + right, 6) = extrinsics_lens_covariance.transpose();
   }
+  if (left > 0 && right > 0 && lens_cross_covariance.rows() == left &&
+      lens_cross_covariance.cols() == right) {
+    joint.block(6, 6 + left, left, right) = lens_cross_covariance;
+    joint.block(6 + left, 6, right, left) = lens_cross_covariance.transpose();
+  }
   return joint;
 }
 
@@ -109,13 +114,31 @@ Status CalibrationUncertainty::Check(int left_num_params,
     }
     RCM_RETURN_IF_ERROR(CheckCovarianceMatrix(*lenses[c], name));
   }
-  if (extrinsics_lens_covariance.size() == 0) return Status::Ok();
+  if (extrinsics_lens_covariance.size() == 0 &&
+      lens_cross_covariance.size() == 0) {
+    return Status::Ok();
+  }
   if (left_lens_covariance.size() == 0 || right_lens_covariance.size() == 0) {
     return Status::Error(
-        "cam1_from_cam0-lens cross-covariance needs both lens covariances");
+        std::string(extrinsics_lens_covariance.size() > 0
+                        ? "cam1_from_cam0-lens cross-covariance"
+                        : "left-right lens cross-covariance") +
+        " needs both lens covariances");
   }
-  if (extrinsics_lens_covariance.rows() != 6 ||
-      extrinsics_lens_covariance.cols() != left_num_params + right_num_params) {
+  if (lens_cross_covariance.size() > 0 &&
+      (lens_cross_covariance.rows() != left_num_params ||
+       lens_cross_covariance.cols() != right_num_params)) {
+    std::ostringstream message;
+    message << "left-right lens cross-covariance is "
+            << lens_cross_covariance.rows() << "x"
+            << lens_cross_covariance.cols() << ", not " << left_num_params
+            << "x" << right_num_params;
+    return Status::Error(message.str());
+  }
+  if (extrinsics_lens_covariance.size() > 0 &&
+      (extrinsics_lens_covariance.rows() != 6 ||
+       extrinsics_lens_covariance.cols() !=
+           left_num_params + right_num_params)) {
     std::ostringstream message;
     message << "cam1_from_cam0-lens cross-covariance is "
             << extrinsics_lens_covariance.rows() << "x"

@@ -47,16 +47,25 @@ StatusOr<Eigen::MatrixXd> ReadCovariance(const YamlReader& reader,
 }
 
 // A 6-row matrix of any (equal) row length: a cross-covariance.
+// A cross-covariance of `rows` rows (of `what`), or of any number of rows
+// when `rows` is 0.
 StatusOr<Eigen::MatrixXd> ReadCrossCovariance(const YamlReader& reader,
                                               const YAML::Node& node,
-                                              const std::string& field) {
-  if (!node.IsSequence() || node.size() != 6) {
+                                              const std::string& field,
+                                              int rows = 6,
+                                              const char* what = "[w; dt]") {
+  if (!node.IsSequence() || node.size() == 0 ||
+      (rows > 0 && static_cast<int>(node.size()) != rows)) {
     return reader.Error(node, field,
-                        "expected 6 rows (of [w; dt]), got " +
+                        "expected " +
+                            (rows > 0 ? std::to_string(rows) + " rows"
+                                      : std::string("rows")) +
+                            " (of " + what + "), got " +
                             DescribeYamlNode(node));
   }
+  rows = static_cast<int>(node.size());
   Eigen::MatrixXd matrix;
-  for (int r = 0; r < 6; ++r) {
+  for (int r = 0; r < rows; ++r) {
     const std::string row_field = field + " row " + std::to_string(r + 1);
     const StatusOr<std::vector<double>> row =
         r == 0 ? reader.NumberList(node[r], row_field)
@@ -65,7 +74,7 @@ StatusOr<Eigen::MatrixXd> ReadCrossCovariance(const YamlReader& reader,
     if (!row.ok()) return row.status();
     if (r == 0) {
       if (row->empty()) return reader.Error(node[r], row_field, "is empty");
-      matrix.resize(6, static_cast<Eigen::Index>(row->size()));
+      matrix.resize(rows, static_cast<Eigen::Index>(row->size()));
     }
     for (size_t c = 0; c < row->size(); ++c) matrix(r, c) = (*row)[c];
   }
@@ -127,6 +136,7 @@ StatusOr<CalibrationCovarianceFile> ReadDocument(const YamlReader& reader,
   }
   file.cameras.resize(num_cameras);
   std::vector<YAML::Node> cross_nodes(num_cameras);
+  std::vector<YAML::Node> lens_cross_nodes(num_cameras);
   for (int k = 0; k < num_cameras; ++k) {
     const std::string name = "cam" + std::to_string(k);
     const YamlEntry* camera = FindYamlEntry(*entries, name);
@@ -155,6 +165,13 @@ StatusOr<CalibrationCovarianceFile> ReadDocument(const YamlReader& reader,
         file.cameras[k].from_previous_intrinsics_covariance =
             std::move(matrix).value();
         cross_nodes[k] = entry.value;
+      } else if (key == "intrinsics_cross_covariance" && k > 0) {
+        StatusOr<Eigen::MatrixXd> matrix = ReadCrossCovariance(
+            reader, entry.value, field, 0, "cam(n-1)'s intrinsics");
+        if (!matrix.ok()) return matrix.status();
+        file.cameras[k].previous_intrinsics_covariance =
+            std::move(matrix).value();
+        lens_cross_nodes[k] = entry.value;
       } else {
         return reader.Error(entry.key, field,
                             k == 0 ? "unknown key (cam0 has "
@@ -162,29 +179,43 @@ StatusOr<CalibrationCovarianceFile> ReadDocument(const YamlReader& reader,
                                    : "unknown key (expected "
                                      "intrinsics_covariance, "
                                      "T_cn_cnm1_covariance, "
-                                     "T_cn_cnm1_intrinsics_covariance)");
+                                     "T_cn_cnm1_intrinsics_covariance, "
+                                     "intrinsics_cross_covariance)");
       }
     }
   }
   // The cross-covariances against the blocks they join.
   for (int k = 1; k < num_cameras; ++k) {
     const CalibrationCovarianceFile::Camera& camera = file.cameras[k];
-    if (camera.from_previous_intrinsics_covariance.size() == 0) continue;
+    const bool extrinsics_cross =
+        camera.from_previous_intrinsics_covariance.size() > 0;
+    if (!extrinsics_cross &&
+        camera.previous_intrinsics_covariance.size() == 0) {
+      continue;
+    }
     const std::string field =
-        "cam" + std::to_string(k) + ".T_cn_cnm1_intrinsics_covariance";
-    const YAML::Node& node = cross_nodes[k];
+        "cam" + std::to_string(k) +
+        (extrinsics_cross ? ".T_cn_cnm1_intrinsics_covariance"
+                          : ".intrinsics_cross_covariance");
+    const YAML::Node& node =
+        extrinsics_cross ? cross_nodes[k] : lens_cross_nodes[k];
     const Eigen::MatrixXd& previous = file.cameras[k - 1].intrinsics_covariance;
-    if (!camera.from_previous_covariance || previous.size() == 0 ||
-        camera.intrinsics_covariance.size() == 0) {
+    if ((extrinsics_cross && !camera.from_previous_covariance) ||
+        previous.size() == 0 || camera.intrinsics_covariance.size() == 0) {
       return reader.Error(node, field,
-                          "needs T_cn_cnm1_covariance and both cameras' "
-                          "intrinsics_covariance");
+                          extrinsics_cross
+                              ? "needs T_cn_cnm1_covariance and both cameras' "
+                                "intrinsics_covariance"
+                              : "needs both cameras' intrinsics_covariance");
     }
     CalibrationUncertainty joint;
-    joint.extrinsics_covariance = *camera.from_previous_covariance;
+    joint.extrinsics_covariance =
+        camera.from_previous_covariance.value_or(
+            Eigen::Matrix<double, 6, 6>::Zero());
     joint.left_lens_covariance = previous;
     joint.right_lens_covariance = camera.intrinsics_covariance;
     joint.extrinsics_lens_covariance = camera.from_previous_intrinsics_covariance;
+    joint.lens_cross_covariance = camera.previous_intrinsics_covariance;
     const Status valid = joint.Check(static_cast<int>(previous.rows()),
                                      static_cast<int>(
                                          camera.intrinsics_covariance.rows()));
@@ -244,9 +275,17 @@ std::string FormatCalibrationCovariance(const CalibrationCovarianceFile& file) {
   for (const CalibrationCovarianceFile::Camera& camera : file.cameras) {
     cross |= camera.from_previous_intrinsics_covariance.size() > 0;
   }
+  bool lens_cross = false;
+  for (const CalibrationCovarianceFile::Camera& camera : file.cameras) {
+    lens_cross |= camera.previous_intrinsics_covariance.size() > 0;
+  }
   if (cross) {
     out << "# T_cn_cnm1_intrinsics_covariance: of [w; dt] (rows) with the "
            "intrinsics of cam(n-1), then camn (columns)\n";
+  }
+  if (lens_cross) {
+    out << "# intrinsics_cross_covariance: of the intrinsics of cam(n-1) "
+           "(rows) with camn's (columns)\n";
   }
   out << "medium: " << file.medium << "\n";
   out << "drift_prior:\n"
@@ -274,6 +313,10 @@ std::string FormatCalibrationCovariance(const CalibrationCovarianceFile& file) {
     if (camera.from_previous_intrinsics_covariance.size() > 0 && k > 0) {
       out << "  T_cn_cnm1_intrinsics_covariance:\n";
       AppendRows(camera.from_previous_intrinsics_covariance, &out);
+    }
+    if (camera.previous_intrinsics_covariance.size() > 0 && k > 0) {
+      out << "  intrinsics_cross_covariance:\n";
+      AppendRows(camera.previous_intrinsics_covariance, &out);
     }
   }
   return out.str();
@@ -305,6 +348,10 @@ StatusOr<CalibrationUncertainty> PairCalibrationUncertainty(
         *file.cameras[right_index].from_previous_covariance;
     uncertainty.extrinsics_lens_covariance =
         file.cameras[right_index].from_previous_intrinsics_covariance;
+  }
+  if (right_index == left_index + 1) {
+    uncertainty.lens_cross_covariance =
+        file.cameras[right_index].previous_intrinsics_covariance;
   }
   const auto [rotation, translation] = drift_override.value_or(
       std::pair<double, double>{file.drift_rotation_sigma,

@@ -321,17 +321,14 @@ struct UnderwaterCalibration {
   //   sigma_n^2        = C_nn - sigma_n_lenses^2  (n's variance were the
   //                                                lenses known),
   // extrinsics_lens_covariance = J C_{[w; t], L} (J the Jacobian of the
-  // change [w; dt] in [w; t]). The extrinsics' covariance already counts
-  // the lenses; a sidecar holds each camera's lens covariance but not the
-  // cam0-cam1 block, and the joint matrix without it need not be positive
-  // semi-definite, so extrinsics_covariance_from_lenses is the correction
-  //   J C_eL (D^-1 - C_LL^-1) C_Le J^T,   D = the per-camera blocks of
-  //                                         C_LL,
-  // with which the sidecar's extrinsics covariance is their covariance
-  // given the lenses plus C_eL D^-1 C_Le: the written joint matrix is then
-  // positive semi-definite, its cross block the true one.
+  // change [w; dt] in [w; t]), lens_cross_covariance the cam0-cam1 block
+  // of C_LL (the extrinsics tie the lenses: the difference of the
+  // principal points is known far better than either), and
+  // extrinsics_covariance_from_lenses is zero (the extrinsics' covariance
+  // already counts the lenses).
   bool lenses_estimated = false;
   std::array<Eigen::MatrixXd, 2> lens_covariance;
+  Eigen::MatrixXd lens_cross_covariance;  // p0 x p1
   // The air side of the joint fit: views used, the RMS of their corners
   // (as rms_px), the air extrinsics and the air board's warp (the water
   // board's under same_board).

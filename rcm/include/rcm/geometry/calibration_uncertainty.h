@@ -60,6 +60,11 @@ struct CalibrationUncertainty {
   // Cov([w; dt], [left params; right params]), 6 x (p_l + p_r); empty =
   // uncorrelated. Needs both lens covariances.
   Eigen::MatrixXd extrinsics_lens_covariance;
+  // Cov(left params, right params), p_l x p_r; empty = uncorrelated. Needs
+  // both lens covariances. (A joint calibration of both lenses, whose
+  // relative position the extrinsics tie: the difference of the principal
+  // points is known far better than either.)
+  Eigen::MatrixXd lens_cross_covariance;
   // Where the numbers come from, in words, for reports: e.g. "default drift
   // prior 0.1 deg, 0.1 mm per axis" or "camchain-covariance.yaml + drift
   // prior 0.1 deg, 0.1 mm per axis".
@@ -85,12 +90,13 @@ struct CalibrationUncertainty {
   bool IsZero() const;
   // The joint covariance of [w; dt; left params; right params] above (the
   // lens blocks of size 0 when empty; zero cross blocks without
-  // extrinsics_lens_covariance).
+  // extrinsics_lens_covariance or lens_cross_covariance).
   Eigen::MatrixXd JointCovariance() const;
 
   // Finite, symmetric (to a relative 1e-9) and positive semi-definite
   // matrices; lens covariances empty or of the cameras' parameter counts;
-  // extrinsics_lens_covariance empty, or 6 x (p_l + p_r) with both lens
+  // extrinsics_lens_covariance empty, or 6 x (p_l + p_r), and
+  // lens_cross_covariance empty, or p_l x p_r, each with both lens
   // covariances given and the joint covariance positive semi-definite.
   // Errors name the matrix: "cam1_from_cam0 covariance is not positive
   // semi-definite".

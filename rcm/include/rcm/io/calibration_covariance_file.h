@@ -57,6 +57,11 @@ struct CalibrationCovarianceFile {
     // Cov([w; dt] of T_cn_cnm1, [previous camera's params; this camera's
     // params]), 6 x (p_prev + p); empty when absent (always on cam0).
     Eigen::MatrixXd from_previous_intrinsics_covariance;
+    // Cov(previous camera's params, this camera's params), p_prev x p;
+    // empty when absent (always on cam0): key intrinsics_cross_covariance,
+    // a joint calibration's (CalibrationUncertainty::
+    // lens_cross_covariance).
+    Eigen::MatrixXd previous_intrinsics_covariance;
   };
   // "air" or "water".
   std::string medium = "air";
