@@ -82,29 +82,45 @@ Status CheckPortsForAirGap(const std::string& air) {
   return Status::Ok();
 }
 
-// The leave-out spread over the covariance's sigma, at least 1: the
-// factor the extrinsics' covariance is scaled by in the sidecar (as for
-// an air calibration, rcm/calib/calibration_covariance.h).
-double ExtrinsicsLeaveOutScale(const calib::ExtrinsicChange& change) {
-  double scale = 1.0;
-  if (!change.rotation_leave_out_sigma_deg) return scale;
+// Per component of [w; dt], the leave-out spread over the covariance's
+// sigma, at least 1: the scales S of the extrinsics' rows in the sidecar.
+// (One scale for all six, the largest ratio, as an air calibration's
+// sidecar has it, rcm/calib/calibration_covariance.h, carries the ratio of
+// the best-known component, often the rotation about the optical axis,
+// whose covariance sigma is tiny, to the others, whose leave-out spread
+// may be below their covariance's: a target-free estimate, which is
+// sensitive to the rotation about x above all, then inherits a sigma
+// several times too large.)
+Eigen::Matrix<double, 6, 1> ExtrinsicsLeaveOutScales(
+    const calib::ExtrinsicChange& change) {
+  Eigen::Matrix<double, 6, 1> scales = Eigen::Matrix<double, 6, 1>::Ones();
+  const auto ratio = [](double leave_out, double covariance) {
+    return covariance > 0.0 ? std::max(1.0, leave_out / covariance) : 1.0;
+  };
   for (int k = 0; k < 3; ++k) {
-    if (change.rotation_sigma_deg[k] > 0.0) {
-      scale = std::max(scale, (*change.rotation_leave_out_sigma_deg)[k] /
-                                  change.rotation_sigma_deg[k]);
+    if (change.rotation_leave_out_sigma_deg) {
+      scales[k] = ratio((*change.rotation_leave_out_sigma_deg)[k],
+                        change.rotation_sigma_deg[k]);
+    }
+    if (change.translation_leave_out_sigma_mm) {
+      scales[3 + k] = ratio((*change.translation_leave_out_sigma_mm)[k],
+                            change.translation_sigma_mm[k]);
     }
   }
-  return scale;
+  return scales;
 }
 
 // The sidecar of an underwater calibration: medium water, no drift prior
-// (the extrinsics were measured in this dive), the extrinsics' covariance
-// of the bundle adjustment (scaled by the leave-out spread), the lenses'
-// from the air calibration's sidecar when it had one, and then the
-// extrinsics' correlation with the lenses and the lenses' share of the
-// extrinsics' covariance (UnderwaterCalibration::extrinsics_lens_
-// covariance). One camera: the air calibration's extrinsics and their
-// uncertainty are kept.
+// (the extrinsics were measured in this dive), and the joint covariance
+// of the extrinsics [w; dt] and the lenses: the lenses' from the joint fit
+// (air views given) or from the air calibration's sidecar when it had
+// one; the extrinsics' from the bundle adjustment, with their correlation
+// with the lenses and the lenses' share of their own
+// (UnderwaterCalibration::extrinsics_lens_covariance); the extrinsics'
+// rows and columns then scaled by the leave-out spread per component
+// (ExtrinsicsLeaveOutScales), E -> S E S and X -> S X, which keeps the
+// joint matrix positive semi-definite. One camera: the air calibration's
+// extrinsics and their uncertainty are kept.
 CalibrationCovarianceFile UnderwaterCovarianceFile(
     const UnderwaterCalibration& result, const StereoRig& air_rig) {
   CalibrationCovarianceFile file;
@@ -126,22 +142,24 @@ CalibrationCovarianceFile UnderwaterCovarianceFile(
     }
   }
   if (result.extrinsics_estimated) {
-    const double scale = ExtrinsicsLeaveOutScale(result.extrinsic_change);
-    file.cameras[1].from_previous_covariance =
-        scale * scale * result.extrinsic_change.covariance;
-    // The extrinsics were fitted through the air lenses: their covariance
-    // with the lenses, and the lenses' share of their own.
+    const Eigen::DiagonalMatrix<double, 6> scales(
+        ExtrinsicsLeaveOutScales(result.extrinsic_change));
+    Eigen::Matrix<double, 6, 6> extrinsics =
+        result.extrinsic_change.covariance;
+    // The extrinsics were fitted through the lenses: their covariance with
+    // the lenses, and the lenses' share of their own.
     const int lens_size =
         static_cast<int>(file.cameras[0].intrinsics_covariance.rows() +
                          file.cameras[1].intrinsics_covariance.rows());
     if (file.cameras[0].intrinsics_covariance.size() > 0 &&
         file.cameras[1].intrinsics_covariance.size() > 0 &&
         result.extrinsics_lens_covariance.cols() == lens_size) {
-      *file.cameras[1].from_previous_covariance +=
-          result.extrinsics_covariance_from_lenses;
+      extrinsics += result.extrinsics_covariance_from_lenses;
       file.cameras[1].from_previous_intrinsics_covariance =
-          result.extrinsics_lens_covariance;
+          scales * result.extrinsics_lens_covariance;
     }
+    file.cameras[1].from_previous_covariance =
+        scales * extrinsics * scales;
   }
   return file;
 }
@@ -493,6 +511,14 @@ int RunCalibrateUnderwater(const Subcommand& command,
         {"angle_sigma_deg", change.angle_sigma_deg},
         {"angle_leave_out_sigma_deg",
          JsonNumber(change.angle_leave_out_sigma_deg)},
+        {"rotation_leave_out_sigma_deg",
+         change.rotation_leave_out_sigma_deg
+             ? Vector3Json(*change.rotation_leave_out_sigma_deg)
+             : nlohmann::json(nullptr)},
+        {"translation_leave_out_sigma_mm",
+         change.translation_leave_out_sigma_mm
+             ? Vector3Json(*change.translation_leave_out_sigma_mm)
+             : nlohmann::json(nullptr)},
         {"rotation_deg", Vector3Json(change.rotation_deg)},
         {"rotation_sigma_deg", Vector3Json(change.rotation_sigma_deg)},
         {"translation_mm", Vector3Json(change.translation_mm)},

@@ -4,6 +4,7 @@
 // input of rcm calibrate --underwater.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -480,6 +481,28 @@ TEST(UnderwaterCli, JointAirAndWater) {
   }
   EXPECT_EQ(written.cameras[1].from_previous_intrinsics_covariance.rows(), 6);
   EXPECT_EQ(written.cameras[1].from_previous_intrinsics_covariance.cols(), 16);
+  EXPECT_EQ(written.cameras[1].previous_intrinsics_covariance.rows(), 8);
+  // The extrinsics' sigmas in the sidecar: per component the larger of the
+  // covariance's and the leave-out's (the joint fit's covariance already
+  // counts the lenses).
+  const nlohmann::json& change = json["extrinsic_change"];
+  for (int k = 0; k < 3; ++k) {
+    const double rotation =
+        std::max(change["rotation_sigma_deg"][k].get<double>(),
+                 change["rotation_leave_out_sigma_deg"][k].get<double>()) *
+        M_PI / 180.0;
+    EXPECT_NEAR(std::sqrt((*written.cameras[1].from_previous_covariance)(k, k)),
+                rotation, 1e-9 * rotation)
+        << k;
+    const double translation =
+        1e-3 *
+        std::max(change["translation_sigma_mm"][k].get<double>(),
+                 change["translation_leave_out_sigma_mm"][k].get<double>());
+    EXPECT_NEAR(
+        std::sqrt((*written.cameras[1].from_previous_covariance)(3 + k, 3 + k)),
+        translation, 1e-9 * translation)
+        << k;
+  }
   const Camchain air_chain = ReadCamchain(dive + "/camchain.yaml").value();
   const Camchain water_chain = ReadCamchain(water + "/camchain.yaml").value();
   EXPECT_FALSE(air_chain.cameras[0].camera == water_chain.cameras[0].camera);
