@@ -116,8 +116,8 @@ void BM_CalibrateAirAndWater(benchmark::State& state) {
   air.target = Checkerboard();
   air.views = test::ObserveStereo(
       dive.air, Checkerboard(),
-      test::BoardPoses(dive.air.left(), Checkerboard(), 30, /*seed=*/11),
-      0.25, /*seed=*/2);
+      test::BoardPoses(dive.air.left(), Checkerboard(), 30, /*seed=*/11), 0.25,
+      /*seed=*/2);
   air.cam0_size = {720, 540};
   air.cam1_size = {720, 540};
   air.same_board = true;

@@ -144,8 +144,7 @@ CalibrationCovarianceFile UnderwaterCovarianceFile(
   if (result.extrinsics_estimated) {
     const Eigen::DiagonalMatrix<double, 6> scales(
         ExtrinsicsLeaveOutScales(result.extrinsic_change));
-    Eigen::Matrix<double, 6, 6> extrinsics =
-        result.extrinsic_change.covariance;
+    Eigen::Matrix<double, 6, 6> extrinsics = result.extrinsic_change.covariance;
     // The extrinsics were fitted through the lenses: their covariance with
     // the lenses, and the lenses' share of their own.
     const int lens_size =
@@ -158,8 +157,7 @@ CalibrationCovarianceFile UnderwaterCovarianceFile(
       file.cameras[1].from_previous_intrinsics_covariance =
           scales * result.extrinsics_lens_covariance;
     }
-    file.cameras[1].from_previous_covariance =
-        scales * extrinsics * scales;
+    file.cameras[1].from_previous_covariance = scales * extrinsics * scales;
   }
   return file;
 }

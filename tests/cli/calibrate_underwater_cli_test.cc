@@ -86,11 +86,11 @@ nlohmann::json Json(const RunResult& result) {
 
 RunResult CalibrateUnderwater(const std::string& dive, const std::string& out,
                               double square, const std::string& extra = "") {
-  std::vector<std::string> args = {"calibrate",     "--underwater",
-                                   "--air",         dive + "/camchain.yaml",
-                                   "--left",        dive + "/left",
-                                   "--right",       dive + "/right",
-                                   "--out",         out,
+  std::vector<std::string> args = {"calibrate", "--underwater",
+                                   "--air",     dive + "/camchain.yaml",
+                                   "--left",    dive + "/left",
+                                   "--right",   dive + "/right",
+                                   "--out",     out,
                                    "--json"};
   for (const std::string& word : Words(Board(square) + " " + extra)) {
     args.push_back(word);
@@ -99,8 +99,8 @@ RunResult CalibrateUnderwater(const std::string& dive, const std::string& out,
 }
 
 RunResult Estimate(const std::string& dive, const std::string& calib) {
-  return Rcm({"estimate", "--calib", calib, "--left", dive + "/left",
-              "--right", dive + "/right", "--json"});
+  return Rcm({"estimate", "--calib", calib, "--left", dive + "/left", "--right",
+              dive + "/right", "--json"});
 }
 
 // The underwater refinement's n and drift against the truth. Before the
@@ -119,10 +119,11 @@ void ExpectUnderwaterCalibrationRecoversTheDive(const nlohmann::json& json,
                                                 bool air_sidecar = false) {
   const double error = json["n"].get<double>() - kTrueN;
   const double leave_out = json["sigma_n_leave_out"].get<double>();
-  std::printf("underwater: n %.5f +- %.5f (leave-out %.5f), error %.5f; "
-              "drift %.3f deg\n",
-              json["n"].get<double>(), json["sigma_n"].get<double>(),
-              leave_out, error, json["extrinsic_change_deg"].get<double>());
+  std::printf(
+      "underwater: n %.5f +- %.5f (leave-out %.5f), error %.5f; "
+      "drift %.3f deg\n",
+      json["n"].get<double>(), json["sigma_n"].get<double>(), leave_out, error,
+      json["extrinsic_change_deg"].get<double>());
   // The candidate models (calib/underwater_model_selection.h): all eight
   // fitted, one chosen, sigma_n the root sum of squares of its parts, and
   // the lenses' part 0 unless the air camchain was given a sidecar (the
@@ -188,12 +189,12 @@ void ExpectRefusedOrCovered(const RunResult& result, const char* what) {
   const nlohmann::json json = nlohmann::json::parse(result.out);
   const double error = json["n"].get<double>() - kTrueN;
   const double sigma = json["sigma_n"].get<double>();
-  std::printf("%s: n %.5f +- %.5f (noise %.5f, calibration %.5f, systematic "
-              "%.5f), error %.5f = %.2f sigma\n",
-              what, json["n"].get<double>(), sigma,
-              json["sigma_n_noise"].get<double>(),
-              json["sigma_n_calibration"].get<double>(),
-              json["sigma_n_systematic"].get<double>(), error, error / sigma);
+  std::printf(
+      "%s: n %.5f +- %.5f (noise %.5f, calibration %.5f, systematic "
+      "%.5f), error %.5f = %.2f sigma\n",
+      what, json["n"].get<double>(), sigma, json["sigma_n_noise"].get<double>(),
+      json["sigma_n_calibration"].get<double>(),
+      json["sigma_n_systematic"].get<double>(), error, error / sigma);
   if (test::ChecksStatistics()) {
     EXPECT_LE(std::abs(error), 3.0 * sigma) << what;
   }
@@ -253,10 +254,10 @@ TEST(UnderwaterCli, NarrowRigThatDriftedHalfADegree) {
   ASSERT_TRUE(water_rig.calibration_uncertainty().has_value());
   EXPECT_EQ(water_rig.calibration_uncertainty()->extrinsics_lens_covariance,
             written.cameras[1].from_previous_intrinsics_covariance);
-  for (const char* file : {"residuals_cam0.png", "residuals_cam1.png",
-                           "coverage_cam0.png", "coverage_cam1.png",
-                           "per_view_rms.png", "per_view.csv",
-                           "underwater.json"}) {
+  for (const char* file :
+       {"residuals_cam0.png", "residuals_cam1.png", "coverage_cam0.png",
+        "coverage_cam1.png", "per_view_rms.png", "per_view.csv",
+        "underwater.json"}) {
     EXPECT_TRUE(fs::exists(water + "/report/" + file)) << file;
   }
   ExpectRefusedOrCovered(Estimate(dive, water + "/camchain.yaml"),
@@ -293,8 +294,8 @@ TEST(UnderwaterCli, DatasetRigThatDriftedHalfADegree) {
   ExpectRefusedOrCovered(refined, "dataset rig, refined camchain");
   ASSERT_EQ(refined.exit_code, 0) << refined.err;
   if (test::ChecksStatistics()) {
-    EXPECT_NEAR(nlohmann::json::parse(refined.out)["n"].get<double>(),
-                kTrueN, 2e-3);
+    EXPECT_NEAR(nlohmann::json::parse(refined.out)["n"].get<double>(), kTrueN,
+                2e-3);
   }
   ExpectRefusedOrCovered(Estimate(dive, dive + "/camchain.yaml"),
                          "dataset rig, stale camchain");
@@ -311,8 +312,8 @@ TEST(UnderwaterCli, OneCameraGivesN) {
   const std::string corners = water + "-corners.vnl";
   const RunResult result = Rcm(
       Words("calibrate --underwater --air " + dive + "/camchain.yaml --left " +
-            dive + "/left --out " + water + " --json --folds 0 " +
-            Board(0.03) + " --corners-out " + corners));
+            dive + "/left --out " + water + " --json --folds 0 " + Board(0.03) +
+            " --corners-out " + corners));
   const nlohmann::json json = Json(result);
   // The same run from the corners it wrote: the same n, to rounding (the
   // file keeps the corners in point order, the detector in its own, so
@@ -417,20 +418,20 @@ TEST(UnderwaterCli, PortBlockThatContradictsEstimateAirGap) {
   const std::string air = test::TempFilePath("air.yaml");
   ASSERT_TRUE(WriteCamchain(air, camchain).ok());
   const std::string water = Folder("water");
-  ExpectRefused(
-      Rcm(Words("calibrate --underwater --estimate-air-gap --air " + air +
-                " --left " + dive + "/left --right " + dive + "/right --out " +
-                water + " " + Board(0.03))),
-      water, "contradicts --estimate-air-gap");
+  ExpectRefused(Rcm(Words("calibrate --underwater --estimate-air-gap --air " +
+                          air + " --left " + dive + "/left --right " + dive +
+                          "/right --out " + water + " " + Board(0.03))),
+                water, "contradicts --estimate-air-gap");
 }
 
 TEST(UnderwaterCli, NPinnedAtTheUpperBound) {
   // A medium of index 2, which nothing rcm serves is near: the refinement
   // ends on the bound and says so instead of giving the number.
   const std::string dive = Folder("dive");
-  Simulate(dive, "--rig narrow --frames 6 --frame-rate 1 --supersampling 1 "
-                 "--n 2 " +
-                     Board(0.03));
+  Simulate(dive,
+           "--rig narrow --frames 6 --frame-rate 1 --supersampling 1 "
+           "--n 2 " +
+               Board(0.03));
   const std::string water = Folder("water");
   ExpectRefused(CalibrateUnderwater(dive, water, 0.03, "--folds 0"), water,
                 "upper bound");
@@ -455,13 +456,13 @@ TEST(UnderwaterCli, JointAirAndWater) {
       dive, water, 0.03,
       Folds() + " --flat-board --thin-port --same-board --air-left " + air +
           "/left --air-right " + air + "/right"));
-  std::printf("joint: n %.5f +- %.5f (noise %.5f, lenses %.5f), air views %d "
-              "rms %.3f px\n",
-              json["n"].get<double>(), json["sigma_n"].get<double>(),
-              json["sigma_n_noise"].get<double>(),
-              json["sigma_n_lenses"].get<double>(),
-              json["air_views"]["views_used"].get<int>(),
-              json["air_views"]["rms_px"].get<double>());
+  std::printf(
+      "joint: n %.5f +- %.5f (noise %.5f, lenses %.5f), air views %d "
+      "rms %.3f px\n",
+      json["n"].get<double>(), json["sigma_n"].get<double>(),
+      json["sigma_n_noise"].get<double>(), json["sigma_n_lenses"].get<double>(),
+      json["air_views"]["views_used"].get<int>(),
+      json["air_views"]["rms_px"].get<double>());
   EXPECT_TRUE(json["lenses_estimated"].get<bool>());
   EXPECT_TRUE(json["air_views"]["same_board"].get<bool>());
   EXPECT_GE(json["air_views"]["views_used"].get<int>(),
@@ -517,11 +518,11 @@ TEST(UnderwaterCli, JointAirAndWater) {
   const std::string other = Folder("other");
   Simulate(other, "--frames 3 --frame-rate 1 --n 1 " + Board(0.03));
   const std::string refused = Folder("refused");
-  ExpectRefused(CalibrateUnderwater(dive, refused, 0.03,
-                                    "--folds 0 --air-left " + other +
-                                        "/left --air-right " + other +
-                                        "/right"),
-                refused, "cam0 air images are ");
+  ExpectRefused(
+      CalibrateUnderwater(dive, refused, 0.03,
+                          "--folds 0 --air-left " + other +
+                              "/left --air-right " + other + "/right"),
+      refused, "cam0 air images are ");
   const std::string board = test::TempFilePath("air-board.yaml");
   {
     std::ofstream file(board);
@@ -545,10 +546,9 @@ TEST(UnderwaterCli, FlagsThatNeedUnderwater) {
   ExpectRefused(Rcm(Words("calibrate --air a.yaml --left l --right r --out " +
                           water + " " + Board(0.03))),
                 water, "go with --underwater", 2);
-  ExpectRefused(
-      Rcm(Words("calibrate --underwater --left l --right r --out " + water +
-                " " + Board(0.03))),
-      water, "--underwater needs --air", 2);
+  ExpectRefused(Rcm(Words("calibrate --underwater --left l --right r --out " +
+                          water + " " + Board(0.03))),
+                water, "--underwater needs --air", 2);
   ExpectRefused(
       Rcm(Words("calibrate --underwater --model radtan --air a.yaml --left l "
                 "--right r --out " +

@@ -27,8 +27,8 @@ Eigen::MatrixXd Covariance(int size, double scale, int seed) {
       a(r, c) = std::sin(1.7 * (r + 1) * (c + 2) + seed) / 3.0;
     }
   }
-  return scale * (a * a.transpose() +
-                  0.1 * Eigen::MatrixXd::Identity(size, size));
+  return scale *
+         (a * a.transpose() + 0.1 * Eigen::MatrixXd::Identity(size, size));
 }
 
 CalibrationCovarianceFile SampleFile() {
@@ -73,7 +73,8 @@ TEST(CalibrationCovarianceFile, PairUncertaintyAddsTheDriftPrior) {
   const CalibrationCovarianceFile file = SampleFile();
   const CalibrationUncertainty uncertainty =
       PairCalibrationUncertainty(file, 0, 1, "c.yaml").value();
-  Eigen::Matrix<double, 6, 6> expected = *file.cameras[1].from_previous_covariance;
+  Eigen::Matrix<double, 6, 6> expected =
+      *file.cameras[1].from_previous_covariance;
   for (int k = 0; k < 3; ++k) {
     expected(k, k) += std::pow(file.drift_rotation_sigma, 2);
     expected(3 + k, 3 + k) += std::pow(file.drift_translation_sigma, 2);
@@ -245,8 +246,8 @@ TEST(CalibrationCovarianceFile, LensCrossCovariance) {
 // or a lens covariance of the wrong size, is an error naming the sidecar.
 TEST(CalibrationCovarianceFile, ReadStereoRigAttachesTheSidecar) {
   const StereoRig rig = test::AlphasenseRealisticRig();
-  const std::string camchain =
-      test::WriteTempFile("rig.yaml", FormatCamchain(CamchainFromStereoRig(rig)));
+  const std::string camchain = test::WriteTempFile(
+      "rig.yaml", FormatCamchain(CamchainFromStereoRig(rig)));
   const std::string sidecar = CovarianceSidecarPath(camchain);
   std::remove(sidecar.c_str());  // an earlier run's
   const StereoRig without = ReadStereoRig(camchain).value();

@@ -92,8 +92,9 @@ std::string_view LensModelName(LensModelId model) {
 
 const std::array<LensModelId, kNumLensModels>& AllLensModels() {
   static const std::array<LensModelId, kNumLensModels> kModels = {
-      LensModelId::kPinhole,  LensModelId::kRadTan,       LensModelId::kEquidistant,
-      LensModelId::kRational, LensModelId::kDoubleSphere, LensModelId::kEucm};
+      LensModelId::kPinhole,      LensModelId::kRadTan,
+      LensModelId::kEquidistant,  LensModelId::kRational,
+      LensModelId::kDoubleSphere, LensModelId::kEucm};
   return kModels;
 }
 
@@ -143,8 +144,7 @@ Status Camera::CheckImageSize(int width, int height) {
             << " is beyond the largest accepted side of " << kMaxImageSide
             << " px";
   } else {
-    message << "image size must be positive, got " << width << " x "
-            << height;
+    message << "image size must be positive, got " << width << " x " << height;
   }
   return Status::Error(message.str());
 }
@@ -207,8 +207,7 @@ Status Camera::CheckDistortion(LensModelId model,
     }
   }
   // The ranges of the unified models (lens_models.h says why).
-  const auto outside = [&](const char* key, double value,
-                           const char* range) {
+  const auto outside = [&](const char* key, double value, const char* range) {
     std::ostringstream message;
     message << LensModelName(model) << " " << key << " = " << value
             << " is outside " << range;

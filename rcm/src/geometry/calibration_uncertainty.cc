@@ -41,8 +41,8 @@ CalibrationUncertainty CalibrationUncertainty::DriftPrior(
 }
 
 CalibrationUncertainty CalibrationUncertainty::DefaultDriftPrior() {
-  CalibrationUncertainty uncertainty =
-      DriftPrior(kDefaultDriftDegrees * kDegree, 1e-3 * kDefaultDriftMillimeters);
+  CalibrationUncertainty uncertainty = DriftPrior(
+      kDefaultDriftDegrees * kDegree, 1e-3 * kDefaultDriftMillimeters);
   uncertainty.source = "default " + uncertainty.source;
   return uncertainty;
 }
@@ -60,7 +60,8 @@ void CalibrationUncertainty::AddDrift(double rotation_sigma,
                                       double translation_sigma) {
   for (int k = 0; k < 3; ++k) {
     extrinsics_covariance(k, k) += rotation_sigma * rotation_sigma;
-    extrinsics_covariance(3 + k, 3 + k) += translation_sigma * translation_sigma;
+    extrinsics_covariance(3 + k, 3 + k) +=
+        translation_sigma * translation_sigma;
   }
 }
 
@@ -75,7 +76,8 @@ bool CalibrationUncertainty::IsZero() const {
 Eigen::MatrixXd CalibrationUncertainty::JointCovariance() const {
   const int left = static_cast<int>(left_lens_covariance.rows());
   const int right = static_cast<int>(right_lens_covariance.rows());
-  Eigen::MatrixXd joint = Eigen::MatrixXd::Zero(6 + left + right, 6 + left + right);
+  Eigen::MatrixXd joint =
+      Eigen::MatrixXd::Zero(6 + left + right, 6 + left + right);
   joint.topLeftCorner<6, 6>() = extrinsics_covariance;
   if (left > 0) joint.block(6, 6, left, left) = left_lens_covariance;
   if (right > 0) {
@@ -96,8 +98,8 @@ Eigen::MatrixXd CalibrationUncertainty::JointCovariance() const {
 
 Status CalibrationUncertainty::Check(int left_num_params,
                                      int right_num_params) const {
-  RCM_RETURN_IF_ERROR(
-      CheckCovarianceMatrix(extrinsics_covariance, "cam1_from_cam0 covariance"));
+  RCM_RETURN_IF_ERROR(CheckCovarianceMatrix(extrinsics_covariance,
+                                            "cam1_from_cam0 covariance"));
   const Eigen::MatrixXd* lenses[2] = {&left_lens_covariance,
                                       &right_lens_covariance};
   const int sizes[2] = {left_num_params, right_num_params};
@@ -107,9 +109,8 @@ Status CalibrationUncertainty::Check(int left_num_params,
     if (lenses[c]->size() == 0) continue;
     if (lenses[c]->rows() != sizes[c] || lenses[c]->cols() != sizes[c]) {
       std::ostringstream message;
-      message << name << " is " << lenses[c]->rows() << "x"
-              << lenses[c]->cols() << ", the camera has " << sizes[c]
-              << " parameters";
+      message << name << " is " << lenses[c]->rows() << "x" << lenses[c]->cols()
+              << ", the camera has " << sizes[c] << " parameters";
       return Status::Error(message.str());
     }
     RCM_RETURN_IF_ERROR(CheckCovarianceMatrix(*lenses[c], name));

@@ -56,12 +56,11 @@ StatusOr<Eigen::MatrixXd> ReadCrossCovariance(const YamlReader& reader,
                                               const char* what = "[w; dt]") {
   if (!node.IsSequence() || node.size() == 0 ||
       (rows > 0 && static_cast<int>(node.size()) != rows)) {
-    return reader.Error(node, field,
-                        "expected " +
-                            (rows > 0 ? std::to_string(rows) + " rows"
-                                      : std::string("rows")) +
-                            " (of " + what + "), got " +
-                            DescribeYamlNode(node));
+    return reader.Error(
+        node, field,
+        "expected " +
+            (rows > 0 ? std::to_string(rows) + " rows" : std::string("rows")) +
+            " (of " + what + "), got " + DescribeYamlNode(node));
   }
   rows = static_cast<int>(node.size());
   Eigen::MatrixXd matrix;
@@ -124,8 +123,7 @@ StatusOr<CalibrationCovarianceFile> ReadDocument(const YamlReader& reader,
           reader.Number(entry.value, "drift_prior." + key);
       if (!value.ok()) return value.status();
       if (*value < 0.0) {
-        return reader.Error(entry.value, "drift_prior." + key,
-                            "must be >= 0");
+        return reader.Error(entry.value, "drift_prior." + key, "must be >= 0");
       }
       if (key == "rotation_deg") {
         file.drift_rotation_sigma = *value * kDegree;
@@ -141,8 +139,9 @@ StatusOr<CalibrationCovarianceFile> ReadDocument(const YamlReader& reader,
     const std::string name = "cam" + std::to_string(k);
     const YamlEntry* camera = FindYamlEntry(*entries, name);
     if (camera == nullptr) {
-      return reader.Error(name, "missing (cameras must be cam0, cam1, ... "
-                                "without gaps)");
+      return reader.Error(name,
+                          "missing (cameras must be cam0, cam1, ... "
+                          "without gaps)");
     }
     const StatusOr<YamlEntries> fields = reader.Entries(camera->value, name);
     if (!fields.ok()) return fields.status();
@@ -209,16 +208,16 @@ StatusOr<CalibrationCovarianceFile> ReadDocument(const YamlReader& reader,
                               : "needs both cameras' intrinsics_covariance");
     }
     CalibrationUncertainty joint;
-    joint.extrinsics_covariance =
-        camera.from_previous_covariance.value_or(
-            Eigen::Matrix<double, 6, 6>::Zero());
+    joint.extrinsics_covariance = camera.from_previous_covariance.value_or(
+        Eigen::Matrix<double, 6, 6>::Zero());
     joint.left_lens_covariance = previous;
     joint.right_lens_covariance = camera.intrinsics_covariance;
-    joint.extrinsics_lens_covariance = camera.from_previous_intrinsics_covariance;
+    joint.extrinsics_lens_covariance =
+        camera.from_previous_intrinsics_covariance;
     joint.lens_cross_covariance = camera.previous_intrinsics_covariance;
-    const Status valid = joint.Check(static_cast<int>(previous.rows()),
-                                     static_cast<int>(
-                                         camera.intrinsics_covariance.rows()));
+    const Status valid =
+        joint.Check(static_cast<int>(previous.rows()),
+                    static_cast<int>(camera.intrinsics_covariance.rows()));
     if (!valid.ok()) return reader.Error(node, field, valid.message());
   }
   return file;
@@ -353,9 +352,9 @@ StatusOr<CalibrationUncertainty> PairCalibrationUncertainty(
     uncertainty.lens_cross_covariance =
         file.cameras[right_index].previous_intrinsics_covariance;
   }
-  const auto [rotation, translation] = drift_override.value_or(
-      std::pair<double, double>{file.drift_rotation_sigma,
-                                file.drift_translation_sigma});
+  const auto [rotation, translation] =
+      drift_override.value_or(std::pair<double, double>{
+          file.drift_rotation_sigma, file.drift_translation_sigma});
   uncertainty.AddDrift(rotation, translation);
   uncertainty.source =
       source + " (" + file.medium + " calibration) + " +

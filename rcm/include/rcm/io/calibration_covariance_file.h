@@ -16,7 +16,8 @@
 //     ...
 //   cam1:
 //     intrinsics_covariance: ...
-//     T_cn_cnm1_covariance:      # 6x6, of [w; dt] of T_cn_cnm1 = cam1_from_cam0:
+//     T_cn_cnm1_covariance:      # 6x6, of [w; dt] of T_cn_cnm1 =
+//     cam1_from_cam0:
 //     - [...]                    # (exp([w]x) R, exp([w]x) t + dt), w in
 //     ...                        # radians and dt in meters, cam1 frame
 //     T_cn_cnm1_intrinsics_covariance:  # 6 rows: [w; dt] against
