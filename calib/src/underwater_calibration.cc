@@ -318,6 +318,53 @@ std::optional<Rigid3d> ThinPortTargetPose(
   return TargetPoseFromNormalized(target_points, observation, rays);
 }
 
+// The views of one medium, posed by ThinPortTargetPose at n0 (1 in air)
+// and their corners appended as views first_view + v: each view's
+// cam0_from_target from cam0's corners, else from cam1's through
+// cam1_from_cam0; a view that gets no pose is not used.
+struct PosedViews {
+  std::vector<bool> used;  // per view of the medium
+  std::array<bool, 2> camera_seen = {false, false};
+  int num_used = 0;
+  int num_stereo = 0;  // used views with corners in both cameras
+};
+PosedViews PoseViews(const std::array<const Camera*, 2>& cameras, double n0,
+                     const std::vector<Eigen::Vector3d>& target_points,
+                     const internal::UsedObservations& observations,
+                     const Rigid3d& cam1_from_cam0, int first_view,
+                     std::vector<Pose>* poses, std::vector<Corner>* corners) {
+  PosedViews posed;
+  posed.used.assign(observations.size(), false);
+  for (size_t v = 0; v < observations.size(); ++v) {
+    const std::array<const TargetObservation*, 2>& observed = observations[v];
+    std::optional<Rigid3d> camera_from_target[2];
+    for (int c = 0; c < 2; ++c) {
+      if (observed[c] == nullptr) continue;
+      camera_from_target[c] =
+          ThinPortTargetPose(*cameras[c], n0, target_points, *observed[c]);
+    }
+    std::optional<Rigid3d> cam0_from_target = camera_from_target[0];
+    if (!cam0_from_target && camera_from_target[1]) {
+      cam0_from_target = cam1_from_cam0.Inverse() * *camera_from_target[1];
+    }
+    if (!cam0_from_target) continue;
+    const int view = first_view + static_cast<int>(v);
+    posed.used[v] = true;
+    ++posed.num_used;
+    (*poses)[view] = PoseFromRigid(*cam0_from_target);
+    for (int c = 0; c < 2; ++c) {
+      if (observed[c] == nullptr) continue;
+      posed.camera_seen[c] = true;
+      for (int k = 0; k < observed[c]->size(); ++k) {
+        corners->push_back(
+            {view, c, observed[c]->point_ids[k], observed[c]->pixels[k], true});
+      }
+    }
+    if (observed[0] != nullptr && observed[1] != nullptr) ++posed.num_stereo;
+  }
+  return posed;
+}
+
 // The port normal of tilt parameters (a, b).
 Eigen::Vector3d NormalFromTilt(const std::array<double, 2>& tilt) {
   return Eigen::Vector3d(tilt[0], tilt[1], 1.0).normalized();
@@ -647,42 +694,18 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     parameters.air_gap[c] = ports[c].air_gap;
     const Eigen::Vector3d normal = ports[c].normal.normalized();
     parameters.tilt[c] = {normal.x() / normal.z(), normal.y() / normal.z()};
-  }
-  for (int c = 0; c < 2; ++c) {
-    std::copy(cameras[c]->params(), cameras[c]->params() + lens_sizes[c],
-              parameters.lens[c].begin());
+    parameters.lens[c] = model.constants[c].lens;  // (joint: the start)
   }
   parameters.cam0_from_target.resize(num_views);
   std::vector<Corner> corners;
-  std::vector<bool> view_used(num_views, false);
-  std::array<bool, 2> camera_used = {false, false};
-  int num_stereo_views = 0;
-  for (int v = 0; v < num_views; ++v) {
-    std::optional<Rigid3d> camera_from_target[2];
-    for (int c = 0; c < 2; ++c) {
-      if (used[v][c] == nullptr) continue;
-      camera_from_target[c] = ThinPortTargetPose(
-          *cameras[c], options.initial_n, model.target_points, *used[v][c]);
-    }
-    std::optional<Rigid3d> cam0_from_target = camera_from_target[0];
-    if (!cam0_from_target && camera_from_target[1]) {
-      cam0_from_target = air_extrinsics.Inverse() * *camera_from_target[1];
-    }
-    if (!cam0_from_target) continue;
-    view_used[v] = true;
-    parameters.cam0_from_target[v] = PoseFromRigid(*cam0_from_target);
-    for (int c = 0; c < 2; ++c) {
-      if (used[v][c] == nullptr) continue;
-      camera_used[c] = true;
-      for (int k = 0; k < used[v][c]->size(); ++k) {
-        corners.push_back(
-            {v, c, used[v][c]->point_ids[k], used[v][c]->pixels[k], true});
-      }
-    }
-    if (used[v][0] != nullptr && used[v][1] != nullptr) ++num_stereo_views;
-  }
-  const int num_views_used =
-      static_cast<int>(std::count(view_used.begin(), view_used.end(), true));
+  const std::array<const Camera*, 2> camera_pair = {cameras[0], cameras[1]};
+  const PosedViews water =
+      PoseViews(camera_pair, options.initial_n, model.target_points, used,
+                air_extrinsics, 0, &parameters.cam0_from_target, &corners);
+  const std::vector<bool>& view_used = water.used;
+  const std::array<bool, 2>& camera_used = water.camera_seen;
+  const int num_stereo_views = water.num_stereo;
+  const int num_views_used = water.num_used;
 
   // The air views (joint): posed through the air lenses, their corners
   // after the water's, views num_views + a.
@@ -701,41 +724,17 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
             air->views, static_cast<int>(model.air_target_points.size()),
             options.min_corners_per_view, options.use_single_camera_views);
     if (!air_used.ok()) return air_used.status().WithContext("air views");
-    const int num_air_views = static_cast<int>(air->views.size());
-    parameters.cam0_from_target.resize(num_views + num_air_views);
-    for (int a = 0; a < num_air_views; ++a) {
-      const std::array<const TargetObservation*, 2>& observed = (*air_used)[a];
-      std::optional<Rigid3d> camera_from_target[2];
-      for (int c = 0; c < 2; ++c) {
-        if (observed[c] == nullptr) continue;
-        camera_from_target[c] = ThinPortTargetPose(
-            *cameras[c], /*n0=*/1.0, model.air_target_points, *observed[c]);
-      }
-      std::optional<Rigid3d> cam0_from_target = camera_from_target[0];
-      if (!cam0_from_target && camera_from_target[1]) {
-        cam0_from_target = air_extrinsics.Inverse() * *camera_from_target[1];
-      }
-      if (!cam0_from_target) continue;
-      ++num_air_views_used;
-      parameters.cam0_from_target[num_views + a] =
-          PoseFromRigid(*cam0_from_target);
-      for (int c = 0; c < 2; ++c) {
-        if (observed[c] == nullptr) continue;
-        camera_in_air[c] = true;
-        for (int k = 0; k < observed[c]->size(); ++k) {
-          corners.push_back({num_views + a, c, observed[c]->point_ids[k],
-                             observed[c]->pixels[k], true});
-        }
-      }
-      if (observed[0] != nullptr && observed[1] != nullptr) {
-        ++num_air_stereo_views;
-      }
-    }
+    parameters.cam0_from_target.resize(num_views + air->views.size());
+    const PosedViews posed = PoseViews(
+        camera_pair, /*n0=*/1.0, model.air_target_points, *air_used,
+        air_extrinsics, num_views, &parameters.cam0_from_target, &corners);
+    num_air_views_used = posed.num_used;
+    num_air_stereo_views = posed.num_stereo;
+    camera_in_air = posed.camera_seen;
     if (num_air_views_used == 0) {
       return Status::Error("no air view shows the target with at least " +
                            std::to_string(options.min_corners_per_view) +
-                           " corners (and a "
-                           "pose)");
+                           " corners (and a pose)");
     }
   }
   if (num_views_used == 0) {

@@ -17,6 +17,7 @@ namespace rcm::calib {
 namespace {
 
 using test::BoardPoses;
+using test::NarrowRadTanRig;
 using test::ObserveStereo;
 using test::ObserveStereoUnderwater;
 
@@ -31,26 +32,6 @@ constexpr double kExactLensPx = 1e-6;
 
 CalibrationTarget Checkerboard() {
   return MakeCheckerboardTarget(9, 6, 0.04).value();
-}
-
-// The narrow radtan pair of underwater_calibration_test.cc: 640x480,
-// f = 520 px, a 65 mm baseline.
-StereoRig NarrowRadTanRig() {
-  const Camera left =
-      Camera::Create(LensModelId::kRadTan, 640, 480,
-                     {520.0, 521.5, 318.0, 243.0}, {-0.12, 0.05, 2e-4, -1e-4})
-          .value();
-  const Camera right =
-      Camera::Create(LensModelId::kRadTan, 640, 480,
-                     {523.0, 522.0, 324.5, 237.0}, {-0.11, 0.04, -1e-4, 3e-4})
-          .value();
-  Rigid3d right_from_left;
-  right_from_left.rotation =
-      Eigen::AngleAxisd(0.3 * kDegree,
-                        Eigen::Vector3d(-0.2, 1.0, 0.3).normalized())
-          .toRotationMatrix();
-  right_from_left.translation = Eigen::Vector3d(-0.065, 0.0004, 0.0008);
-  return StereoRig::Create(left, right, right_from_left).value();
 }
 
 // `camera` with its focal lengths scaled by 1 + `scale`, its principal

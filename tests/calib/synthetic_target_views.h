@@ -199,6 +199,26 @@ inline int AddGrossOutliers(double fraction, unsigned seed,
   return num_moved;
 }
 
+// A narrow radtan pair: 640x480, f = 520 px (63 degrees across in air,
+// 47 under water), a 65 mm baseline, cam1 turned 0.3 degrees.
+inline StereoRig NarrowRadTanRig() {
+  const Camera left =
+      Camera::Create(LensModelId::kRadTan, 640, 480,
+                     {520.0, 521.5, 318.0, 243.0}, {-0.12, 0.05, 2e-4, -1e-4})
+          .value();
+  const Camera right =
+      Camera::Create(LensModelId::kRadTan, 640, 480,
+                     {523.0, 522.0, 324.5, 237.0}, {-0.11, 0.04, -1e-4, 3e-4})
+          .value();
+  Rigid3d right_from_left;
+  right_from_left.rotation =
+      Eigen::AngleAxisd(0.3 * (M_PI / 180.0),
+                        Eigen::Vector3d(-0.2, 1.0, 0.3).normalized())
+          .toRotationMatrix();
+  right_from_left.translation = Eigen::Vector3d(-0.065, 0.0004, 0.0008);
+  return StereoRig::Create(left, right, right_from_left).value();
+}
+
 }  // namespace rcm::calib::test
 
 #endif  // RCM_TESTS_CALIB_SYNTHETIC_TARGET_VIEWS_H_

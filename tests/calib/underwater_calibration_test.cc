@@ -22,6 +22,7 @@ namespace rcm::calib {
 namespace {
 
 using test::BoardPoses;
+using test::NarrowRadTanRig;
 using test::ObserveStereoUnderwater;
 
 constexpr double kDegree = M_PI / 180.0;
@@ -37,26 +38,6 @@ constexpr double kExactTolerance = 1e-9;
 // 9x6 inner corners, 40 mm squares: 0.32 x 0.20 m of corners.
 CalibrationTarget Checkerboard() {
   return MakeCheckerboardTarget(9, 6, 0.04).value();
-}
-
-// A narrow radtan pair: 640x480, f = 520 px (63 degrees across in air,
-// 47 under water), a 65 mm baseline, cam1 turned 0.3 degrees.
-StereoRig NarrowRadTanRig() {
-  const Camera left =
-      Camera::Create(LensModelId::kRadTan, 640, 480,
-                     {520.0, 521.5, 318.0, 243.0}, {-0.12, 0.05, 2e-4, -1e-4})
-          .value();
-  const Camera right =
-      Camera::Create(LensModelId::kRadTan, 640, 480,
-                     {523.0, 522.0, 324.5, 237.0}, {-0.11, 0.04, -1e-4, 3e-4})
-          .value();
-  Rigid3d right_from_left;
-  right_from_left.rotation =
-      Eigen::AngleAxisd(0.3 * kDegree,
-                        Eigen::Vector3d(-0.2, 1.0, 0.3).normalized())
-          .toRotationMatrix();
-  right_from_left.translation = Eigen::Vector3d(-0.065, 0.0004, 0.0008);
-  return StereoRig::Create(left, right, right_from_left).value();
 }
 
 // The housing drift of the dive: cam1 turned by 0.5 degrees about a skew
@@ -660,8 +641,8 @@ TEST(UnderwaterCalibration, NAtABoundIsAnError) {
     // dive on it); other errors are not.
     EXPECT_TRUE(IsIndexOnBoundError(status)) << "n " << c.n;
   }
-  EXPECT_FALSE(IsIndexOnBoundError(Status::Error(
-      "too few views: 2 views show the target to both cameras")));
+  EXPECT_FALSE(IsIndexOnBoundError(
+      Status::Error("too few views: 2 views show the target to both cameras")));
   EXPECT_FALSE(IsIndexOnBoundError(Status::Ok()));
 }
 

@@ -141,6 +141,14 @@ TEST(CalibrationCovarianceFile, BadFilesGiveOneLineErrors) {
 // An underwater calibration's sidecar: the extrinsics' cross-covariance
 // with both lenses reads back bit for bit and reaches the pair's
 // uncertainty; one that cannot belong to a covariance is an error.
+// The error of parsing `file` as written.
+std::string ParseError(const CalibrationCovarianceFile& file) {
+  return ParseCalibrationCovariance(FormatCalibrationCovariance(file),
+                                    "side.yaml")
+      .status()
+      .message();
+}
+
 TEST(CalibrationCovarianceFile, ExtrinsicsLensCrossCovariance) {
   const Eigen::MatrixXd full = Covariance(22, 1e-3, 4);  // [w; dt; 8; 8]
   CalibrationCovarianceFile file = SampleFile();
@@ -166,21 +174,16 @@ TEST(CalibrationCovarianceFile, ExtrinsicsLensCrossCovariance) {
             file.cameras[1].from_previous_intrinsics_covariance);
   EXPECT_TRUE(pair.Check(8, 8).ok());
 
-  const auto error = [](CalibrationCovarianceFile bad) {
-    return ParseCalibrationCovariance(FormatCalibrationCovariance(bad),
-                                      "side.yaml")
-        .status()
-        .message();
-  };
   CalibrationCovarianceFile bad = file;
   bad.cameras[1].from_previous_intrinsics_covariance *= 1e4;
-  EXPECT_THAT(error(bad), HasSubstr("not positive semi-definite"));
+  EXPECT_THAT(ParseError(bad), HasSubstr("not positive semi-definite"));
   bad = file;
   bad.cameras[1].from_previous_intrinsics_covariance.conservativeResize(6, 15);
-  EXPECT_THAT(error(bad), HasSubstr("is 6x15, not 6x16"));
+  EXPECT_THAT(ParseError(bad), HasSubstr("is 6x15, not 6x16"));
   bad = file;
   bad.cameras[0].intrinsics_covariance.resize(0, 0);
-  EXPECT_THAT(error(bad), HasSubstr("needs T_cn_cnm1_covariance and both"));
+  EXPECT_THAT(ParseError(bad),
+              HasSubstr("needs T_cn_cnm1_covariance and both"));
   const std::string rows =
       "medium: water\ncam0: {}\ncam1:\n  T_cn_cnm1_intrinsics_covariance:\n"
       "  - [1, 2]\n";
@@ -223,22 +226,16 @@ TEST(CalibrationCovarianceFile, LensCrossCovariance) {
   EXPECT_LT((pair.JointCovariance() - full).bottomRows(16).norm(),
             1e-14 * full.norm());
 
-  const auto error = [](CalibrationCovarianceFile bad) {
-    return ParseCalibrationCovariance(FormatCalibrationCovariance(bad),
-                                      "side.yaml")
-        .status()
-        .message();
-  };
   CalibrationCovarianceFile bad = file;
   bad.cameras[1].previous_intrinsics_covariance *= 1e3;
-  EXPECT_THAT(error(bad), HasSubstr("not positive semi-definite"));
+  EXPECT_THAT(ParseError(bad), HasSubstr("not positive semi-definite"));
   bad = file;
   bad.cameras[1].previous_intrinsics_covariance.conservativeResize(8, 7);
-  EXPECT_THAT(error(bad), HasSubstr("is 8x7, not 8x8"));
+  EXPECT_THAT(ParseError(bad), HasSubstr("is 8x7, not 8x8"));
   bad = file;
   bad.cameras[1].from_previous_intrinsics_covariance.resize(0, 0);
   bad.cameras[0].intrinsics_covariance.resize(0, 0);
-  EXPECT_THAT(error(bad), HasSubstr("needs both cameras' intrinsics"));
+  EXPECT_THAT(ParseError(bad), HasSubstr("needs both cameras' intrinsics"));
 }
 
 // ReadStereoRig attaches the sidecar when there is one, and the default
