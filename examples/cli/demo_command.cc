@@ -32,7 +32,6 @@
 #include "rcm/viz/line_plot.h"
 #include "simulation_flags.h"
 
-
 namespace rcm::cli {
 namespace {
 
@@ -44,7 +43,8 @@ constexpr char kUsage[] =
     "Simulates a short sequence of the paper's dataset rig (Alphasense, "
     "720x540,\nequidistant lenses, calibrated in air) moving through a pool "
     "behind flat\nports, matches features in each stereo pair along the "
-    "refractive epipolar\nloci (the front end of rcm estimate), estimates the\nrefractive index n of the water from the matches "
+    "refractive epipolar\nloci (the front end of rcm estimate), estimates "
+    "the\nrefractive index n of the water from the matches "
     "alone (per frame, over a\nsliding window, and over all frames), and "
     "writes into ./rcm_demo/ (or --out):\n"
     "  n_per_frame.png   n per frame with its 1-sigma band, against the "
@@ -87,7 +87,7 @@ struct FrameResult {
   double sigma_frame = NAN;
   double n_window = NAN;
   double sigma_window = NAN;
-  bool medium_switch = false;  // this frame confirmed a switch
+  bool medium_switch = false;   // this frame confirmed a switch
   int switch_first_frame = -1;  // the switch's first frame of the new medium
 };
 
@@ -177,8 +177,8 @@ double MedianLocusDistance(const StereoRig& rig,
   return Median(std::move(residuals));
 }
 
-cv::Mat PlotNPerFrame(const std::vector<FrameResult>& frames,
-                      double n_final, double sigma_final) {
+cv::Mat PlotNPerFrame(const std::vector<FrameResult>& frames, double n_final,
+                      double sigma_final) {
   std::vector<double> x;
   std::vector<double> truth;
   std::vector<double> n_frame;
@@ -204,9 +204,8 @@ cv::Mat PlotNPerFrame(const std::vector<FrameResult>& frames,
   std::ostringstream title;
   title << (switched ? "n from the images since the last switch: "
                      : "n from the images: ")
-        << FormatFixed(n_final, 4) << " +- "
-        << FormatFixed(sigma_final, 4) << " (truth "
-        << FormatFixed(frames.back().n_true, 3) << ")";
+        << FormatFixed(n_final, 4) << " +- " << FormatFixed(sigma_final, 4)
+        << " (truth " << FormatFixed(frames.back().n_true, 3) << ")";
   plot.SetTitle(title.str());
   plot.SetXLabel("frame (20 Hz)");
   plot.SetYLabel("refractive index n");
@@ -275,10 +274,10 @@ int RunDemo() {
   // self-calibration of cam1's rotation uses; and the matches with the
   // front end's systematic error floor. So the demo's sigma is what
   // rcm estimate would report on these images.
-  const StereoRig rig =
-      simulation->rig
-          .WithCalibrationUncertainty(CalibrationUncertainty::DefaultDriftPrior())
-          .value();
+  const StereoRig rig = simulation->rig
+                            .WithCalibrationUncertainty(
+                                CalibrationUncertainty::DefaultDriftPrior())
+                            .value();
   RefinementOptions refinement;
   refinement.systematic_px = kFrontEndSystematicPx;
   StatusOr<std::unique_ptr<SequenceSimulator>> created =
@@ -290,10 +289,10 @@ int RunDemo() {
   SequenceSimulator& simulator = *created.value();
   const int num_frames = simulator.num_frames();
   std::cerr << "rcm demo: " << num_frames << " frames of the "
-            << simulation.value().rig_name << " rig ("
-            << rig.left().width() << "x" << rig.left().height()
-            << ") in a pool, media " << simulator.media().ToString()
-            << ", seed " << FLAGS_seed << std::endl;
+            << simulation.value().rig_name << " rig (" << rig.left().width()
+            << "x" << rig.left().height() << ") in a pool, media "
+            << simulator.media().ToString() << ", seed " << FLAGS_seed
+            << std::endl;
 
   StatusOr<SlidingWindowRefractiveIndexEstimator> window =
       SlidingWindowRefractiveIndexEstimator::Create(rig, refinement,
@@ -331,8 +330,8 @@ int RunDemo() {
     // re-acquires with its prior range when the medium changes).
     std::optional<RefractiveIndexInterval> guide;
     if (const auto current = window.value().Current(); current.ok()) {
-      guide = RefractiveIndexInterval::Around(current->n, current->sigma_n,
-                                              6.0, 0.01);
+      guide = RefractiveIndexInterval::Around(current->n, current->sigma_n, 6.0,
+                                              0.01);
     }
     StatusOr<StereoMatches> matched = front_end->Match(
         frame.value().left, frame.value().right, i, frame.value().t, guide);
@@ -383,8 +382,7 @@ int RunDemo() {
                          }),
           since_switch.end());
     }
-    since_switch.insert(since_switch.end(), matches.begin(),
-                        matches.end());
+    since_switch.insert(since_switch.end(), matches.begin(), matches.end());
     if (i == 0) {
       first_left = frame.value().left;
       first_right = frame.value().right;
@@ -397,8 +395,7 @@ int RunDemo() {
               << FormatFixed(result.sigma_frame, 4) << ", window "
               << FormatFixed(result.n_window, 4) << " +- "
               << FormatFixed(result.sigma_window, 4)
-              << (result.medium_switch ? "  (medium switch)" : "")
-              << std::endl;
+              << (result.medium_switch ? "  (medium switch)" : "") << std::endl;
   }
 
   // The estimator of record over every frame of the current medium.
@@ -415,8 +412,9 @@ int RunDemo() {
   // The rig as the estimate found it: cam1 turned by the self-calibrated
   // rotation, for the corrected pictures.
   const StereoRig estimated_rig =
-      estimate.rotation ? rig.WithCam1Moved(estimate.rotation->angle_axis).value()
-                        : rig;
+      estimate.rotation
+          ? rig.WithCam1Moved(estimate.rotation->angle_axis).value()
+          : rig;
   const double truth = results.back().n_true;
   const double error_n = estimate.n - truth;
   const PreparedCorrespondences prepared =
@@ -453,18 +451,18 @@ int RunDemo() {
   StatusOr<RemapMaps> right_maps =
       BuildVirtualPinholeMaps(right_water, right_view);
   if (!left_maps.ok() || !right_maps.ok()) {
-    PrintError(command, "cannot build the correction maps: " +
-                            (left_maps.ok() ? right_maps.status()
-                                            : left_maps.status())
-                                .message());
+    PrintError(command,
+               "cannot build the correction maps: " +
+                   (left_maps.ok() ? right_maps.status() : left_maps.status())
+                       .message());
     return kExitFailure;
   }
   // Pixel of a raw pixel in a rectified view through `camera` (at n = 1:
   // the lens corrected, the water ignored).
-  const auto rectified_pixel = [&](const RefractiveCamera& camera,
-                                   const Eigen::Matrix3d& camera_from_view,
-                                   const Eigen::Vector2d& raw)
-      -> std::optional<Eigen::Vector2d> {
+  const auto rectified_pixel =
+      [&](const RefractiveCamera& camera,
+          const Eigen::Matrix3d& camera_from_view,
+          const Eigen::Vector2d& raw) -> std::optional<Eigen::Vector2d> {
     const std::optional<Eigen::Vector3d> bearing =
         camera.BearingInWaterFromImage(raw);
     if (!bearing) return std::nullopt;
@@ -479,9 +477,9 @@ int RunDemo() {
   {
     const PreparedCorrespondences prepared =
         PrepareCorrespondences(rig, first_matches);
-    const std::vector<double> r = LocusResiduals(
-        EssentialMatrix(estimated_rig.right_from_left()), prepared.prepared,
-        estimate.n);
+    const std::vector<double> r =
+        LocusResiduals(EssentialMatrix(estimated_rig.right_from_left()),
+                       prepared.prepared, estimate.n);
     for (size_t k = 0; k < r.size(); ++k) {
       if (std::abs(r[k]) < 1.0) {
         inliers_first.push_back(first_matches[prepared.source_index[k]]);
@@ -567,14 +565,12 @@ int RunDemo() {
       {"sigma_n_noise", estimate.sigma_n_noise},
       {"sigma_n_calibration", estimate.sigma_n_calibration},
       {"sigma_n_systematic", estimate.sigma_n_systematic},
-      {"rotation_deg", estimate.rotation
-                           ? nlohmann::json{estimate.rotation->angle_axis.x() *
-                                                180.0 / M_PI,
-                                            estimate.rotation->angle_axis.y() *
-                                                180.0 / M_PI,
-                                            estimate.rotation->angle_axis.z() *
-                                                180.0 / M_PI}
-                           : nlohmann::json(nullptr)},
+      {"rotation_deg",
+       estimate.rotation
+           ? nlohmann::json{estimate.rotation->angle_axis.x() * 180.0 / M_PI,
+                            estimate.rotation->angle_axis.y() * 180.0 / M_PI,
+                            estimate.rotation->angle_axis.z() * 180.0 / M_PI}
+           : nlohmann::json(nullptr)},
       {"crlb", estimate.crlb},
       {"sigma_px", estimate.sigma_px},
       {"n_true", truth},
@@ -626,11 +622,12 @@ int RunDemo() {
             << (num_frames - first_frame_of_medium)
             << (first_frame_of_medium > 0 ? " frames since the last switch"
                                           : " frames")
-            << " (truth " << FormatFixed(truth, 5)
-            << ", off by " << FormatFixed(std::abs(error_n / estimate.sigma_n), 1)
+            << " (truth " << FormatFixed(truth, 5) << ", off by "
+            << FormatFixed(std::abs(error_n / estimate.sigma_n), 1)
             << " sigma)\n"
-            << "  sigma_n: pixel noise " << FormatFixed(estimate.sigma_n_noise, 5)
-            << ", calibration " << FormatFixed(estimate.sigma_n_calibration, 5)
+            << "  sigma_n: pixel noise "
+            << FormatFixed(estimate.sigma_n_noise, 5) << ", calibration "
+            << FormatFixed(estimate.sigma_n_calibration, 5)
             << " (default drift prior 0.1 deg, 0.1 mm), matches' systematic "
                "error "
             << FormatFixed(estimate.sigma_n_systematic, 5) << "\n"

@@ -4,9 +4,8 @@
 
 #include <Eigen/Cholesky>
 #include <algorithm>
-#include <cmath>
-#include <cstdio>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -23,27 +22,26 @@
 #include "image_input_flags.h"
 #include "medium_flag.h"
 #include "progress.h"
-#include "rig_flags.h"
 #include "rcm/estimation/batch_refinement.h"
 #include "rcm/estimation/calibration_propagation.h"
 #include "rcm/estimation/match_refractive_index.h"
 #include "rcm/estimation/medium_drift.h"
-#include "rcm/estimation/prepared_correspondence.h"
-#include "rcm/frontend/stereo_front_end.h"
-#include "rcm/geometry/epipolar.h"
 #include "rcm/estimation/online_estimator.h"
 #include "rcm/estimation/paper_online_estimator.h"
+#include "rcm/estimation/prepared_correspondence.h"
 #include "rcm/estimation/refinement_options.h"
 #include "rcm/estimation/sliding_window_estimator.h"
 #include "rcm/estimation/thick_port_refinement.h"
+#include "rcm/frontend/stereo_front_end.h"
+#include "rcm/geometry/epipolar.h"
 #include "rcm/io/atomic_file.h"
 #include "rcm/io/correspondence_csv.h"
-#include "rcm/io/number_format.h"
 #include "rcm/io/image_file.h"
+#include "rcm/io/number_format.h"
 #include "rcm/io/stereo_rig_file.h"
 #include "rcm/viz/line_plot.h"
 #include "rcm/viz/match_index_image.h"
-
+#include "rig_flags.h"
 
 DEFINE_string(matches, "",
               "correspondence CSV with header frame,xl,yl,xr,yr[,t] in raw "
@@ -151,7 +149,6 @@ constexpr char kUsage[] =
     "Exit status: 0 on success, 1 when the input cannot give an estimate, "
     "2 on\nwrong flags.";
 
-
 // Matching again with the self-calibrated rotation when it moves pixels at
 // the focal length's distance from the center by more than this (the
 // band's half-width is about a pixel), at most kMaxMatchingPasses passes.
@@ -234,11 +231,11 @@ struct Report {
 struct ImageRun {
   std::string source;  // the source's Describe()
   std::vector<Frame> frames;
-  std::vector<FrameRow> own_rows;             // each pair's own estimate
-  FrontEndTimings stage_ms;                   // sums over the pairs
-  double read_ms = 0.0;                       // decoding, summed
-  double guide_ms = 0.0;                      // per-pair estimates, summed
-  double seconds = 0.0;                       // wall clock of the pass
+  std::vector<FrameRow> own_rows;  // each pair's own estimate
+  FrontEndTimings stage_ms;        // sums over the pairs
+  double read_ms = 0.0;            // decoding, summed
+  double guide_ms = 0.0;           // per-pair estimates, summed
+  double seconds = 0.0;            // wall clock of the pass
   int reacquired = 0;
   // Passes of matching again with the self-calibrated rotation, and that
   // rotation (zero when the pairs were matched with the calibration).
@@ -256,8 +253,7 @@ double Milliseconds(std::chrono::steady_clock::time_point start) {
       .count();
 }
 
-StatusOr<ImageRun> RunFrontEnd(const StereoRig& rig,
-                               StereoImageSource* source,
+StatusOr<ImageRun> RunFrontEnd(const StereoRig& rig, StereoImageSource* source,
                                const StereoFrontEndOptions& options,
                                const RefinementOptions& refinement) {
   StatusOr<StereoFrontEnd> front_end = StereoFrontEnd::Create(rig, options);
@@ -268,8 +264,7 @@ StatusOr<ImageRun> RunFrontEnd(const StereoRig& rig,
   run.source = source->Describe();
   const size_t pairs = source->NumPairs();
   const size_t picture_index =
-      FLAGS_picture_frame >= 0 ? std::numeric_limits<size_t>::max()
-                               : pairs / 2;
+      FLAGS_picture_frame >= 0 ? std::numeric_limits<size_t>::max() : pairs / 2;
   std::optional<RefractiveIndexInterval> guide;
   Progress progress("rcm estimate: pair", pairs);
   const auto start = std::chrono::steady_clock::now();
@@ -353,21 +348,22 @@ RefinementOptions RefinementOptionsFromFlags() {
   options.inlier_threshold_px = FLAGS_inlier_threshold;
   options.refine_rotation = FLAGS_refine_rotation;
   options.self_calibrate_rotation = FLAGS_self_calibrate;
-  options.systematic_px = FLAGS_systematic_px >= 0.0
-                              ? FLAGS_systematic_px
-                              : (FLAGS_matches.empty() ? kFrontEndSystematicPx
-                                                       : 0.0);
+  options.systematic_px =
+      FLAGS_systematic_px >= 0.0
+          ? FLAGS_systematic_px
+          : (FLAGS_matches.empty() ? kFrontEndSystematicPx : 0.0);
   return options;
 }
 
 // --drift-prior DEG[,MM] as (radians, meters); nullopt when not given.
 StatusOr<std::optional<std::pair<double, double>>> DriftPriorFromFlag() {
-  if (FLAGS_drift_prior.empty()) return std::optional<std::pair<double, double>>();
+  if (FLAGS_drift_prior.empty())
+    return std::optional<std::pair<double, double>>();
   double degrees = 0.0;
   double millimeters = NAN;
   char tail = 0;
-  const int read = std::sscanf(FLAGS_drift_prior.c_str(), "%lf,%lf%c",
-                               &degrees, &millimeters, &tail);
+  const int read = std::sscanf(FLAGS_drift_prior.c_str(), "%lf,%lf%c", &degrees,
+                               &millimeters, &tail);
   // MM left out: the same number as DEG (as in the default 0.1,0.1).
   if (read == 1) millimeters = degrees;
   if ((read != 1 && read != 2) || !std::isfinite(degrees) ||
@@ -453,11 +449,11 @@ StatusOr<Report> RunRefine(const StereoRig& rig,
       ", scan " + FormatFixed(summary->n_seed, 4) + ", robust stage " +
       FormatFixed(summary->n_robust, 5));
   if (air_gap) {
-    report.extra["air_gap"] = {{"left_m", air_gap->left_air_gap},
-                               {"right_m", air_gap->right_air_gap},
-                               {"sigma_m", air_gap->sigma},
-                               {"correlation_with_n",
-                                air_gap->correlation_with_n}};
+    report.extra["air_gap"] = {
+        {"left_m", air_gap->left_air_gap},
+        {"right_m", air_gap->right_air_gap},
+        {"sigma_m", air_gap->sigma},
+        {"correlation_with_n", air_gap->correlation_with_n}};
     report.text_lines.push_back(
         "  air gap    " + FormatFixed(1e3 * air_gap->left_air_gap, 2) +
         " mm (left), " + FormatFixed(1e3 * air_gap->right_air_gap, 2) +
@@ -818,15 +814,15 @@ std::vector<std::string> CalibrationLines(const Report& report) {
   if (report.consistency) {
     const FrameConsistency& c = *report.consistency;
     const bool disagree = c.inflation > 1.0;
-    lines.push_back(
-        "  frames     " + std::to_string(c.frames) +
-        (disagree ? " disagree beyond" : " agree within") +
-        " their sigmas: chi2 " + FormatFixed(c.chi_squared, 1) + " for " +
-        std::to_string(c.dof) + " dof (p " + FormatProbability(c.p_value) +
-        ")" +
-        (disagree ? "; the pixel-noise share of sigma_n is inflated x" +
-                        FormatFixed(c.inflation, 2)
-                  : ""));
+    lines.push_back("  frames     " + std::to_string(c.frames) +
+                    (disagree ? " disagree beyond" : " agree within") +
+                    " their sigmas: chi2 " + FormatFixed(c.chi_squared, 1) +
+                    " for " + std::to_string(c.dof) + " dof (p " +
+                    FormatProbability(c.p_value) + ")" +
+                    (disagree
+                         ? "; the pixel-noise share of sigma_n is inflated x" +
+                               FormatFixed(c.inflation, 2)
+                         : ""));
   }
   return lines;
 }
@@ -844,14 +840,12 @@ cv::Mat PlotPerFrame(const Report& report) {
   }
   LinePlot plot;
   plot.SetTitle("n = " + FormatFixed(report.n, 5) + " +- " +
-                FormatFixed(report.sigma_n, 5) + " (" + FLAGS_estimator +
-                ")");
+                FormatFixed(report.sigma_n, 5) + " (" + FLAGS_estimator + ")");
   plot.SetXLabel("frame");
   plot.SetYLabel("refractive index n");
-  const std::string what = FLAGS_estimator == "refine" ? "each frame alone"
-                           : FLAGS_estimator == "window"
-                               ? "window estimate"
-                               : "estimate so far";
+  const std::string what = FLAGS_estimator == "refine"   ? "each frame alone"
+                           : FLAGS_estimator == "window" ? "window estimate"
+                                                         : "estimate so far";
   if (!x.empty()) {
     plot.AddBand(x, low, high, what + ": 1 sigma", PaletteColor(7), 0.2);
     plot.AddLine(x, n, what, LineStyle{PaletteColor(7)});
@@ -1006,7 +1000,8 @@ int RunEstimate() {
                FLAGS_calib +
                    " gives a thick port (an air gap or glass), which only "
                    "--estimator refine models; the " +
-                   FLAGS_estimator + " estimator assumes the paper's thin port");
+                   FLAGS_estimator +
+                   " estimator assumes the paper's thin port");
     return kExitUsage;
   }
   // The output folder first: a run is not wasted on one that cannot be
@@ -1218,17 +1213,17 @@ int RunEstimate() {
     return true;
   };
   if (!FLAGS_per_frame.empty() &&
-      !write(FLAGS_per_frame, WriteFileAtomically(
-                                  FLAGS_per_frame,
-                                  FormatFrameRows(report->rows)))) {
+      !write(FLAGS_per_frame,
+             WriteFileAtomically(FLAGS_per_frame,
+                                 FormatFrameRows(report->rows)))) {
     return kExitFailure;
   }
   if (!FLAGS_out.empty()) {
     const std::filesystem::path out(FLAGS_out);
     const std::string per_frame = (out / "per_frame.csv").string();
     const std::string plot = (out / "n_per_frame.png").string();
-    if (!write(per_frame, WriteFileAtomically(
-                              per_frame, FormatFrameRows(report->rows))) ||
+    if (!write(per_frame,
+               WriteFileAtomically(per_frame, FormatFrameRows(report->rows))) ||
         !write(plot, WritePng(PlotPerFrame(*report), plot))) {
       return kExitFailure;
     }
@@ -1247,8 +1242,7 @@ int RunEstimate() {
       }
     }
     const std::string summary = (out / "estimate.json").string();
-    if (!write(summary,
-               WriteFileAtomically(summary, json.dump(2) + "\n"))) {
+    if (!write(summary, WriteFileAtomically(summary, json.dump(2) + "\n"))) {
       return kExitFailure;
     }
   }

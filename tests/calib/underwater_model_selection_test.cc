@@ -5,16 +5,16 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <cmath>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "calib/synthetic_target_views.h"
 #include "rcm/estimation/batch_refinement.h"
-#include "rcm/sim/stereo_sampler.h"
 #include "rcm/sim/reference_rigs.h"
+#include "rcm/sim/stereo_sampler.h"
 #include "support/sample_moments.h"
 #include "support/test_budget.h"
 
@@ -44,8 +44,9 @@ struct Dive {
 
 StereoRig Drifted(const StereoRig& rig) {
   return rig
-      .WithCam1Moved(0.5 * kDegree * Eigen::Vector3d(0.3, -1.0, 0.2).normalized(),
-                     Eigen::Vector3d(3e-4, -1e-4, 2e-4))
+      .WithCam1Moved(
+          0.5 * kDegree * Eigen::Vector3d(0.3, -1.0, 0.2).normalized(),
+          Eigen::Vector3d(3e-4, -1e-4, 2e-4))
       .value();
 }
 
@@ -157,10 +158,9 @@ TEST(UnderwaterModelSelection, ExactBowedBoardChoosesTheBow) {
           << candidate.model.Name();
     }
   }
-  EXPECT_DOUBLE_EQ(selection->sigma_n,
-                   std::hypot(selection->sigma_n_noise,
-                              selection->sigma_n_lenses,
-                              selection->sigma_n_model));
+  EXPECT_DOUBLE_EQ(selection->sigma_n, std::hypot(selection->sigma_n_noise,
+                                                  selection->sigma_n_lenses,
+                                                  selection->sigma_n_model));
 }
 
 // A flat board behind 6 mm acrylic with an 8 mm air gap, described to the
@@ -344,7 +344,8 @@ TEST(UnderwaterCalibration, LensCorrelationKeepsTargetFreeSigmaHonest) {
   lens(0, 1) = lens(1, 0) = 0.8 * lens(0, 0);
   air_uncertainty.left_lens_covariance = lens;
   air_uncertainty.right_lens_covariance = lens;
-  const StereoRig air = dive.air.WithCalibrationUncertainty(air_uncertainty).value();
+  const StereoRig air =
+      dive.air.WithCalibrationUncertainty(air_uncertainty).value();
   UnderwaterCalibrationOptions options;
   options.folds = 0;
   options.fit_conventional_model = false;
@@ -361,7 +362,8 @@ TEST(UnderwaterCalibration, LensCorrelationKeepsTargetFreeSigmaHonest) {
   joint.extrinsics_covariance = nominal->extrinsic_change.covariance +
                                 nominal->extrinsics_covariance_from_lenses;
   joint.extrinsics_lens_covariance = nominal->extrinsics_lens_covariance;
-  ASSERT_TRUE(joint.Check(size, size).ok()) << joint.Check(size, size).message();
+  ASSERT_TRUE(joint.Check(size, size).ok())
+      << joint.Check(size, size).message();
   CalibrationUncertainty independent = joint;
   independent.extrinsics_lens_covariance.resize(0, 0);
 
@@ -410,9 +412,10 @@ TEST(UnderwaterCalibration, LensCorrelationKeepsTargetFreeSigmaHonest) {
   };
   const double sd = rms(z);
   const double sd_independent = rms(z_independent);
-  std::printf("[ MEASURED ] target-free z over %d draws: rms %.3f with the "
-              "lens correlation, %.3f without\n",
-              kDraws, sd, sd_independent);
+  std::printf(
+      "[ MEASURED ] target-free z over %d draws: rms %.3f with the "
+      "lens correlation, %.3f without\n",
+      kDraws, sd, sd_independent);
   if (!rcm::test::ChecksStatistics()) return;
   EXPECT_GT(sd, 0.65);
   EXPECT_LT(sd, 1.35);
@@ -462,7 +465,8 @@ int MonteCarloTrials() {
 }
 
 // The z-scores of `trials` dives under `error`; prints their moments.
-std::vector<double> ZScoresUnderModelError(const ModelError& error, int trials) {
+std::vector<double> ZScoresUnderModelError(const ModelError& error,
+                                           int trials) {
   std::vector<double> z;
   int chose_truth = 0;
   for (int trial = 0; trial < trials; ++trial) {
@@ -470,8 +474,8 @@ std::vector<double> ZScoresUnderModelError(const ModelError& error, int trials) 
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     Eigen::Vector2d warp = Eigen::Vector2d::Zero();
     if (error.bow) {
-      const double bowl = (0.5e-3 + 2.5e-3 * unit(rng)) *
-                          (unit(rng) < 0.5 ? -1.0 : 1.0);
+      const double bowl =
+          (0.5e-3 + 2.5e-3 * unit(rng)) * (unit(rng) < 0.5 ? -1.0 : 1.0);
       const double share = unit(rng);
       warp = bowl * Eigen::Vector2d(share, 1.0 - share);
     }
@@ -482,9 +486,9 @@ std::vector<double> ZScoresUnderModelError(const ModelError& error, int trials) 
     if (error.tilt) {
       const double tilt = (0.5 + 2.5 * unit(rng)) * kDegree;
       const double azimuth = 2.0 * M_PI * unit(rng);
-      housing.normal = Eigen::Vector3d(std::sin(tilt) * std::cos(azimuth),
-                                       std::sin(tilt) * std::sin(azimuth),
-                                       std::cos(tilt));
+      housing.normal =
+          Eigen::Vector3d(std::sin(tilt) * std::cos(azimuth),
+                          std::sin(tilt) * std::sin(azimuth), std::cos(tilt));
     }
     Dive dive = MakeDive(kMonteCarloViews, 0.3, 2000 + trial, warp, housing);
     FlatPort described = housing;
@@ -499,10 +503,11 @@ std::vector<double> ZScoresUnderModelError(const ModelError& error, int trials) 
     z.push_back((selection->n - kTrueN) / selection->sigma_n);
     if (trial == 0) {
       // The first dive's candidates, as docs/calibrate.md shows them.
-      std::printf("[ MEASURED ] %s, dive 0: n %.5f +- %.5f (noise %.5f, "
-                  "model %.5f), truth %.3f\n",
-                  error.name, selection->n, selection->sigma_n,
-                  selection->sigma_n_noise, selection->sigma_n_model, kTrueN);
+      std::printf(
+          "[ MEASURED ] %s, dive 0: n %.5f +- %.5f (noise %.5f, "
+          "model %.5f), truth %.3f\n",
+          error.name, selection->n, selection->sigma_n,
+          selection->sigma_n_noise, selection->sigma_n_model, kTrueN);
       for (size_t k = 0; k < selection->candidates.size(); ++k) {
         const UnderwaterCandidate& c = selection->candidates[k];
         if (!c.fit) {
@@ -510,12 +515,12 @@ std::vector<double> ZScoresUnderModelError(const ModelError& error, int trials) 
                       c.error.c_str());
           continue;
         }
-        std::printf("[ MEASURED ]   %s %-38s n %.5f +- %.5f rms %.4f px "
-                    "held-out %.4f px evidence %.1f%s\n",
-                    static_cast<int>(k) == selection->chosen ? "*" : " ",
-                    c.model.Name().c_str(), c.fit->n, c.sigma_n_noise,
-                    c.fit->rms_px, c.held_out_rms_px, c.evidence,
-                    c.plausible ? "" : " x");
+        std::printf(
+            "[ MEASURED ]   %s %-38s n %.5f +- %.5f rms %.4f px "
+            "held-out %.4f px evidence %.1f%s\n",
+            static_cast<int>(k) == selection->chosen ? "*" : " ",
+            c.model.Name().c_str(), c.fit->n, c.sigma_n_noise, c.fit->rms_px,
+            c.held_out_rms_px, c.evidence, c.plausible ? "" : " x");
       }
     }
     const UnderwaterCandidateModel& chosen =
@@ -525,9 +530,10 @@ std::vector<double> ZScoresUnderModelError(const ModelError& error, int trials) 
                    chosen.port_tilt == error.tilt;
   }
   const rcm::test::SampleMoments moments = rcm::test::Moments(z);
-  std::printf("[ MEASURED ] %s: z of n mean %.3f, sd %.3f; the true model "
-              "chosen in %d of %d\n",
-              error.name, moments.mean, moments.stddev, chose_truth, trials);
+  std::printf(
+      "[ MEASURED ] %s: z of n mean %.3f, sd %.3f; the true model "
+      "chosen in %d of %d\n",
+      error.name, moments.mean, moments.stddev, chose_truth, trials);
   return z;
 }
 
@@ -537,10 +543,11 @@ TEST(UnderwaterModelSelection, MonteCarloHonestUnderEachModelError) {
   const std::vector<ModelError> errors =
       rcm::test::kSanitizerBuild && trials == 1
           ? std::vector<ModelError>{{"bow, air gap and tilt", true, true, true}}
-          : std::vector<ModelError>{{"bowed board", true, false, false},
-                                    {"air gap", false, true, false},
-                                    {"tilted port", false, false, true},
-                                    {"bow, air gap and tilt", true, true, true}};
+          : std::vector<ModelError>{
+                {"bowed board", true, false, false},
+                {"air gap", false, true, false},
+                {"tilted port", false, false, true},
+                {"bow, air gap and tilt", true, true, true}};
   std::vector<double> pooled;
   for (const ModelError& error : errors) {
     const std::vector<double> z = ZScoresUnderModelError(error, trials);
@@ -551,9 +558,10 @@ TEST(UnderwaterModelSelection, MonteCarloHonestUnderEachModelError) {
     EXPECT_LT(sd, acceptance ? 1.3 : 2.0) << error.name;
   }
   const rcm::test::SampleMoments moments = rcm::test::Moments(pooled);
-  std::printf("[ MEASURED ] every error: z of n mean %.3f, sd %.3f over %zu "
-              "dives\n",
-              moments.mean, moments.stddev, pooled.size());
+  std::printf(
+      "[ MEASURED ] every error: z of n mean %.3f, sd %.3f over %zu "
+      "dives\n",
+      moments.mean, moments.stddev, pooled.size());
   if (!rcm::test::ChecksStatistics() || pooled.size() < 2) return;
   EXPECT_GT(moments.stddev, 0.7);
   EXPECT_LT(moments.stddev, 1.35);

@@ -447,16 +447,14 @@ std::vector<RigDefect> RigDefects() {
        Steps({CameraInfos(true, "", ""),
               [](const std::string& dir) { fs::remove(dir + "/right.yaml"); }}),
        infos, "$D/right.yaml: cannot open: No such file or directory"},
-      {"CameraInfoNanFocal",
-       CameraInfos(true, "data: [346.7,", "data: [nan,"),
+      {"CameraInfoNanFocal", CameraInfos(true, "data: [346.7,", "data: [nan,"),
        infos, "$D/left.yaml:7: camera_matrix"},
       {"CameraInfoInfDistortion",
        CameraInfos(false, "[-0.01, 0.002", "[-0.01, .inf"), infos,
        "$D/right.yaml:12: distortion_coefficients"},
       {"CameraInfoZeroBaseline",
        CameraInfos(false, "360.5, " + FormatDouble(kRightP03), "360.5, 0"),
-       infos,
-       "zero baseline"},
+       infos, "zero baseline"},
   };
 }
 
@@ -732,8 +730,11 @@ void AddEstimateRows(std::vector<BadInputCase>* rows) {
   // The calibration's uncertainty: the drift prior flag and the sidecar.
   for (const auto& [name, value] :
        std::vector<std::pair<std::string, std::string>>{
-           {"Text", "abc"}, {"Negative", "-0.1"}, {"TooLarge", "20"},
-           {"ThreeNumbers", "0.1,0.1,0.1"}, {"Nan", "nan"}}) {
+           {"Text", "abc"},
+           {"Negative", "-0.1"},
+           {"TooLarge", "20"},
+           {"ThreeNumbers", "0.1,0.1,0.1"},
+           {"Nan", "nan"}}) {
     rows->push_back({"EstimateDriftPrior" + name,
                      Nothing(),
                      {"estimate", "--calib", kRig, "--matches", kMatches,
@@ -751,9 +752,10 @@ void AddEstimateRows(std::vector<BadInputCase>* rows) {
        {"$D/out/estimate.json"}});
   rows->push_back(
       {"EstimateCovarianceSidecarNotPositive",
-       Steps({File("rig.yaml", test::ReadWholeFile(kRig)),
-              File("rig-covariance.yaml",
-                   "medium: air\ncam0:\n  intrinsics_covariance:\n  - [-1]\n")}),
+       Steps(
+           {File("rig.yaml", test::ReadWholeFile(kRig)),
+            File("rig-covariance.yaml",
+                 "medium: air\ncam0:\n  intrinsics_covariance:\n  - [-1]\n")}),
        {"estimate", "--calib", "$D/rig.yaml", "--matches", kMatches, "--out",
         "$D/out"},
        "$D/rig-covariance.yaml:4: cam0.intrinsics_covariance: is not positive "
@@ -959,14 +961,13 @@ void AddSimulateRows(std::vector<BadInputCase>* rows) {
       {"SimulateExtrinsicDriftTooLarge", Nothing(),
        SimulateArgs({"--extrinsic-drift", "0,0,45", "--out", "$D/out"}),
        "rotation of 45 deg is above 10 deg", outputs});
-  rows->push_back(
-      {"SimulateLensChangeMalformed", Nothing(),
-       SimulateArgs({"--lens-change", "0.5,x", "--out", "$D/out"}),
-       "--lens-change 0.5,x: expected PCT0[,PCT1]", outputs});
-  rows->push_back(
-      {"SimulateLensChangeTooLarge", Nothing(),
-       SimulateArgs({"--lens-change", "0,8", "--out", "$D/out"}),
-       "lens change of camera 1: a focal scale of 0.08 is outside", outputs});
+  rows->push_back({"SimulateLensChangeMalformed", Nothing(),
+                   SimulateArgs({"--lens-change", "0.5,x", "--out", "$D/out"}),
+                   "--lens-change 0.5,x: expected PCT0[,PCT1]", outputs});
+  rows->push_back({"SimulateLensChangeTooLarge", Nothing(),
+                   SimulateArgs({"--lens-change", "0,8", "--out", "$D/out"}),
+                   "lens change of camera 1: a focal scale of 0.08 is outside",
+                   outputs});
   rows->push_back(
       {"SimulateBoardAprilGrid", Nothing(),
        SimulateArgs({"--board", "aprilgrid", "--cols", "6", "--rows", "6",
@@ -1160,8 +1161,8 @@ void AddCalibrateRows(std::vector<BadInputCase>* rows) {
   }
   // --corners FILE.vnl (mrcal's corners format) and --corners-out.
   const std::vector<std::string> corner_args = {
-      "--corners", "$D/c.vnl", "--left", "$D/left", "--right", "$D/right",
-      "--out",     "$D/out/rig.yaml"};
+      "--corners", "$D/c.vnl", "--left", "$D/left",
+      "--right",   "$D/right", "--out",  "$D/out/rig.yaml"};
   std::string full_board;  // 35 rows of the 7x5 board for one left image
   for (int i = 0; i < 35; ++i) full_board += "$D/left/000000.png 10 20 0\n";
   std::string nine_by_six;  // 54 rows: a 9x6 board's
@@ -1207,12 +1208,12 @@ void AddCalibrateRows(std::vector<BadInputCase>* rows) {
                    CalibrateArgs({"--corners", "$D/c.vnl", "--bag", "$D/b.bag",
                                   "--out", "$D/out/rig.yaml"}),
                    "--corners takes --left and --right", outputs});
-  rows->push_back({"CalibrateCornersOutInAMissingFolder", pair,
-                   CalibrateArgs(Concat(folders, {"--corners-out",
-                                                  "$D/nowhere/c.vnl"})),
-                   "--corners-out $D/nowhere/c.vnl: folder $D/nowhere does "
-                   "not exist",
-                   Concat(outputs, {"$D/nowhere/c.vnl"})});
+  rows->push_back(
+      {"CalibrateCornersOutInAMissingFolder", pair,
+       CalibrateArgs(Concat(folders, {"--corners-out", "$D/nowhere/c.vnl"})),
+       "--corners-out $D/nowhere/c.vnl: folder $D/nowhere does "
+       "not exist",
+       Concat(outputs, {"$D/nowhere/c.vnl"})});
   rows->push_back({"CalibrateImageSizeWithoutCorners", pair,
                    CalibrateArgs(Concat(folders, {"--image-size", "640,480"})),
                    "--image-size goes with --corners", outputs});

@@ -7,9 +7,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -234,10 +234,10 @@ TEST(CalibrateCli, FoldersToCamchainAndReport) {
       json["board_flatness"]["bowl_leave_out_sigma_mm"].get<double>());
   const size_t flatness = result.out.find("board flatness: bowl ");
   ASSERT_NE(flatness, std::string::npos) << result.out;
-  EXPECT_NE(result.out.substr(flatness, result.out.find('\n', flatness) -
-                                            flatness)
-                .find(leave_out),
-            std::string::npos)
+  EXPECT_NE(
+      result.out.substr(flatness, result.out.find('\n', flatness) - flatness)
+          .find(leave_out),
+      std::string::npos)
       << result.out;
   EXPECT_EQ(json["projection_uncertainty"]["cam0"]["distance_m"], "inf");
   EXPECT_GT(json["projection_uncertainty"]["cam1"]["median_px"].get<double>(),
@@ -252,18 +252,17 @@ TEST(CalibrateCli, FoldersToCamchainAndReport) {
 
 TEST(CalibrateCli, JsonOnStdoutAndAnOutputFolder) {
   const std::string dir = WriteFolders(Pairs(), "pairs");
-  const RunResult result =
-      Rcm(Args(dir, dir + "/calibration",
-               {"--json", "--folds", "0", "--flat-board",
-                "--uncertainty-distance", "1.5"}));
+  const RunResult result = Rcm(Args(dir, dir + "/calibration",
+                                    {"--json", "--folds", "0", "--flat-board",
+                                     "--uncertainty-distance", "1.5"}));
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const nlohmann::json json = nlohmann::json::parse(result.out);
   EXPECT_FALSE(json["board_flatness"]["estimated"].get<bool>());
   EXPECT_EQ(json["projection_uncertainty"]["cam0"]["distance_m"], 1.5);
-  EXPECT_EQ(Rcm(Args(dir, dir + "/calibration",
-                     {"--uncertainty-distance", "-1"}))
-                .exit_code,
-            2);
+  EXPECT_EQ(
+      Rcm(Args(dir, dir + "/calibration", {"--uncertainty-distance", "-1"}))
+          .exit_code,
+      2);
   EXPECT_EQ(json["camchain"], dir + "/calibration/camchain.yaml");
   EXPECT_FALSE(json.contains("cross_validation"));
   EXPECT_FALSE(json["board_flatness"].contains("bowl_leave_out_sigma_mm"));
@@ -296,8 +295,7 @@ void ExpectSameCalibration(const std::string& a_path,
   const Rigid3d& tb = *b.cameras[1].cam_from_previous;
   EXPECT_LT((ta.translation - tb.translation).norm(),
             kRelativeTolerance * tb.translation.norm());
-  EXPECT_LT((ta.rotation - tb.rotation).norm(),
-            kRelativeTolerance);
+  EXPECT_LT((ta.rotation - tb.rotation).norm(), kRelativeTolerance);
 }
 
 // --corners-out writes what the run calibrated from; --corners with the
@@ -319,8 +317,8 @@ TEST(CalibrateCli, CornersOutThenCornersGivesTheSameCamchain) {
   EXPECT_GE(std::count(text.begin(), text.end(), '\n'),
             1 + 35 * 2 * pairs.Stereo());
 
-  const RunResult read = Rcm(Args(
-      dir, dir + "/read.yaml", {"--folds", "0", "--corners", corners}));
+  const RunResult read = Rcm(
+      Args(dir, dir + "/read.yaml", {"--folds", "0", "--corners", corners}));
   ASSERT_EQ(read.exit_code, 0) << read.err;
   EXPECT_NE(read.out.find("corners file " + corners), std::string::npos)
       << read.out;
@@ -356,12 +354,28 @@ TEST(CalibrateCli, CornersOfMrcalStyleNamesPairByTheirNumber) {
   const std::string renamed = dir + "/mrcal.vnl";
   std::ofstream(renamed) << "# filename x y level\n" << right_rows << left_rows;
   const cv::Size size = Pairs().left.front().size();
-  const RunResult read = Rcm(
-      {"calibrate", "--corners", renamed, "--left", "frames/left*.png",
-       "--right", "frames/right*.png", "--image-size",
-       std::to_string(size.width) + "," + std::to_string(size.height),
-       "--out", dir + "/read.yaml", "--folds", "0", "--board", "chessboard",
-       "--cols", "7", "--rows", "5", "--square", BoardFlags()[7]});
+  const RunResult read =
+      Rcm({"calibrate",
+           "--corners",
+           renamed,
+           "--left",
+           "frames/left*.png",
+           "--right",
+           "frames/right*.png",
+           "--image-size",
+           std::to_string(size.width) + "," + std::to_string(size.height),
+           "--out",
+           dir + "/read.yaml",
+           "--folds",
+           "0",
+           "--board",
+           "chessboard",
+           "--cols",
+           "7",
+           "--rows",
+           "5",
+           "--square",
+           BoardFlags()[7]});
   ASSERT_EQ(read.exit_code, 0) << read.err;
   ExpectSameCalibration(dir + "/read.yaml", dir + "/detected.yaml");
 }

@@ -126,7 +126,7 @@ TEST(EstimateCli, OnlineAgreesWithRefine) {
   // models (online_estimator.h): they agree to a small fraction of sigma
   // (measured 0.1 sigma in n, 0.1 % in sigma on these 10 frames).
   for (const bool exact : {true, false}) {
-    std::vector<std::string> args = {"estimate", "--calib", kRig,
+    std::vector<std::string> args = {"estimate",  "--calib",    kRig,
                                      "--matches", kDemoMatches, "--json"};
     if (exact) args.insert(args.end(), {"--drift-prior", "0"});
     const RunResult refine = Rcm(args);
@@ -140,8 +140,7 @@ TEST(EstimateCli, OnlineAgreesWithRefine) {
     const double sigma = a["sigma_n"].get<double>();
     EXPECT_NEAR(a["n"].get<double>(), b["n"].get<double>(),
                 exact ? 1e-6 : 0.2 * sigma);
-    EXPECT_NEAR(sigma, b["sigma_n"].get<double>(),
-                exact ? 1e-6 : 0.01 * sigma);
+    EXPECT_NEAR(sigma, b["sigma_n"].get<double>(), exact ? 1e-6 : 0.01 * sigma);
     EXPECT_EQ(a["inliers"], b["inliers"]);
   }
 }
@@ -239,12 +238,12 @@ TEST(EstimateCli, PinnedAtTheUpperBoundIsRefused) {
   std::filesystem::remove_all(dive);
   const RunResult simulated =
       Rcm({"simulate", "--out", dive, "--rig", "narrow", "--noimages",
-           "--depth-range", "0.9,1.1", "--matches-per-frame", "300",
-           "--frames", "2", "--n", "1.342", "--extrinsic-drift", "-0.15,0,0"});
+           "--depth-range", "0.9,1.1", "--matches-per-frame", "300", "--frames",
+           "2", "--n", "1.342", "--extrinsic-drift", "-0.15,0,0"});
   ASSERT_EQ(simulated.exit_code, 0) << simulated.err;
-  const RunResult held = Rcm({"estimate", "--calib", dive + "/camchain.yaml",
-                              "--matches", dive + "/matches.csv",
-                              "--noself-calibrate", "--json"});
+  const RunResult held =
+      Rcm({"estimate", "--calib", dive + "/camchain.yaml", "--matches",
+           dive + "/matches.csv", "--noself-calibrate", "--json"});
   ExpectFailsWithOneLine(held, 1, "is at the upper bound of [1, 2]");
   EXPECT_NE(held.err.find("rcm calibrate --underwater"), std::string::npos);
   const RunResult calibrated =
@@ -264,17 +263,16 @@ TEST(EstimateCli, MediumGivesTheTurnOfAStaleNarrowRig) {
   std::filesystem::remove_all(dive);
   const RunResult simulated =
       Rcm({"simulate", "--out", dive, "--rig", "narrow", "--noimages",
-           "--depth-range", "0.9,1.1", "--matches-per-frame", "300",
-           "--frames", "10", "--n", "1.340", "--match-noise", "0.3",
-           "--extrinsic-drift", "0.3,0.4,0"});
+           "--depth-range", "0.9,1.1", "--matches-per-frame", "300", "--frames",
+           "10", "--n", "1.340", "--match-noise", "0.3", "--extrinsic-drift",
+           "0.3,0.4,0"});
   ASSERT_EQ(simulated.exit_code, 0) << simulated.err;
   // Without the medium (item 4 of issue 30, the drift alone): the default
   // drift prior (0.1 degree) is 5 of its sigmas short of the turn, but the
   // data pull the self-calibrated rotation to it; n within 3 of its sigmas
   // (measured 1.0), and the calibration said stale.
-  const RunResult alone =
-      Rcm({"estimate", "--calib", dive + "/camchain.yaml", "--matches",
-           dive + "/matches.csv", "--json"});
+  const RunResult alone = Rcm({"estimate", "--calib", dive + "/camchain.yaml",
+                               "--matches", dive + "/matches.csv", "--json"});
   ASSERT_EQ(alone.exit_code, 0) << alone.err;
   const nlohmann::json own = nlohmann::json::parse(alone.out);
   EXPECT_LT(std::abs(own["n"].get<double>() - 1.340),
@@ -612,9 +610,9 @@ TEST(EstimateCli, PortBlocksSelectTheThickPortModel) {
   options.num_frames = 2;
   options.per_frame = 250;
   const std::string matches = test::WriteTempFile(
-      "thick.csv", FormatCorrespondenceCsv(
-                       SampleFlatPortCorrespondences(rig, port, port, options)
-                           .value()));
+      "thick.csv",
+      FormatCorrespondenceCsv(
+          SampleFlatPortCorrespondences(rig, port, port, options).value()));
   const StereoRig with_ports = rig.WithPorts(port, port).value();
   const std::string thick_rig = test::WriteTempFile(
       "thick_rig.yaml", FormatCamchain(CamchainFromStereoRig(with_ports)));

@@ -61,8 +61,7 @@ TEST(CalibrationPropagation, RotationColumnsMatchJets) {
   const CalibrationParameterLayout layout = CalibrationParameterLayout::Of(rig);
   LocusNormalEquations equations(layout.Size());
   AccumulateLocusNormalEquations(rig, layout, aligned, prepared.prepared, all,
-                                 1.3,
-                                 rotation, &equations);
+                                 1.3, rotation, &equations);
   ASSERT_EQ(equations.count, static_cast<int64_t>(all.size()));
 
   using Jet = ceres::Jet<double, 4>;
@@ -72,8 +71,8 @@ TEST(CalibrationPropagation, RotationColumnsMatchJets) {
                     Jet(rotation[2], 3)};
   for (const PreparedCorrespondence& match : prepared.prepared) {
     Jet r;
-    ASSERT_TRUE(SampsonCoplanarityResidual<Jet>(essential, match, Jet(1.3, 0),
-                                                w, &r));
+    ASSERT_TRUE(
+        SampsonCoplanarityResidual<Jet>(essential, match, Jet(1.3, 0), w, &r));
     expected += r.v * r.v.transpose();
   }
   // Central differences of step 1e-6 rad: truncation ~1e-12 and rounding
@@ -140,8 +139,9 @@ TEST(CalibrationPropagation, SensitivitiesMatchTheEstimatorsResponse) {
     const double step = 1e-6 * (1.0 + std::abs(truth.left().params()[j]));
     double responses[2];
     for (int s = 0; s < 2; ++s) {
-      std::vector<double> params(truth.left().params(),
-                                 truth.left().params() + truth.left().num_params());
+      std::vector<double> params(
+          truth.left().params(),
+          truth.left().params() + truth.left().num_params());
       params[j] += s == 0 ? step : -step;
       const Camera moved =
           Camera::Create(truth.left().model(), truth.left().width(),
@@ -212,10 +212,10 @@ TEST(CalibrationPropagation, LensExtrinsicsCorrelationIsTheJointResponse) {
       std::vector<double> params(camera.params(),
                                  camera.params() + camera.num_params());
       for (int j = 0; j < d.size(); ++j) params[j] += e * d[j];
-      return Camera::Create(camera.model(), camera.width(), camera.height(),
-                            {params[0], params[1], params[2], params[3]},
-                            std::vector<double>(params.begin() + 4,
-                                                params.end()))
+      return Camera::Create(
+                 camera.model(), camera.width(), camera.height(),
+                 {params[0], params[1], params[2], params[3]},
+                 std::vector<double>(params.begin() + 4, params.end()))
           .value();
     };
     return StereoRig::Create(camera(truth.left(), left),
@@ -233,9 +233,10 @@ TEST(CalibrationPropagation, LensExtrinsicsCorrelationIsTheJointResponse) {
       (n_alone(moved(kStep)) - n_alone(moved(-kStep))) / (2.0 * kStep);
   const double with_correlation = variance(joint);
   const double without = variance(independent);
-  std::printf("[ MEASURED ] dn/de %.6g: variance %.6g with the correlation "
-              "(response^2 %.6g), %.6g without\n",
-              response, with_correlation, response * response, without);
+  std::printf(
+      "[ MEASURED ] dn/de %.6g: variance %.6g with the correlation "
+      "(response^2 %.6g), %.6g without\n",
+      response, with_correlation, response * response, without);
   // The linearization's sensitivities match the estimator's response to
   // about 1e-4 each (SensitivitiesMatchTheEstimatorsResponse); the square
   // of their sum here to 1e-3 (measured 2.6e-4), while leaving the
@@ -262,8 +263,8 @@ TEST(CalibrationPropagation, SelfCalibrationIsExactOnExactData) {
     for (const bool drifted : {false, true}) {
       const StereoRig truth =
           drifted ? scene.rig.WithCam1Moved(drift).value() : scene.rig;
-      const std::vector<StereoCorrespondence> data = Frames(
-          truth, kTrueN, scene.min_depth, scene.max_depth, 4, 200, 7);
+      const std::vector<StereoCorrespondence> data =
+          Frames(truth, kTrueN, scene.min_depth, scene.max_depth, 4, 200, 7);
       const RefinementSummary summary =
           RefineRefractiveIndex(WithDefaultPrior(scene.rig), data,
                                 RefinementOptions())
@@ -302,15 +303,16 @@ TEST(CalibrationPropagation, SelfCalibrationRecoversAHalfDegreeDriftInAPool) {
             .value();
     const double bound =
         CramerRaoBoundN(truth, exact, kTrueN, kNoisePx).value();
-    std::printf("0.5 deg drift: n %.5f +- %.5f (%.2f sigma off), %.2fx the "
-                "bound %.5f; rotation (%.3f, %.3f, %.3f) deg for (%.3f, "
-                "%.3f, %.3f)\n",
-                summary.n, summary.sigma_n, (summary.n - kTrueN) / summary.sigma_n,
-                summary.sigma_n / bound, bound,
-                summary.rotation->angle_axis[0] / kDegree,
-                summary.rotation->angle_axis[1] / kDegree,
-                summary.rotation->angle_axis[2] / kDegree, drift[0] / kDegree,
-                drift[1] / kDegree, drift[2] / kDegree);
+    std::printf(
+        "0.5 deg drift: n %.5f +- %.5f (%.2f sigma off), %.2fx the "
+        "bound %.5f; rotation (%.3f, %.3f, %.3f) deg for (%.3f, "
+        "%.3f, %.3f)\n",
+        summary.n, summary.sigma_n, (summary.n - kTrueN) / summary.sigma_n,
+        summary.sigma_n / bound, bound,
+        summary.rotation->angle_axis[0] / kDegree,
+        summary.rotation->angle_axis[1] / kDegree,
+        summary.rotation->angle_axis[2] / kDegree, drift[0] / kDegree,
+        drift[1] / kDegree, drift[2] / kDegree);
     EXPECT_LE(std::abs(summary.n - kTrueN), 2.0 * summary.sigma_n);
     EXPECT_LE(summary.sigma_n, 3.0 * bound);
     // Held at the stale calibration instead, n is far off (or refused).
@@ -355,8 +357,8 @@ StereoRig DrawDrift(const StereoRig& rig, std::mt19937_64* rng) {
         CalibrationUncertainty::kDefaultDriftDegrees * kDegree * gaussian(*rng);
   }
   for (int k = 0; k < 3; ++k) {
-    translation[k] =
-        1e-3 * CalibrationUncertainty::kDefaultDriftMillimeters * gaussian(*rng);
+    translation[k] = 1e-3 * CalibrationUncertainty::kDefaultDriftMillimeters *
+                     gaussian(*rng);
   }
   return rig.WithCam1Moved(rotation, translation).value();
 }
@@ -478,16 +480,18 @@ ZStatistics MonteCarloFrameByFrame(const DriftScene& scene, bool window,
     frames->trials = frame_trials;
     frames->failed = pooled.trials * scene.frames - frame_trials;
     frames->mean = frame_sum / frame_trials;
-    frames->sd = std::sqrt(frame_sum2 / frame_trials - frames->mean * frames->mean);
+    frames->sd =
+        std::sqrt(frame_sum2 / frame_trials - frames->mean * frames->mean);
     frames->mean_sigma = frame_sigma / frame_trials;
   }
   return pooled;
 }
 
 void ExpectHonest(const ZStatistics& z, const char* what) {
-  std::printf("%s: %d trials, %d failed, z mean %.2f sd %.2f, mean sigma_n "
-              "%.5f\n",
-              what, z.trials, z.failed, z.mean, z.sd, z.mean_sigma);
+  std::printf(
+      "%s: %d trials, %d failed, z mean %.2f sd %.2f, mean sigma_n "
+      "%.5f\n",
+      what, z.trials, z.failed, z.mean, z.sd, z.mean_sigma);
   EXPECT_EQ(z.failed, 0) << what;
   if (!test::ChecksStatistics()) return;
   EXPECT_GE(z.sd, 0.7) << what;
@@ -514,7 +518,8 @@ TEST(CalibrationPropagation, MonteCarloOnlineSigmaHonestUnderDriftPool) {
   ExpectHonest(MonteCarloFrameByFrame(DriftScenes()[0], false), "online, pool");
 }
 TEST(CalibrationPropagation, MonteCarloOnlineSigmaHonestUnderDriftBoard) {
-  ExpectHonest(MonteCarloFrameByFrame(DriftScenes()[1], false), "online, board");
+  ExpectHonest(MonteCarloFrameByFrame(DriftScenes()[1], false),
+               "online, board");
 }
 // The window's, and each frame's own sigma (a frame's n at its own
 // self-calibrated rotation, whose uncertainty dominates on the board): the
@@ -564,7 +569,8 @@ TEST(CalibrationPropagation, EstimatePinnedAtTheUpperBoundIsAnError) {
 // in its sigma.
 TEST(CalibrationPropagation, AirAtTheLowerBoundIsAValidAnswer) {
   const StereoRig rig = test::AlphasenseRealisticRig();
-  std::vector<StereoCorrespondence> data = Frames(rig, 1.0, 0.6, 6.0, 2, 300, 4);
+  std::vector<StereoCorrespondence> data =
+      Frames(rig, 1.0, 0.6, 6.0, 2, 300, 4);
   AddPixelNoise(0.3, 5, &data);
   const RefinementSummary summary =
       RefineRefractiveIndex(WithDefaultPrior(rig), data, RefinementOptions())
@@ -622,11 +628,10 @@ TEST(CalibrationPropagation, ChiSquaredUpperTailMatchesTables) {
     int dof;
     double quantile;
     double p;
-  } table[] = {{2, 9.2103, 0.01},  {3, 7.8147, 0.05},  {10, 23.2093, 0.01},
+  } table[] = {{2, 9.2103, 0.01},   {3, 7.8147, 0.05},   {10, 23.2093, 0.01},
                {19, 30.1435, 0.05}, {30, 50.8922, 0.01}, {100, 135.807, 0.01}};
   for (const auto& row : table) {
-    EXPECT_NEAR(ChiSquaredUpperTail(row.quantile, row.dof), row.p,
-                0.05 * row.p)
+    EXPECT_NEAR(ChiSquaredUpperTail(row.quantile, row.dof), row.p, 0.05 * row.p)
         << row.dof;
   }
   EXPECT_EQ(ChiSquaredUpperTail(0.0, 5), 1.0);

@@ -64,9 +64,9 @@ Status RefinementOptions::Check() const {
           << max_num_iterations;
   } else if (!(systematic_px >= 0.0) || !std::isfinite(systematic_px)) {
     error << "systematic_px must be >= 0 pixels, got " << systematic_px;
-  } else if (n_prior && (!(n_prior->n >= 1.0 && n_prior->n <= 2.0) ||
-                         !(n_prior->sigma > 0.0) ||
-                         !std::isfinite(n_prior->sigma))) {
+  } else if (n_prior &&
+             (!(n_prior->n >= 1.0 && n_prior->n <= 2.0) ||
+              !(n_prior->sigma > 0.0) || !std::isfinite(n_prior->sigma))) {
     error << "the prior on n needs n in [1, 2] and a positive sigma, got "
           << n_prior->n << " +- " << n_prior->sigma;
   } else if (num_threads < 1) {

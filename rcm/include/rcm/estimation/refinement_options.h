@@ -107,7 +107,8 @@ struct RefinementOptions {
 // thick_port_refinement.h): dense QR, options' iterations and threads,
 // silent, and tight tolerances: one parameter (or a few) and cheap
 // iterations, and the noise-free case must reach 1e-9 in n.
-ceres::Solver::Options RefinementSolverOptions(const RefinementOptions& options);
+ceres::Solver::Options RefinementSolverOptions(
+    const RefinementOptions& options);
 
 // Ok unless n is pinned at the upper bound of [1, 2], which no medium
 // reaches: within max(1e-6, sigma_n) of 2, so that the data cannot tell
