@@ -72,6 +72,9 @@ release_only=(
   # UnderwaterCalibration.*, EstimateCli.*]: the two dives' accuracy end to end
   'UnderwaterCli.DatasetRigThatDriftedHalfADegree'
   'UnderwaterCli.NarrowRigThatDriftedHalfADegree'
+  # [JointAirWaterCalibration.Exact*, UnderwaterCli.JointAirAndWaterBadInput]:
+  # the joint calibration of air and water end to end
+  'UnderwaterCli.JointAirAndWater'
   # [OpenCvSampleStereo.*, CalibrateCli.Corners*]: rcm against mrcal on the
   # sample pairs, a comparison of two solvers' numbers
   'MrcalPeer.*'

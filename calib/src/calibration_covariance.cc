@@ -30,6 +30,9 @@ CalibrationCovarianceFile AirCalibrationCovariance(
       CalibrationUncertainty::kDefaultDriftDegrees * M_PI / 180.0;
   file.drift_translation_sigma =
       1e-3 * CalibrationUncertainty::kDefaultDriftMillimeters;
+  // The lenses may change between the air and the water.
+  file.drift_focal_sigma =
+      1e-2 * CalibrationUncertainty::kDefaultFocalDriftPercent;
   file.cameras.resize(2);
   const CameraCalibration* cameras[2] = {&calibration.cam0, &calibration.cam1};
   for (int c = 0; c < 2; ++c) {

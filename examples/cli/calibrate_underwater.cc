@@ -111,7 +111,8 @@ Eigen::Matrix<double, 6, 1> ExtrinsicsLeaveOutScales(
 }
 
 // The sidecar of an underwater calibration: medium water, no drift prior
-// (the extrinsics were measured in this dive), and the joint covariance
+// (the extrinsics and the lenses were measured in this dive: no focal
+// drift prior either), and the joint covariance
 // of the extrinsics [w; dt] and the lenses: the lenses' from the joint fit
 // (air views given) or from the air calibration's sidecar when it had
 // one; the extrinsics' from the bundle adjustment, with their correlation

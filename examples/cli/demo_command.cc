@@ -28,6 +28,7 @@
 #include "rcm/io/atomic_file.h"
 #include "rcm/io/image_file.h"
 #include "rcm/io/number_format.h"
+#include "rcm/io/stereo_rig_file.h"
 #include "rcm/sim/sequence_simulator.h"
 #include "rcm/viz/line_plot.h"
 #include "simulation_flags.h"
@@ -274,10 +275,8 @@ int RunDemo() {
   // self-calibration of cam1's rotation uses; and the matches with the
   // front end's systematic error floor. So the demo's sigma is what
   // rcm estimate would report on these images.
-  const StereoRig rig = simulation->rig
-                            .WithCalibrationUncertainty(
-                                CalibrationUncertainty::DefaultDriftPrior())
-                            .value();
+  const StereoRig rig =
+      WithDefaultCalibrationUncertainty(simulation->rig).value();
   RefinementOptions refinement;
   refinement.systematic_px = kFrontEndSystematicPx;
   StatusOr<std::unique_ptr<SequenceSimulator>> created =
@@ -627,8 +626,9 @@ int RunDemo() {
             << " sigma)\n"
             << "  sigma_n: pixel noise "
             << FormatFixed(estimate.sigma_n_noise, 5) << ", calibration "
-            << FormatFixed(estimate.sigma_n_calibration, 5)
-            << " (default drift prior 0.1 deg, 0.1 mm), matches' systematic "
+            << FormatFixed(estimate.sigma_n_calibration, 5) << " ("
+            << rig.calibration_uncertainty()->source
+            << "), matches' systematic "
                "error "
             << FormatFixed(estimate.sigma_n_systematic, 5) << "\n"
             << DriftLine(estimate, simulation->options.cam1_drift)

@@ -93,11 +93,14 @@ DEFINE_bool(refine_rotation, false,
             "refine: also estimate a small rotation correction of cam1 "
             "(reported with its correlation with n)");
 DEFINE_string(drift_prior, "",
-              "DEG[,MM]: how far the rig may have drifted since its "
+              "DEG[,MM[,PCT]]: how far the rig may have drifted since its "
               "calibration, per axis (cam1's rotation in degrees, its "
-              "translation in millimetres), carried into sigma_n; default: "
-              "the camchain's covariance sidecar (rcm calibrate writes it) "
-              "or 0.1,0.1; MM left out is DEG (0 = the calibration exact)");
+              "translation in millimetres) and each camera's focal lengths "
+              "(percent), carried into sigma_n; default: the camchain's "
+              "covariance sidecar (rcm calibrate writes it) or 0.1,0.1,0.3 "
+              "(an underwater calibration's sidecar: no focal drift); MM left "
+              "out is DEG, PCT left out the sidecar's or 0.3 (0,0,0 = the "
+              "calibration exact)");
 DEFINE_bool(self_calibrate, true,
             "refine: estimate cam1's rotation with n, with the drift prior "
             "as its prior (the data decide it where they separate it from "
@@ -141,9 +144,10 @@ constexpr char kUsage[] =
     "closed-form is the paper's baseline;\nit assumes a rectified rig and is "
     "biased under pixel noise (DESIGN.md Sec. 2).\n\n"
     "sigma_n counts the calibration's uncertainty (the camchain's covariance\n"
-    "sidecar, or a drift prior of 0.1 deg, 0.1 mm per axis: --drift-prior)\n"
-    "and the matches' systematic error (--systematic-px) beside the pixel\n"
-    "noise; cam1's rotation is self-calibrated with its prior. An n at the\n"
+    "sidecar, or a drift prior of 0.1 deg, 0.1 mm per axis and 0.3 % in\n"
+    "each camera's focal lengths: --drift-prior) and the matches'\n"
+    "systematic error (--systematic-px) beside the pixel noise; cam1's\n"
+    "rotation is self-calibrated with its prior. An n at the\n"
     "upper bound 2 is refused; a stale calibration is named (then\n"
     "rcm calibrate --underwater).\n\n"
     "Exit status: 0 on success, 1 when the input cannot give an estimate, "
@@ -355,27 +359,30 @@ RefinementOptions RefinementOptionsFromFlags() {
   return options;
 }
 
-// --drift-prior DEG[,MM] as (radians, meters); nullopt when not given.
-StatusOr<std::optional<std::pair<double, double>>> DriftPriorFromFlag() {
-  if (FLAGS_drift_prior.empty())
-    return std::optional<std::pair<double, double>>();
+// --drift-prior DEG[,MM[,PCT]] into `options` (radians, meters, relative);
+// left as they are when the flag is not given.
+Status DriftPriorFromFlag(RigFileOptions* options) {
+  if (FLAGS_drift_prior.empty()) return Status::Ok();
   double degrees = 0.0;
   double millimeters = NAN;
+  double percent = NAN;
   char tail = 0;
-  const int read = std::sscanf(FLAGS_drift_prior.c_str(), "%lf,%lf%c", &degrees,
-                               &millimeters, &tail);
+  const int read = std::sscanf(FLAGS_drift_prior.c_str(), "%lf,%lf,%lf%c",
+                               &degrees, &millimeters, &percent, &tail);
   // MM left out: the same number as DEG (as in the default 0.1,0.1).
   if (read == 1) millimeters = degrees;
-  if ((read != 1 && read != 2) || !std::isfinite(degrees) ||
+  if ((read < 1 || read > 3) || !std::isfinite(degrees) ||
       !std::isfinite(millimeters) || degrees < 0.0 || millimeters < 0.0 ||
-      degrees > 10.0 || millimeters > 100.0) {
+      degrees > 10.0 || millimeters > 100.0 ||
+      (read == 3 && !(percent >= 0.0 && percent <= 10.0))) {
     return Status::Error(
-        "--drift-prior must be DEG[,MM] with 0 <= DEG <= 10 and 0 <= MM <= "
-        "100, got '" +
+        "--drift-prior must be DEG[,MM[,PCT]] with 0 <= DEG <= 10, 0 <= MM <= "
+        "100 and 0 <= PCT <= 10, got '" +
         FLAGS_drift_prior + "'");
   }
-  return std::optional<std::pair<double, double>>(
-      std::pair<double, double>{degrees * M_PI / 180.0, 1e-3 * millimeters});
+  options->drift_prior = {degrees * M_PI / 180.0, 1e-3 * millimeters};
+  if (read == 3) options->focal_drift = 1e-2 * percent;
+  return Status::Ok();
 }
 
 // The estimators' shared uncertainty fields.
@@ -731,6 +738,9 @@ constexpr double kStaleRotationSigmas = 3.0;
 // Above this multiple correlation a free rotation is hardly separable
 // from n (sigma_n more than 3.2x its value with the rotation known).
 constexpr double kHardlySeparableCorrelation = 0.95;
+// A sigma_n above this tells fresh from sea water at less than one sigma
+// (their indices differ by 0.007).
+constexpr double kWideSigmaN = 0.007;
 
 // Warnings about the estimate's uncertainty: a stale calibration, a free
 // rotation the data hardly separate from n, frames that disagree.
@@ -766,6 +776,21 @@ std::vector<std::string> UncertaintyWarnings(const Report& report,
           "x its value with the rotation known; calibrate in the water (rcm "
           "calibrate --underwater) for a better n");
     }
+  }
+  // The lenses' possible change since the calibration (the focal drift
+  // prior of an air calibration) is most of a sigma_n too wide to use.
+  if (report.calibration && report.sigma_n > kWideSigmaN &&
+      report.calibration->variance_lenses >
+          0.5 * report.sigma_n * report.sigma_n) {
+    warnings.push_back(
+        "sigma_n " + FormatFixed(report.sigma_n, 3) +
+        " is mostly the lenses' (" +
+        FormatFixed(std::sqrt(report.calibration->variance_lenses), 3) +
+        "): these data cannot tell a change of the focal lengths since the "
+        "calibration (" +
+        report.calibration->source +
+        ") from n; calibrate in the water (rcm calibrate --underwater, with "
+        "the air views: --air-left/--air-right) for a better n");
   }
   if (report.consistency && report.consistency->inflation > 1.0) {
     warnings.push_back(
@@ -981,14 +1006,11 @@ int RunEstimate() {
     front_end_options = *options;
   }
 
-  const StatusOr<std::optional<std::pair<double, double>>> drift_prior =
-      DriftPriorFromFlag();
-  if (!drift_prior.ok()) {
-    PrintError(command, drift_prior.status().message());
+  RigFileOptions rig_options;
+  if (const Status drift = DriftPriorFromFlag(&rig_options); !drift.ok()) {
+    PrintError(command, drift.message());
     return kExitUsage;
   }
-  RigFileOptions rig_options;
-  rig_options.drift_prior = *drift_prior;
   const StatusOr<StereoRig> rig = ReadStereoRig(
       FLAGS_calib, FLAGS_left_camera, FLAGS_right_camera, rig_options);
   if (!rig.ok()) {

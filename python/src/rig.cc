@@ -26,7 +26,8 @@ bool Readable(const std::string& path) {
 StereoRig ReadRig(const py::object& path, const py::object& right_info,
                   const std::string& left_camera,
                   const std::string& right_camera,
-                  const std::optional<std::pair<double, double>>& drift_prior) {
+                  const std::optional<std::pair<double, double>>& drift_prior,
+                  const std::optional<double>& focal_drift) {
   std::vector<std::string> paths = {PathFromPython(path)};
   if (!right_info.is_none()) paths.push_back(PathFromPython(right_info));
   for (const std::string& file : paths) {
@@ -46,6 +47,12 @@ StereoRig ReadRig(const py::object& path, const py::object& right_info,
           "in meters), both finite and >= 0");
     }
     options.drift_prior = drift_prior;
+  }
+  if (focal_drift) {
+    if (!std::isfinite(*focal_drift) || *focal_drift < 0.0) {
+      ThrowValueError("focal_drift must be a relative sigma, finite and >= 0");
+    }
+    options.focal_drift = focal_drift;
   }
   const std::string spec =
       paths.size() == 1 ? paths[0] : paths[0] + "," + paths[1];
@@ -244,20 +251,24 @@ exact); one read from a file carries the default drift prior (0.1 degree,
       .def(
           "with_drift_prior",
           [](const StereoRig& r, double rotation_sigma,
-             double translation_sigma) {
+             double translation_sigma, double focal_sigma) {
             if (!(rotation_sigma >= 0.0) || !(translation_sigma >= 0.0) ||
-                !std::isfinite(rotation_sigma) ||
-                !std::isfinite(translation_sigma)) {
+                !(focal_sigma >= 0.0) || !std::isfinite(rotation_sigma) ||
+                !std::isfinite(translation_sigma) ||
+                !std::isfinite(focal_sigma)) {
               ThrowValueError("drift prior sigmas must be finite and >= 0");
             }
-            return ValueOrThrow(
-                r.WithCalibrationUncertainty(CalibrationUncertainty::DriftPrior(
-                    rotation_sigma, translation_sigma)));
+            RigFileOptions options;
+            options.drift_prior = {rotation_sigma, translation_sigma};
+            options.focal_drift = focal_sigma;
+            return ValueOrThrow(WithDefaultCalibrationUncertainty(r, options));
           },
           py::arg("rotation_sigma"), py::arg("translation_sigma"),
+          py::arg("focal_sigma") = 0.0,
           "A copy whose calibration uncertainty is only a drift prior: "
-          "per-axis "
-          "standard deviations in radians and meters.")
+          "per-axis standard deviations of cam1's rotation and translation "
+          "in radians and meters, and of each camera's focal lengths, "
+          "relative (0.003 = 0.3 %; calibration_uncertainty.h).")
       .def("write", &WriteRig, py::arg("path"),
            "Writes the rig as a two-camera Kalibr camchain (cam0 left, cam1 "
            "right, T_cn_cnm1 = cam1_from_cam0, port blocks for the ports), "
@@ -268,6 +279,7 @@ exact); one read from a file carries the default drift prior (0.1 degree,
              py::arg("right_info") = py::none(), py::kw_only(),
              py::arg("left_camera") = "cam0", py::arg("right_camera") = "cam1",
              py::arg("drift_prior") = py::none(),
+             py::arg("focal_drift") = py::none(),
              R"doc(
 Reads a stereo rig.
 
@@ -277,7 +289,10 @@ read_stereo_rig(left_info_path, right_info_path)
     the ROS camera_info files of the left and the right camera.
 
 drift_prior: (rotation sigma in radians, translation sigma in meters)
-replacing the default drift prior of the calibration uncertainty.
+replacing the default drift prior of the calibration uncertainty;
+focal_drift: each camera's focal lengths' relative sigma (0.003 = 0.3 %),
+replacing the focal drift prior (by default 0.3 % for an air calibration
+or a rig without a covariance sidecar, 0 for an underwater one).
 Raises FileNotFoundError/PermissionError (OSError) for a file that cannot be
 read and ValueError for bad contents, with the library's one-line message.
 )doc");

@@ -36,9 +36,30 @@ def test_reads_the_demo_camchain(demo_rig_path):
     sigma = np.deg2rad(0.1)
     np.testing.assert_allclose(
         np.diag(uncertainty["extrinsics_covariance"])[:3], sigma**2, rtol=1e-12)
-    # No lens covariance, so no correlation of the extrinsics with one.
+    # The lenses carry the default focal drift prior (0.3 %: fx and fy of
+    # each camera scale together), without a correlation with the
+    # extrinsics or between the cameras.
+    assert "focal drift prior 0.3 %" in uncertainty["source"]
+    lens = uncertainty["left_lens_covariance"]
+    fx, fy = rig.cam0.intrinsics[:2]
+    np.testing.assert_allclose(lens[:2, :2],
+                               0.003**2 * np.outer([fx, fy], [fx, fy]),
+                               rtol=1e-12)
+    assert not lens[2:, :].any() and not lens[:, 2:].any()
     assert uncertainty["extrinsics_lens_covariance"].size == 0
     assert uncertainty["lens_cross_covariance"].size == 0
+    # focal_drift=0: the lenses as calibrated.
+    exact = rcm.read_stereo_rig(demo_rig_path, focal_drift=0.0)
+    assert exact.calibration_uncertainty["left_lens_covariance"].size == 0
+    with pytest.raises(ValueError, match="focal_drift must be"):
+        rcm.read_stereo_rig(demo_rig_path, focal_drift=-1.0)
+    # with_drift_prior: the focal sigma is its third argument.
+    prior = rig.with_drift_prior(0.0, 0.0, focal_sigma=0.01)
+    np.testing.assert_allclose(
+        prior.calibration_uncertainty["right_lens_covariance"][0, 0],
+        (0.01 * rig.cam1.fx)**2, rtol=1e-12)
+    assert rig.with_drift_prior(0.0, 0.0).calibration_uncertainty[
+        "right_lens_covariance"].size == 0
 
 
 def test_write_reads_back_identical(tmp_path, demo_rig_path):

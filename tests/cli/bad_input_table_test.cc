@@ -733,13 +733,15 @@ void AddEstimateRows(std::vector<BadInputCase>* rows) {
            {"Text", "abc"},
            {"Negative", "-0.1"},
            {"TooLarge", "20"},
-           {"ThreeNumbers", "0.1,0.1,0.1"},
-           {"Nan", "nan"}}) {
+           {"FourNumbers", "0.1,0.1,0.1,0.1"},
+           {"Nan", "nan"},
+           {"FocalTooLarge", "0.1,0.1,20"},
+           {"FocalNegative", "0.1,0.1,-1"}}) {
     rows->push_back({"EstimateDriftPrior" + name,
                      Nothing(),
                      {"estimate", "--calib", kRig, "--matches", kMatches,
                       "--drift-prior", value, "--out", "$D/out"},
-                     "--drift-prior must be DEG[,MM]",
+                     "--drift-prior must be DEG[,MM[,PCT]]",
                      {"$D/out/estimate.json"}});
   }
   rows->push_back(
@@ -774,12 +776,15 @@ void AddEstimateRows(std::vector<BadInputCase>* rows) {
        {"estimate", "--calib", kRig, "--matches", kMatches, "--out", "$D/file"},
        "$D/file: cannot create the output folder",
        {}});
-  rows->push_back({"EstimatePerFrameBelowAFile",
-                   File("file", "a file\n"),
-                   {"estimate", "--calib", kRig, "--matches", kMatches,
-                    "--per-frame", "$D/file/per_frame.csv"},
-                   "$D/file/per_frame.csv: cannot write",
-                   {"$D/file/per_frame.csv"}});
+  // (The lenses taken as calibrated: with the default focal drift prior
+  // the wide sigma_n's warning line would come before the error.)
+  rows->push_back(
+      {"EstimatePerFrameBelowAFile",
+       File("file", "a file\n"),
+       {"estimate", "--calib", kRig, "--matches", kMatches, "--drift-prior",
+        "0.1,0.1,0", "--per-frame", "$D/file/per_frame.csv"},
+       "$D/file/per_frame.csv: cannot write",
+       {"$D/file/per_frame.csv"}});
 }
 
 // --- rcm undistort ---------------------------------------------------------

@@ -18,6 +18,7 @@
 #include "rcm/calib/calibration_target.h"
 #include "rcm/calib/target_image.h"
 #include "rcm/calib/target_renderer.h"
+#include "rcm/io/calibration_covariance_file.h"
 #include "rcm/io/camchain.h"
 #include "support/temp_file.h"
 #ifdef RCM_HAVE_ROSBAG
@@ -196,6 +197,18 @@ TEST(CalibrateCli, FoldersToCamchainAndReport) {
             std::string::npos)
       << result.out;
   ExpectCloseToTruth(out);
+  // The covariance sidecar: medium air, its drift priors (0.1 degree and
+  // 0.1 mm per axis, 0.3 % in each camera's focal lengths), both lenses'
+  // covariance and the extrinsics'.
+  const CalibrationCovarianceFile sidecar =
+      ReadCalibrationCovariance(dir + "/rig-covariance.yaml").value();
+  EXPECT_EQ(sidecar.medium, "air");
+  EXPECT_NEAR(sidecar.drift_rotation_sigma, 0.1 * M_PI / 180.0, 1e-15);
+  EXPECT_NEAR(sidecar.drift_translation_sigma, 1e-4, 1e-15);
+  EXPECT_NEAR(sidecar.drift_focal_sigma, 0.003, 1e-15);
+  ASSERT_EQ(sidecar.cameras.size(), 2u);
+  EXPECT_EQ(sidecar.cameras[0].intrinsics_covariance.rows(), 8);
+  EXPECT_TRUE(sidecar.cameras[1].from_previous_covariance.has_value());
   for (const char* file :
        {"calibration.json", "per_view.csv", "per_view_rms.png",
         "residuals_cam0.png", "residuals_cam1.png", "coverage_cam0.png",

@@ -34,6 +34,34 @@ TEST(CalibrationUncertainty, DriftPriorAndChecks) {
   EXPECT_THAT(bad.Check(8, 4).message(), HasSubstr("not finite"));
 }
 
+// The focal drift prior: s^2 g g^T on each lens, g = [fx, fy, 0, ...]; a
+// camera with exact lenses gets that alone; 0 adds nothing.
+TEST(CalibrationUncertainty, FocalDriftScalesBothFocalLengthsTogether) {
+  Eigen::VectorXd left(8);
+  left << 500.0, 502.0, 320.0, 240.0, 0.1, 0.0, 0.0, 0.0;
+  Eigen::VectorXd right(4);
+  right << 400.0, 400.0, 300.0, 200.0;
+  CalibrationUncertainty uncertainty = CalibrationUncertainty::DriftPrior(0, 0);
+  uncertainty.left_lens_covariance = Eigen::MatrixXd::Identity(8, 8);
+  uncertainty.AddFocalDrift(0.0, left, right);
+  EXPECT_EQ(uncertainty.left_lens_covariance, Eigen::MatrixXd::Identity(8, 8));
+  EXPECT_EQ(uncertainty.right_lens_covariance.size(), 0);
+  uncertainty.AddFocalDrift(0.003, left, right);
+  EXPECT_NEAR(uncertainty.left_lens_covariance(0, 0), 1.0 + 2.25, 1e-12);
+  EXPECT_NEAR(uncertainty.left_lens_covariance(0, 1), 0.003 * 0.003 * 500 * 502,
+              1e-12);
+  EXPECT_EQ(uncertainty.left_lens_covariance(2, 2), 1.0);
+  EXPECT_EQ(uncertainty.left_lens_covariance(0, 2), 0.0);
+  ASSERT_EQ(uncertainty.right_lens_covariance.rows(), 4);
+  EXPECT_NEAR(uncertainty.right_lens_covariance(1, 1), 1.44, 1e-12);
+  EXPECT_EQ(uncertainty.right_lens_covariance(2, 2), 0.0);
+  // A perfectly correlated fx and fy: rank one, positive semi-definite.
+  EXPECT_TRUE(uncertainty.Check(8, 4).ok())
+      << uncertainty.Check(8, 4).message();
+  EXPECT_EQ(CalibrationUncertainty::DescribeFocalDrift(0.003),
+            "focal drift prior 0.3 %");
+}
+
 // The extrinsics' correlation with the lenses: JointCovariance places the
 // blocks, and Check requires both lenses, the 6 x (p_l + p_r) shape and a
 // positive semi-definite joint matrix.

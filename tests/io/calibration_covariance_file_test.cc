@@ -43,6 +43,22 @@ CalibrationCovarianceFile SampleFile() {
   return file;
 }
 
+// Camera::params() of an 8-parameter lens ([fx, fy, cx, cy, d...]).
+Eigen::VectorXd Params(double fx) {
+  Eigen::VectorXd params(8);
+  params << fx, fx + 1.0, 320.0, 240.0, 0.1, -0.02, 1e-3, 2e-4;
+  return params;
+}
+
+// PairCalibrationUncertainty for two 8-parameter lenses.
+StatusOr<CalibrationUncertainty> Pair(
+    const CalibrationCovarianceFile& file, int left, int right,
+    std::optional<std::pair<double, double>> drift = std::nullopt,
+    std::optional<double> focal = std::nullopt) {
+  return PairCalibrationUncertainty(file, left, right, "c.yaml", Params(500.0),
+                                    Params(490.0), drift, focal);
+}
+
 TEST(CalibrationCovarianceFile, SidecarPathIsNextToTheCamchain) {
   EXPECT_EQ(CovarianceSidecarPath("out/camchain.yaml"),
             "out/camchain-covariance.yaml");
@@ -71,8 +87,7 @@ TEST(CalibrationCovarianceFile, RoundTripIsBitExact) {
 
 TEST(CalibrationCovarianceFile, PairUncertaintyAddsTheDriftPrior) {
   const CalibrationCovarianceFile file = SampleFile();
-  const CalibrationUncertainty uncertainty =
-      PairCalibrationUncertainty(file, 0, 1, "c.yaml").value();
+  const CalibrationUncertainty uncertainty = Pair(file, 0, 1).value();
   Eigen::Matrix<double, 6, 6> expected =
       *file.cameras[1].from_previous_covariance;
   for (int k = 0; k < 3; ++k) {
@@ -87,18 +102,74 @@ TEST(CalibrationCovarianceFile, PairUncertaintyAddsTheDriftPrior) {
   EXPECT_THAT(uncertainty.source, HasSubstr("drift prior 0.05 deg, 0.2 mm"));
   // An override replaces the file's drift prior.
   const CalibrationUncertainty overridden =
-      PairCalibrationUncertainty(file, 0, 1, "c.yaml",
-                                 std::pair<double, double>{0.0, 0.0})
-          .value();
+      Pair(file, 0, 1, std::pair<double, double>{0.0, 0.0}).value();
   EXPECT_EQ(overridden.extrinsics_covariance,
             *file.cameras[1].from_previous_covariance);
   // Reversed or non-adjacent pairs have no measured extrinsics.
-  const CalibrationUncertainty reversed =
-      PairCalibrationUncertainty(file, 1, 0, "c.yaml").value();
+  const CalibrationUncertainty reversed = Pair(file, 1, 0).value();
   EXPECT_TRUE((reversed.extrinsics_covariance.topRightCorner<3, 3>().isZero()));
   EXPECT_NEAR(reversed.extrinsics_covariance(0, 0),
               std::pow(file.drift_rotation_sigma, 2), 1e-24);
-  EXPECT_FALSE(PairCalibrationUncertainty(file, 0, 2, "c.yaml").ok());
+  EXPECT_FALSE(Pair(file, 0, 2).ok());
+}
+
+// The focal drift prior: written and read back, the default of its medium
+// when absent, added to each lens covariance as s^2 g g^T with g = [fx,
+// fy, 0, ...] (an empty lens covariance becomes that alone), replaced by an
+// override, and refused for a lens covariance of the wrong size.
+TEST(CalibrationCovarianceFile, FocalDriftPriorReachesTheLenses) {
+  CalibrationCovarianceFile file = SampleFile();
+  file.medium = "air";
+  file.drift_focal_sigma = 0.004;
+  const std::string text = FormatCalibrationCovariance(file);
+  EXPECT_THAT(text, HasSubstr("focal_percent: 0.4"));
+  const CalibrationCovarianceFile read =
+      ParseCalibrationCovariance(text, "c.yaml").value();
+  EXPECT_EQ(read.drift_focal_sigma, 0.004);
+  EXPECT_EQ(FormatCalibrationCovariance(read), text);
+  for (const std::string medium : {"air", "water"}) {
+    const CalibrationCovarianceFile absent =
+        ParseCalibrationCovariance("medium: " + medium + "\ncam0: {}\n",
+                                   "c.yaml")
+            .value();
+    EXPECT_EQ(absent.drift_focal_sigma,
+              medium == "air"
+                  ? 1e-2 * CalibrationUncertainty::kDefaultFocalDriftPercent
+                  : 0.0)
+        << medium;
+  }
+
+  const CalibrationUncertainty pair = Pair(read, 0, 1).value();
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(8);
+  g.head(2) = Params(500.0).head(2);
+  const Eigen::MatrixXd expected =
+      file.cameras[0].intrinsics_covariance + 0.004 * 0.004 * g * g.transpose();
+  EXPECT_LT((pair.left_lens_covariance - expected).cwiseAbs().maxCoeff(),
+            1e-12 * expected.cwiseAbs().maxCoeff());
+  EXPECT_NEAR(pair.right_lens_covariance(0, 1) -
+                  file.cameras[1].intrinsics_covariance(0, 1),
+              0.004 * 0.004 * 490.0 * 491.0, 1e-9);
+  EXPECT_EQ(pair.right_lens_covariance(2, 2),
+            file.cameras[1].intrinsics_covariance(2, 2));
+  EXPECT_THAT(pair.source, HasSubstr("focal drift prior 0.4 %"));
+  EXPECT_TRUE(pair.Check(8, 8).ok());
+  // Lenses taken as exact in the file get the prior alone.
+  CalibrationCovarianceFile exact = read;
+  exact.cameras[0].intrinsics_covariance.resize(0, 0);
+  const CalibrationUncertainty prior_only = Pair(exact, 0, 1).value();
+  EXPECT_NEAR(prior_only.left_lens_covariance(0, 0), std::pow(0.004 * 500.0, 2),
+              1e-12);
+  EXPECT_EQ(prior_only.left_lens_covariance(3, 3), 0.0);
+  // An override of 0: the file's lenses as they are.
+  EXPECT_EQ(Pair(read, 0, 1, std::nullopt, 0.0).value().left_lens_covariance,
+            file.cameras[0].intrinsics_covariance);
+  // A lens covariance that is not the camera's size.
+  const StatusOr<CalibrationUncertainty> wrong = PairCalibrationUncertainty(
+      read, 0, 1, "c.yaml", Params(500.0).head(5), Params(490.0));
+  ASSERT_FALSE(wrong.ok());
+  EXPECT_THAT(wrong.status().message(),
+              HasSubstr("c.yaml: cam0: intrinsics_covariance has 8 rows, the "
+                        "camera has 5 parameters"));
 }
 
 TEST(CalibrationCovarianceFile, BadFilesGiveOneLineErrors) {
@@ -168,8 +239,7 @@ TEST(CalibrationCovarianceFile, ExtrinsicsLensCrossCovariance) {
             file.cameras[1].from_previous_intrinsics_covariance);
   EXPECT_EQ(read.cameras[0].from_previous_intrinsics_covariance.size(), 0);
   EXPECT_EQ(FormatCalibrationCovariance(read), text);
-  const CalibrationUncertainty pair =
-      PairCalibrationUncertainty(read, 0, 1, "c.yaml").value();
+  const CalibrationUncertainty pair = Pair(read, 0, 1).value();
   EXPECT_EQ(pair.extrinsics_lens_covariance,
             file.cameras[1].from_previous_intrinsics_covariance);
   EXPECT_TRUE(pair.Check(8, 8).ok());
@@ -215,8 +285,7 @@ TEST(CalibrationCovarianceFile, LensCrossCovariance) {
   EXPECT_EQ(read.cameras[1].previous_intrinsics_covariance,
             file.cameras[1].previous_intrinsics_covariance);
   EXPECT_EQ(FormatCalibrationCovariance(read), text);
-  const CalibrationUncertainty pair =
-      PairCalibrationUncertainty(read, 0, 1, "c.yaml").value();
+  const CalibrationUncertainty pair = Pair(read, 0, 1).value();
   EXPECT_EQ(pair.lens_cross_covariance,
             file.cameras[1].previous_intrinsics_covariance);
   EXPECT_TRUE(pair.Check(8, 8).ok());
@@ -253,6 +322,20 @@ TEST(CalibrationCovarianceFile, ReadStereoRigAttachesTheSidecar) {
               HasSubstr("default drift prior 0.1 deg, 0.1 mm per axis"));
   EXPECT_NEAR(without.calibration_uncertainty()->extrinsics_covariance(0, 0),
               std::pow(0.1 * kDegree, 2), 1e-20);
+  // And the default focal drift prior of an air calibration on each lens.
+  EXPECT_THAT(without.calibration_uncertainty()->source,
+              HasSubstr("focal drift prior 0.3 %"));
+  EXPECT_NEAR(without.calibration_uncertainty()->left_lens_covariance(0, 0),
+              std::pow(0.003 * rig.left().fx(), 2), 1e-12);
+  EXPECT_NEAR(without.calibration_uncertainty()->right_lens_covariance(1, 1),
+              std::pow(0.003 * rig.right().fy(), 2), 1e-12);
+  RigFileOptions exact_lenses;
+  exact_lenses.focal_drift = 0.0;
+  EXPECT_EQ(ReadStereoRig(camchain, "cam0", "cam1", exact_lenses)
+                .value()
+                .calibration_uncertainty()
+                ->left_lens_covariance.size(),
+            0);
 
   ASSERT_TRUE(WriteCalibrationCovariance(sidecar, SampleFile()).ok());
   const StereoRig with = ReadStereoRig(camchain).value();

@@ -204,7 +204,10 @@ play_recording_depth "$work/water.bag" "$work/depth_n1.bag"
 # node of its own (/stale_K). The live window holds cam1's rotation and
 # carries the calibration's uncertainty in sigma_n: at 0.15 deg n must be
 # within 3 sigma_n of the truth with a sigma_n over 5x the fresh rig's
-# (never a precise-looking wrong number); at 0.3 deg the matching band
+# (never a precise-looking wrong number), or refused because these data
+# cannot pin n (the default focal drift prior of a camchain without a
+# sidecar: on a narrow rig at one depth a lens change and n are one
+# unknown, calibration_uncertainty.h); at 0.3 deg the matching band
 # misses the turned rig and every message must be valid: false with n NaN,
 # with a throttled warning, the node still running.
 k=0
@@ -236,9 +239,12 @@ if len(rows) < 4:
     sys.exit("%d messages for 6 pairs" % len(rows))
 valid = [r for r in rows if r["field.valid"] in ("1", "True")]
 if abs(drift) < 0.2:
-    if len(valid) != len(rows):
-        sys.exit("a 0.15 deg turn gave no estimate: %s" % rows[-1]["field.status"])
     for r in rows:
+        if r not in valid:
+            print("node_test: stale %.2f deg: refused: %s" % (drift, r["field.status"][:100]))
+            if "cannot pin n" not in r["field.status"]:
+                sys.exit("a 0.15 deg turn gave no estimate: %s" % r["field.status"])
+            continue
         n, sigma = float(r["field.n"]), float(r["field.sigma_n"])
         print("node_test: stale %.2f deg: n %.5f +- %.5f (truth 1.333, %.1f sigma)"
               % (drift, n, sigma, abs(n - 1.333) / sigma))

@@ -80,18 +80,32 @@ Status RefinementOptions::Check() const {
 Status CheckNotPinnedAtUpperBound(double n, double sigma_n) {
   constexpr double kUpperBound = 2.0;
   constexpr double kPinnedTolerance = 1e-6;
+  // Further from 2 than this, n itself is not at the bound.
+  constexpr double kWideOfTheBound = 0.05;
   if (!(n >= kUpperBound - std::max(kPinnedTolerance, sigma_n))) {
     return Status::Ok();
   }
   std::ostringstream message;
   message.setf(std::ios::fixed);
   message.precision(4);
+  if (n < kUpperBound - kWideOfTheBound) {
+    // Not at the bound: a sigma that reaches it.
+    message << "n = " << n << " +- " << sigma_n
+            << " reaches the upper bound 2 within one sigma: these data "
+               "cannot pin n, its uncertainty is mostly the calibration's (a "
+               "turn of cam1, or a change of a lens's focal length, since the "
+               "calibration that these data cannot tell from n); calibrate "
+               "in the water (rcm calibrate --underwater) and estimate with "
+               "that camchain";
+    return Status::Error(message.str());
+  }
   message << "n = " << n
           << " is at the upper bound of [1, 2], which no medium reaches: the "
              "rig has likely moved since its calibration (cam1 turned by a "
-             "few tenths of a degree) or the rig file is not this rig's; "
-             "calibrate in the water (rcm calibrate --underwater) or "
-             "estimate the rotation with n (--refine-rotation)";
+             "few tenths of a degree, or a lens's focal length changed) or "
+             "the rig file is not this rig's; calibrate in the water (rcm "
+             "calibrate --underwater) or estimate the rotation with n "
+             "(--refine-rotation)";
   return Status::Error(message.str());
 }
 

@@ -1,6 +1,7 @@
 #include "rcm/geometry/calibration_uncertainty.h"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -54,6 +55,31 @@ std::string CalibrationUncertainty::DescribeDriftPrior(
   text << "drift prior " << rotation_sigma / kDegree << " deg, "
        << 1e3 * translation_sigma << " mm per axis";
   return text.str();
+}
+
+std::string CalibrationUncertainty::DescribeFocalDrift(double focal_sigma) {
+  std::ostringstream text;
+  text.precision(3);
+  text << "focal drift prior " << 100.0 * focal_sigma << " %";
+  return text.str();
+}
+
+void CalibrationUncertainty::AddFocalDrift(
+    double focal_sigma, const Eigen::VectorXd& left_params,
+    const Eigen::VectorXd& right_params) {
+  if (focal_sigma == 0.0) return;
+  const auto add = [focal_sigma](const Eigen::VectorXd& params,
+                                 Eigen::MatrixXd* covariance) {
+    const Eigen::Index size = params.size();
+    if (covariance->size() == 0)
+      *covariance = Eigen::MatrixXd::Zero(size, size);
+    Eigen::VectorXd g = Eigen::VectorXd::Zero(size);
+    g.head(std::min<Eigen::Index>(2, size)) =
+        params.head(std::min<Eigen::Index>(2, size));
+    *covariance += focal_sigma * focal_sigma * g * g.transpose();
+  };
+  add(left_params, &left_lens_covariance);
+  add(right_params, &right_lens_covariance);
 }
 
 void CalibrationUncertainty::AddDrift(double rotation_sigma,

@@ -109,15 +109,21 @@ StatusOr<CalibrationCovarianceFile> ReadDocument(const YamlReader& reader,
     }
     num_cameras = std::max(num_cameras, *index + 1);
   }
+  // An older file without focal_percent: the default of its medium.
+  file.drift_focal_sigma =
+      file.medium == "air"
+          ? 1e-2 * CalibrationUncertainty::kDefaultFocalDriftPercent
+          : 0.0;
   if (const YamlEntry* drift = FindYamlEntry(*entries, "drift_prior")) {
     const StatusOr<YamlEntries> fields =
         reader.Entries(drift->value, "drift_prior");
     if (!fields.ok()) return fields.status();
     for (const auto& [key, entry] : *fields) {
-      if (key != "rotation_deg" && key != "translation_mm") {
+      if (key != "rotation_deg" && key != "translation_mm" &&
+          key != "focal_percent") {
         return reader.Error(entry.key, "drift_prior." + key,
                             "unknown key (expected rotation_deg, "
-                            "translation_mm)");
+                            "translation_mm, focal_percent)");
       }
       const StatusOr<double> value =
           reader.Number(entry.value, "drift_prior." + key);
@@ -127,6 +133,8 @@ StatusOr<CalibrationCovarianceFile> ReadDocument(const YamlReader& reader,
       }
       if (key == "rotation_deg") {
         file.drift_rotation_sigma = *value * kDegree;
+      } else if (key == "focal_percent") {
+        file.drift_focal_sigma = 1e-2 * *value;
       } else {
         file.drift_translation_sigma = 1e-3 * *value;
       }
@@ -291,7 +299,9 @@ std::string FormatCalibrationCovariance(const CalibrationCovarianceFile& file) {
       << "  rotation_deg: " << FormatDouble(file.drift_rotation_sigma / kDegree)
       << "\n"
       << "  translation_mm: "
-      << FormatDouble(1e3 * file.drift_translation_sigma) << "\n";
+      << FormatDouble(1e3 * file.drift_translation_sigma) << "\n"
+      << "  focal_percent: " << FormatDouble(1e2 * file.drift_focal_sigma)
+      << "\n";
   for (size_t k = 0; k < file.cameras.size(); ++k) {
     const CalibrationCovarianceFile::Camera& camera = file.cameras[k];
     out << "cam" << k << ":";
@@ -328,8 +338,10 @@ Status WriteCalibrationCovariance(const std::string& path,
 
 StatusOr<CalibrationUncertainty> PairCalibrationUncertainty(
     const CalibrationCovarianceFile& file, int left_index, int right_index,
-    const std::string& source,
-    std::optional<std::pair<double, double>> drift_override) {
+    const std::string& source, const Eigen::VectorXd& left_params,
+    const Eigen::VectorXd& right_params,
+    std::optional<std::pair<double, double>> drift_override,
+    std::optional<double> focal_override) {
   const int num_cameras = static_cast<int>(file.cameras.size());
   for (const int index : {left_index, right_index}) {
     if (index < 0 || index >= num_cameras) {
@@ -359,6 +371,26 @@ StatusOr<CalibrationUncertainty> PairCalibrationUncertainty(
   uncertainty.source =
       source + " (" + file.medium + " calibration) + " +
       CalibrationUncertainty::DescribeDriftPrior(rotation, translation);
+  const double focal = focal_override.value_or(file.drift_focal_sigma);
+  if (focal > 0.0) {
+    // The file's lens covariance and the camera must agree in size (the
+    // rig's check tells it otherwise; the prior is added first).
+    for (const auto& [index, params] :
+         {std::pair<int, const Eigen::VectorXd*>{left_index, &left_params},
+          {right_index, &right_params}}) {
+      const Eigen::MatrixXd& lens = file.cameras[index].intrinsics_covariance;
+      if (lens.size() > 0 && lens.rows() != params->size()) {
+        return Status::Error(source + ": cam" + std::to_string(index) +
+                             ": intrinsics_covariance has " +
+                             std::to_string(lens.rows()) +
+                             " rows, the camera has " +
+                             std::to_string(params->size()) + " parameters");
+      }
+    }
+    uncertainty.AddFocalDrift(focal, left_params, right_params);
+    uncertainty.source +=
+        ", " + CalibrationUncertainty::DescribeFocalDrift(focal);
+  }
   return uncertainty;
 }
 

@@ -28,11 +28,10 @@ StatusOr<RigFile> ReadRigFile(const std::string& path) {
   return RigFile{std::move(text).value(), *format};
 }
 
-// The default drift prior, or the one of `options`.
-CalibrationUncertainty DriftOnly(const RigFileOptions& options) {
-  if (!options.drift_prior) return CalibrationUncertainty::DefaultDriftPrior();
-  return CalibrationUncertainty::DriftPrior(options.drift_prior->first,
-                                            options.drift_prior->second);
+// A camera's Camera::params() as a vector.
+Eigen::VectorXd ParamsOf(const Camera& camera) {
+  return Eigen::Map<const Eigen::VectorXd>(camera.params(),
+                                           camera.num_params());
 }
 
 StatusOr<StereoRig> WithUncertainty(const StereoRig& rig,
@@ -65,7 +64,9 @@ StatusOr<StereoRig> ReadCamchainRig(const std::string& path,
   const std::string sidecar = CovarianceSidecarPath(path);
   std::error_code error;
   if (!std::filesystem::exists(sidecar, error)) {
-    return WithUncertainty(*rig, DriftOnly(options), path);
+    StatusOr<StereoRig> with = WithDefaultCalibrationUncertainty(*rig, options);
+    if (!with.ok()) return with.status().WithContext(path);
+    return with;
   }
   const StatusOr<CalibrationCovarianceFile> covariance =
       ReadCalibrationCovariance(sidecar);
@@ -77,7 +78,8 @@ StatusOr<StereoRig> ReadCamchainRig(const std::string& path,
                          std::to_string(camchain->cameras.size()));
   }
   StatusOr<CalibrationUncertainty> uncertainty = PairCalibrationUncertainty(
-      *covariance, indices[0], indices[1], sidecar, options.drift_prior);
+      *covariance, indices[0], indices[1], sidecar, ParamsOf(rig->left()),
+      ParamsOf(rig->right()), options.drift_prior, options.focal_drift);
   if (!uncertainty.ok()) return uncertainty.status();
   return WithUncertainty(*rig, std::move(uncertainty).value(), sidecar);
 }
@@ -118,6 +120,24 @@ StatusOr<StereoRig> ReadCameraInfoPair(const std::string& left_path,
 
 }  // namespace
 
+StatusOr<StereoRig> WithDefaultCalibrationUncertainty(
+    const StereoRig& rig, const RigFileOptions& options) {
+  CalibrationUncertainty uncertainty =
+      options.drift_prior
+          ? CalibrationUncertainty::DriftPrior(options.drift_prior->first,
+                                               options.drift_prior->second)
+          : CalibrationUncertainty::DefaultDriftPrior();
+  const double focal = options.focal_drift.value_or(
+      1e-2 * CalibrationUncertainty::kDefaultFocalDriftPercent);
+  if (focal > 0.0) {
+    uncertainty.AddFocalDrift(focal, ParamsOf(rig.left()),
+                              ParamsOf(rig.right()));
+    uncertainty.source +=
+        ", " + CalibrationUncertainty::DescribeFocalDrift(focal);
+  }
+  return rig.WithCalibrationUncertainty(std::move(uncertainty));
+}
+
 StatusOr<StereoRig> ReadStereoRig(const std::string& spec,
                                   const std::string& left,
                                   const std::string& right,
@@ -141,7 +161,9 @@ StatusOr<StereoRig> ReadStereoRig(const std::string& spec,
     }
     const StatusOr<StereoRig> rig = ReadCameraInfoPair(left_path, right_path);
     if (!rig.ok()) return rig.status();
-    return WithUncertainty(*rig, DriftOnly(options), spec);
+    StatusOr<StereoRig> with = WithDefaultCalibrationUncertainty(*rig, options);
+    if (!with.ok()) return with.status().WithContext(spec);
+    return with;
   }
 
   const StatusOr<RigFile> file = ReadRigFile(spec);

@@ -114,8 +114,10 @@ ceres::Solver::Options RefinementSolverOptions(
 // reaches: within max(1e-6, sigma_n) of 2, so that the data cannot tell
 // it from the bound. Then the one-line failure that names the likely
 // causes (the rig moved since its calibration, a wrong rig file) and the
-// remedies (rcm calibrate --underwater, --refine-rotation). The lower
-// bound stays a valid answer (air).
+// remedies (rcm calibrate --underwater, --refine-rotation); an n more
+// than 0.05 below 2 whose sigma reaches the bound gets one that says the
+// data cannot pin n (its sigma is the calibration's). The lower bound
+// stays a valid answer (air).
 Status CheckNotPinnedAtUpperBound(double n, double sigma_n = 0.0);
 
 // A new Ceres loss of `loss` with scale `scale_px` (owned by the problem

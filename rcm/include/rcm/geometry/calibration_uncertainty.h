@@ -21,6 +21,23 @@
 // a narrow-field rig. A rig without a measured covariance therefore gets the
 // default drift prior of 0.1 degree and 0.1 mm per axis.
 //
+// The lenses drift too: a lens's focal length moves with its temperature
+// and with the housing's pressure, between the air calibration and the
+// water. A focal drift prior of relative standard deviation s_f scales
+// each camera's focal lengths by (1 + e), e ~ N(0, s_f^2), independently
+// per camera; with g = [fx, fy, 0, ..., 0] (Camera::params() order) it
+// adds to each lens covariance
+//
+//   Sigma_lens += s_f^2 g g^T.
+//
+// A difference of 0.2 % between the cameras' changes moves n by 0.04 on a
+// wide rig and by 0.13 on a narrow one at near-constant depth, so an air
+// calibration without a measured lens change gets the default focal
+// drift prior of 0.3 % (lens changes of 0.2-1 % are what real air-to-water
+// dives show: 0.2 % is within one sigma, 1 % is 3.3 sigma); a calibration
+// made under water (medium water) gets none, its lenses were measured in
+// the water.
+//
 // Lens parameters in Camera::params() order, [fx, fy, cx, cy, d...] (px
 // and unitless); an empty matrix means the lens is taken as exact.
 //
@@ -50,6 +67,8 @@ struct CalibrationUncertainty {
   // The default drift prior's per-axis standard deviations.
   static constexpr double kDefaultDriftDegrees = 0.1;
   static constexpr double kDefaultDriftMillimeters = 0.1;
+  // The default focal drift prior of an air calibration, percent.
+  static constexpr double kDefaultFocalDriftPercent = 0.3;
 
   // Covariance of [w; dt] above (rad^2, rad m, m^2).
   Eigen::Matrix<double, 6, 6> extrinsics_covariance =
@@ -79,9 +98,18 @@ struct CalibrationUncertainty {
   // "drift prior 0.1 deg, 0.1 mm per axis" for those sigmas.
   static std::string DescribeDriftPrior(double rotation_sigma,
                                         double translation_sigma);
+  // "focal drift prior 0.3 %" for a relative sigma of 0.003.
+  static std::string DescribeFocalDrift(double focal_sigma);
 
   // Adds a drift prior to the extrinsics' covariance.
   void AddDrift(double rotation_sigma, double translation_sigma);
+  // Adds the focal drift prior above, s_f = focal_sigma (relative, >= 0),
+  // to each lens covariance; `left_params` and `right_params` are the
+  // cameras' Camera::params() ([fx, fy, ...]). An empty lens covariance
+  // becomes s_f^2 g g^T (the cross blocks, when empty, stay uncorrelated).
+  // Does nothing when focal_sigma is 0.
+  void AddFocalDrift(double focal_sigma, const Eigen::VectorXd& left_params,
+                     const Eigen::VectorXd& right_params);
 
   Eigen::Matrix3d RotationCovariance() const {
     return extrinsics_covariance.topLeftCorner<3, 3>();

@@ -10,6 +10,9 @@
 //   drift_prior:                 # what the rig may drift after it, per axis
 //     rotation_deg: 0.1          #   (the estimators add it to the
 //     translation_mm: 0.1        #   covariance below)
+//     focal_percent: 0.3         # each camera's focal lengths, relative
+//                                #   (calibration_uncertainty.h); absent:
+//                                #   0.3 for medium air, 0 for water
 //   cam0:
 //     intrinsics_covariance:     # of [fx, fy, cx, cy, d...] (Camera::params)
 //     - [0.137, 0.13, ...]       # rows, as many as the camera has parameters
@@ -69,6 +72,8 @@ struct CalibrationCovarianceFile {
   // The drift prior's per-axis standard deviations, radians and meters.
   double drift_rotation_sigma = 0.0;
   double drift_translation_sigma = 0.0;
+  // The focal drift prior, relative (0.003 = 0.3 %).
+  double drift_focal_sigma = 0.0;
   // cameras[k] is camk.
   std::vector<Camera> cameras;
 };
@@ -98,12 +103,16 @@ Status WriteCalibrationCovariance(const std::string& path,
 // right_index = left_index + 1 (other pairs chain several transforms:
 // their extrinsics get the drift prior alone), plus the file's
 // drift prior, or `drift_override` (rotation, translation sigmas) when
-// given. `source` names the file in CalibrationUncertainty::source.
-// Fails on an index beyond the file's cameras.
+// given, and the file's focal drift prior on `left_params` and
+// `right_params` (the cameras' Camera::params()), or `focal_override`.
+// `source` names the file in CalibrationUncertainty::source. Fails on an
+// index beyond the file's cameras.
 StatusOr<CalibrationUncertainty> PairCalibrationUncertainty(
     const CalibrationCovarianceFile& file, int left_index, int right_index,
-    const std::string& source,
-    std::optional<std::pair<double, double>> drift_override = std::nullopt);
+    const std::string& source, const Eigen::VectorXd& left_params,
+    const Eigen::VectorXd& right_params,
+    std::optional<std::pair<double, double>> drift_override = std::nullopt,
+    std::optional<double> focal_override = std::nullopt);
 
 }  // namespace rcm
 

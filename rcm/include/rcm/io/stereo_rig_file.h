@@ -16,9 +16,11 @@
 // a camchain's covariance sidecar (rig-covariance.yaml next to rig.yaml,
 // calibration_covariance_file.h, written by rcm calibrate) with its drift
 // prior when the sidecar exists; otherwise, and for camera_info files, the
-// default drift prior (0.1 degree, 0.1 mm per axis). `drift_prior`
-// replaces the drift prior by (rotation sigma in radians, translation
-// sigma in meters) in either case.
+// default drift prior (0.1 degree, 0.1 mm per axis) and the default focal
+// drift prior of an air calibration (0.3 %, calibration_uncertainty.h).
+// `drift_prior` replaces the drift prior by (rotation sigma in radians,
+// translation sigma in meters), `focal_drift` the focal drift prior
+// (relative sigma), in either case.
 #ifndef RCM_IO_STEREO_RIG_FILE_H_
 #define RCM_IO_STEREO_RIG_FILE_H_
 
@@ -33,7 +35,14 @@ namespace rcm {
 
 struct RigFileOptions {
   std::optional<std::pair<double, double>> drift_prior;
+  std::optional<double> focal_drift;
 };
+
+// `rig` with what ReadStereoRig gives a rig file without a sidecar: the
+// default drift prior and the default focal drift prior, or those of
+// `options`.
+StatusOr<StereoRig> WithDefaultCalibrationUncertainty(
+    const StereoRig& rig, const RigFileOptions& options = {});
 
 StatusOr<StereoRig> ReadStereoRig(const std::string& spec,
                                   const std::string& left = "cam0",
