@@ -85,8 +85,10 @@ TEST(ThickPortRefinement, ExactJointAirGap) {
 // housing, for gaps of 0, 10 and 30 mm with glass of 0, 5 and 10 mm and
 // the 8 mm + 6 mm (the RMS of 12 unbiased trials exceeds 1.5x its
 // expectation with probability ~1e-3 per housing), while the thin-port
-// estimate is biased by several bounds. Dataset rig, true n = 1.335, 300 matches per trial.
-TEST(ThickPortRefinement, WithinOneAndAHalfCramerRaoBoundsWhereThinPortIsBiased) {
+// estimate is biased by several bounds. Dataset rig, true n = 1.335, 300
+// matches per trial.
+TEST(ThickPortRefinement,
+     WithinOneAndAHalfCramerRaoBoundsWhereThinPortIsBiased) {
   const StereoRig rig = test::AlphasenseRealisticRig();
   constexpr double kN = 1.335;
   constexpr double kNoisePx = 0.3;
@@ -141,8 +143,9 @@ TEST(ThickPortRefinement, WithinOneAndAHalfCramerRaoBoundsWhereThinPortIsBiased)
 // evaluated at a noisy estimate overstates the spread. The test holds the
 // z-scores' sd within [0.5, 1.3] (never optimistic beyond sampling: its
 // sampling sd is 1/sqrt(60) = 0.13) and |mean| < 0.6 (3.3 sd of a mean of
-// 30). n and the gap are strongly correlated (the bias table of docs/thin_port_bias.md: a
-// gap reads as a smaller n), which the reported correlation shows.
+// 30). n and the gap are strongly correlated (the bias table of
+// docs/thin_port_bias.md: a gap reads as a smaller n), which the reported
+// correlation shows.
 TEST(ThickPortRefinement, MonteCarloJointAirGapSigmaIsHonest) {
   const StereoRig rig = test::AlphasenseRealisticRig();
   const FlatPort truth = Port(0.008, 0.006);
@@ -156,8 +159,8 @@ TEST(ThickPortRefinement, MonteCarloJointAirGapSigmaIsHonest) {
   for (int trial = 0; trial < kTrials; ++trial) {
     const StatusOr<ThickPortRefinementSummary> result =
         RefineRefractiveIndexThickPort(
-            rig, guess, guess, Matches(rig, truth, 1.335, 0.3, 300 + trial, 500),
-            options);
+            rig, guess, guess,
+            Matches(rig, truth, 1.335, 0.3, 300 + trial, 500), options);
     ASSERT_TRUE(result.ok()) << result.status().message();
     z_n.push_back((result->refinement.n - 1.335) / result->refinement.sigma_n);
     z_gap.push_back((result->air_gap->left_air_gap - 0.008) /
@@ -171,7 +174,8 @@ TEST(ThickPortRefinement, MonteCarloJointAirGapSigmaIsHonest) {
     double mean = 0.0;
     for (const double v : *z) mean += v / kTrials;
     double variance = 0.0;
-    for (const double v : *z) variance += (v - mean) * (v - mean) / (kTrials - 1);
+    for (const double v : *z)
+      variance += (v - mean) * (v - mean) / (kTrials - 1);
     EXPECT_GT(std::sqrt(variance), 0.5);
     EXPECT_LT(std::sqrt(variance), 1.3);
     EXPECT_LT(std::abs(mean), 0.6);

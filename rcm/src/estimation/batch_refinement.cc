@@ -6,8 +6,8 @@
 
 #include <Eigen/Cholesky>
 #include <algorithm>
-#include <limits>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <sstream>
 #include <utility>
@@ -15,11 +15,11 @@
 #include "rcm/estimation/calibration_propagation.h"
 #include "rcm/estimation/closed_form.h"
 #include "rcm/estimation/cramer_rao_bound.h"
-#include "rcm/estimation/thick_port_refinement.h"
 #include "rcm/estimation/paper_online_estimator.h"
 #include "rcm/estimation/prepared_correspondence.h"
 #include "rcm/estimation/robust_locus_fit.h"
 #include "rcm/estimation/sampson_coplanarity_error.h"
+#include "rcm/estimation/thick_port_refinement.h"
 #include "rcm/geometry/epipolar.h"
 
 namespace rcm {
@@ -27,7 +27,6 @@ namespace {
 
 // The paper's mask threshold, for the closed-form seed.
 constexpr double kSeedMaskEta = 0.3;
-
 
 // The median of eq. 14 over the matches that pass the paper's mask.
 std::optional<double> ClosedFormSeed(
@@ -69,8 +68,8 @@ ceres::CostFunction* NewRotationPrior(const Eigen::Matrix3d& covariance,
                                       double sigma_px) {
   const Eigen::Matrix3d lower = covariance.llt().matrixL();
   const ceres::Matrix root_information =
-      sigma_px * lower.triangularView<Eigen::Lower>().solve(
-                     Eigen::Matrix3d::Identity());
+      sigma_px *
+      lower.triangularView<Eigen::Lower>().solve(Eigen::Matrix3d::Identity());
   return new ceres::NormalPrior(root_information, ceres::Vector::Zero(3));
 }
 
@@ -95,7 +94,8 @@ ceres::Solver::Summary Solve(const Eigen::Matrix3d& essential,
                              bool with_rotation, ceres::CostFunction* prior,
                              ceres::CostFunction* n_prior,
                              Parameters* parameters, ceres::Problem* problem) {
-  ceres::LossFunction* loss_function = NewLossFunction(loss, options.loss_scale_px);
+  ceres::LossFunction* loss_function =
+      NewLossFunction(loss, options.loss_scale_px);
   if (prior != nullptr) {
     problem->AddResidualBlock(prior, nullptr, parameters->rotation);
   }
@@ -222,13 +222,12 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
             ? NewRotationPrior(uncertainty.RotationCovariance(),
                                0.5 * options.loss_scale_px)
             : nullptr;
-    const ceres::Solver::Summary stage1 =
-        Solve(essential, matches, all, options.loss, options, with_rotation,
-              prior,
-              options.n_prior
-                  ? NewIndexPrior(*options.n_prior, 0.5 * options.loss_scale_px)
-                  : nullptr,
-              &parameters, &problem);
+    const ceres::Solver::Summary stage1 = Solve(
+        essential, matches, all, options.loss, options, with_rotation, prior,
+        options.n_prior
+            ? NewIndexPrior(*options.n_prior, 0.5 * options.loss_scale_px)
+            : nullptr,
+        &parameters, &problem);
     if (!stage1.IsSolutionUsable()) {
       return Status::Error("the robust refinement failed: " + stage1.message);
     }
@@ -302,21 +301,21 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
             ? NewRotationPrior(uncertainty.RotationCovariance(),
                                std::max(prior_sigma_px, 1e-6))
             : nullptr;
-    const ceres::Solver::Summary stage2 =
-        Solve(essential, matches, inliers, RobustLoss::kNone, options,
-              with_rotation, prior,
-              options.n_prior ? NewIndexPrior(*options.n_prior,
-                                              std::max(prior_sigma_px, 1e-6))
-                              : nullptr,
-              &parameters, &problem);
+    const ceres::Solver::Summary stage2 = Solve(
+        essential, matches, inliers, RobustLoss::kNone, options, with_rotation,
+        prior,
+        options.n_prior
+            ? NewIndexPrior(*options.n_prior, std::max(prior_sigma_px, 1e-6))
+            : nullptr,
+        &parameters, &problem);
     if (!stage2.IsSolutionUsable()) {
       return Status::Error("the least-squares refinement failed: " +
                            stage2.message);
     }
     summary.num_iterations += static_cast<int>(stage2.iterations.size());
     summary.sigma_px = data_sigma_px(parameters);
-    summary.cost = 0.5 * summary.sigma_px * summary.sigma_px *
-                   static_cast<double>(dof);
+    summary.cost =
+        0.5 * summary.sigma_px * summary.sigma_px * static_cast<double>(dof);
     if (!with_prior || solve + 1 >= kMaxPriorSolves ||
         std::abs(summary.sigma_px - prior_sigma_px) <=
             kPriorSigmaTolerance * summary.sigma_px) {
@@ -332,19 +331,21 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
   const Eigen::Vector3d rotation(parameters.rotation[0], parameters.rotation[1],
                                  parameters.rotation[2]);
   const Rigid3d final_extrinsics =
-      with_rotation ? CorrectedExtrinsics(rig.right_from_left(), parameters.rotation)
-                    : rig.right_from_left();
+      with_rotation
+          ? CorrectedExtrinsics(rig.right_from_left(), parameters.rotation)
+          : rig.right_from_left();
   const Eigen::Matrix3d final_essential = EssentialMatrix(final_extrinsics);
   std::vector<StereoCorrespondence> raw;
   raw.reserve(matches.size());
-  for (const int64_t i : prepared.source_index) raw.push_back(correspondences[i]);
+  for (const int64_t i : prepared.source_index)
+    raw.push_back(correspondences[i]);
   const CalibrationParameterLayout layout =
       CalibrationParameterLayout::Of(rig, options.systematic_px);
   LocusNormalEquations equations(layout.Size());
   std::vector<LocusNormalEquations> per_frame;
   AccumulateLocusNormalEquations(rig, layout, raw, matches, inliers,
-                                 parameters.n,
-                                 rotation, &equations, &per_frame);
+                                 parameters.n, rotation, &equations,
+                                 &per_frame);
   summary.consistency = FrameConsistencyOf(per_frame, summary.sigma_px);
   const double inflation =
       summary.consistency ? summary.consistency->inflation : 1.0;

@@ -104,9 +104,9 @@ StatusOr<ThickPortRefinementSummary> RefineRefractiveIndexThickPort(
   const int min_inliers = options.base.min_inliers;
   if (static_cast<int>(matches.size()) < min_inliers) {
     std::ostringstream message;
-    message << "too few correspondences: " << matches.size()
-            << " usable of " << correspondences.size() << ", at least "
-            << min_inliers << " needed";
+    message << "too few correspondences: " << matches.size() << " usable of "
+            << correspondences.size() << ", at least " << min_inliers
+            << " needed";
     return Status::Error(message.str());
   }
 
@@ -152,8 +152,8 @@ StatusOr<ThickPortRefinementSummary> RefineRefractiveIndexThickPort(
   }
   if (static_cast<int>(inliers.size()) < min_inliers) {
     std::ostringstream message;
-    message << "too few inliers: " << inliers.size() << " of "
-            << matches.size() << " within " << options.base.inlier_threshold_px
+    message << "too few inliers: " << inliers.size() << " of " << matches.size()
+            << " within " << options.base.inlier_threshold_px
             << " px of the thick-port loci, at least " << min_inliers
             << " needed";
     return Status::Error(message.str());
@@ -161,9 +161,9 @@ StatusOr<ThickPortRefinementSummary> RefineRefractiveIndexThickPort(
 
   // Stage 2: least squares on the inliers, and its covariance.
   ceres::Problem problem;
-  const ceres::Solver::Summary stage2 = Solve(
-      stereo, matches, inliers, RobustLoss::kNone, options, &parameters,
-      &problem);
+  const ceres::Solver::Summary stage2 =
+      Solve(stereo, matches, inliers, RobustLoss::kNone, options, &parameters,
+            &problem);
   if (!stage2.IsSolutionUsable()) {
     return Status::Error("the least-squares refinement failed: " +
                          stage2.message);
@@ -219,8 +219,8 @@ StatusOr<ThickPortRefinementSummary> RefineRefractiveIndexThickPort(
     double n_gap = 0.0;
     double gap_variance = 0.0;
     covariance.GetCovarianceBlock(&parameters.n, &parameters.gap_delta, &n_gap);
-    covariance.GetCovarianceBlock(&parameters.gap_delta,
-                                  &parameters.gap_delta, &gap_variance);
+    covariance.GetCovarianceBlock(&parameters.gap_delta, &parameters.gap_delta,
+                                  &gap_variance);
     AirGapEstimate gap;
     gap.left_air_gap = left_port.air_gap + parameters.gap_delta;
     gap.right_air_gap = right_port.air_gap + parameters.gap_delta;
@@ -247,15 +247,15 @@ StatusOr<ThickPortRefinementSummary> RefineRefractiveIndexThickPort(
   if (!at.ok()) return at.status();
   std::vector<StereoCorrespondence> raw;
   raw.reserve(matches.size());
-  for (const int64_t i : prepared.source_index) raw.push_back(correspondences[i]);
+  for (const int64_t i : prepared.source_index)
+    raw.push_back(correspondences[i]);
   const CalibrationParameterLayout layout =
       CalibrationParameterLayout::Of(*at, options.base.systematic_px);
   LocusNormalEquations equations(layout.Size());
   std::vector<LocusNormalEquations> per_frame;
   AccumulateLocusNormalEquations(*at, layout, raw, matches, inliers,
-                                 parameters.n,
-                                 Eigen::Vector3d::Zero(), &equations,
-                                 &per_frame);
+                                 parameters.n, Eigen::Vector3d::Zero(),
+                                 &equations, &per_frame);
   summary.consistency = FrameConsistencyOf(per_frame, summary.sigma_px);
   if (summary.consistency) {
     summary.sigma_n_noise *= summary.consistency->inflation;

@@ -73,8 +73,7 @@ bool GeneralizedEpipolarValue(const ThickPortStereo& stereo, const T& n,
           T(left.glass_index), left.normal, xl, yl, origin_l, direction_l) ||
       !ThickPortRefraction::RayInMedium(
           n, T(right.air_gap) + gap_delta, T(right.glass_thickness),
-          T(right.glass_index), right.normal, xr, yr, origin_r,
-          direction_r)) {
+          T(right.glass_index), right.normal, xr, yr, origin_r, direction_r)) {
     return false;
   }
   // The right ray in cam0: R^T d_r and R^T (o_r - t).

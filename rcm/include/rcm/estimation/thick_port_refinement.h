@@ -14,8 +14,8 @@
 //   sigma_px^2 = sum r_i^2 / (N - p),   cov = sigma_px^2 (J^T J)^-1,
 //   crlb = sigma_px / sqrt(sum_i (dr_i/dn)^2)   (port known).
 // The air gap and n are strongly correlated (a larger gap shifts every ray
-// sideways, which the loci partly read as a smaller n; docs/thin_port_bias.md's thin-port
-// table): estimating the gap costs precision in n, reported as the
+// sideways, which the loci partly read as a smaller n; docs/thin_port_bias.md's
+// thin-port table): estimating the gap costs precision in n, reported as the
 // correlation and as sigma_n against crlb.
 #ifndef RCM_ESTIMATION_THICK_PORT_REFINEMENT_H_
 #define RCM_ESTIMATION_THICK_PORT_REFINEMENT_H_
