@@ -60,19 +60,6 @@ struct Parameters {
   double rotation[3] = {0.0, 0.0, 0.0};
 };
 
-// The prior of the rotation correction in pixels of residual: with
-// Sigma = L L^T (Cholesky) and sigma_px the pixel noise,
-// |sigma_px L^-1 w|^2 = sigma_px^2 w^T Sigma^-1 w, the prior's negative
-// log-likelihood in the units of the Sampson residuals' sum of squares.
-ceres::CostFunction* NewRotationPrior(const Eigen::Matrix3d& covariance,
-                                      double sigma_px) {
-  const Eigen::Matrix3d lower = covariance.llt().matrixL();
-  const ceres::Matrix root_information =
-      sigma_px *
-      lower.triangularView<Eigen::Lower>().solve(Eigen::Matrix3d::Identity());
-  return new ceres::NormalPrior(root_information, ceres::Vector::Zero(3));
-}
-
 // The prior on n (RefinementOptions::n_prior) in pixels of residual:
 // sigma_px (n - mean) / sigma, as NewRotationPrior's.
 ceres::CostFunction* NewIndexPrior(const IndexPrior& prior, double sigma_px) {

@@ -1,5 +1,8 @@
 #include "rcm/estimation/refinement_options.h"
 
+#include <ceres/normal_prior.h>
+
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -132,6 +135,15 @@ ceres::LossFunction* NewLossFunction(RobustLoss loss, double scale_px) {
       return new ceres::CauchyLoss(scale_px);
   }
   return nullptr;
+}
+
+ceres::CostFunction* NewRotationPrior(const Eigen::Matrix3d& covariance,
+                                      double sigma_px) {
+  const Eigen::Matrix3d lower = covariance.llt().matrixL();
+  const ceres::Matrix root_information =
+      sigma_px *
+      lower.triangularView<Eigen::Lower>().solve(Eigen::Matrix3d::Identity());
+  return new ceres::NormalPrior(root_information, ceres::Vector::Zero(3));
 }
 
 }  // namespace rcm

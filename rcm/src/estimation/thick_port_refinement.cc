@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <utility>
 
@@ -17,6 +18,7 @@ namespace {
 struct Parameters {
   double n = 1.0;
   double gap_delta = 0.0;
+  double rotation[3] = {0.0, 0.0, 0.0};  // cam1's correction, angle-axis
 };
 
 // sum_i rho(r_i^2) at (n, 0), unusable matches at the loss' value of a
@@ -41,18 +43,31 @@ double RobustCost(const ThickPortStereo& stereo,
   return cost;
 }
 
+// One Ceres problem over `indices` of `matches`; with `rotation_prior`
+// (NewRotationPrior) cam1's rotation correction is estimated under it.
 ceres::Solver::Summary Solve(const ThickPortStereo& stereo,
                              const std::vector<PreparedCorrespondence>& matches,
                              const std::vector<int64_t>& indices,
                              RobustLoss loss,
                              const ThickPortRefinementOptions& options,
+                             ceres::CostFunction* rotation_prior,
                              Parameters* parameters, ceres::Problem* problem) {
   ceres::LossFunction* loss_function =
       NewLossFunction(loss, options.base.loss_scale_px);
+  if (rotation_prior != nullptr) {
+    problem->AddResidualBlock(rotation_prior, nullptr, parameters->rotation);
+  }
   for (const int64_t i : indices) {
-    problem->AddResidualBlock(
-        GeneralizedEpipolarError::Create(stereo, matches[i]), loss_function,
-        &parameters->n, &parameters->gap_delta);
+    if (rotation_prior != nullptr) {
+      problem->AddResidualBlock(
+          GeneralizedEpipolarError::CreateWithRotation(stereo, matches[i]),
+          loss_function, &parameters->n, &parameters->gap_delta,
+          parameters->rotation);
+    } else {
+      problem->AddResidualBlock(
+          GeneralizedEpipolarError::Create(stereo, matches[i]), loss_function,
+          &parameters->n, &parameters->gap_delta);
+    }
   }
   problem->SetParameterLowerBound(&parameters->n, 0, 1.0);
   problem->SetParameterUpperBound(&parameters->n, 0, 2.0);
@@ -110,6 +125,30 @@ StatusOr<ThickPortRefinementSummary> RefineRefractiveIndexThickPort(
     return Status::Error(message.str());
   }
 
+  // How cam1's rotation is treated (batch_refinement.h): estimated with
+  // the calibration's rotation covariance as prior (self-calibration)
+  // when there is one, as for the thin port, unless the air gap is
+  // estimated too; otherwise held, its uncertainty propagated.
+  const CalibrationUncertainty uncertainty =
+      rig.calibration_uncertainty().value_or(CalibrationUncertainty());
+  const RotationMode mode =
+      options.base.self_calibrate_rotation && !options.estimate_air_gap &&
+              !uncertainty.RotationCovariance().isZero(0.0)
+          ? RotationMode::kPrior
+          : RotationMode::kHeld;
+  const bool with_rotation = mode == RotationMode::kPrior;
+  // The prior in pixels of residual for the pixel noise sigma_px.
+  const auto rotation_prior = [&](double sigma_px) -> ceres::CostFunction* {
+    return with_rotation ? NewRotationPrior(uncertainty.RotationCovariance(),
+                                            std::max(sigma_px, 1e-6))
+                         : nullptr;
+  };
+  const auto residual = [&](const Parameters& at, size_t i, double* r) {
+    return GeneralizedEpipolarResidual(stereo, matches[i], at.n, at.gap_delta,
+                                       with_rotation ? at.rotation : nullptr,
+                                       r);
+  };
+
   // Seed: the robust cost's minimum over a scan of [1, 2].
   Parameters parameters;
   double best_cost = std::numeric_limits<double>::infinity();
@@ -124,13 +163,16 @@ StatusOr<ThickPortRefinementSummary> RefineRefractiveIndexThickPort(
   }
   summary.n_seed = parameters.n;
 
-  // Stage 1: robust, all matches.
+  // Stage 1: robust, all matches. The prior's weight needs the pixel
+  // noise, unknown before stage 2: half the loss scale, which the options
+  // call about twice the noise.
   std::vector<int64_t> all(matches.size());
   for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int64_t>(i);
   {
     ceres::Problem problem;
     const ceres::Solver::Summary stage1 =
-        Solve(stereo, matches, all, options.base.loss, options, &parameters,
+        Solve(stereo, matches, all, options.base.loss, options,
+              rotation_prior(0.5 * options.base.loss_scale_px), &parameters,
               &problem);
     if (!stage1.IsSolutionUsable()) {
       return Status::Error("the robust refinement failed: " + stage1.message);
@@ -144,8 +186,7 @@ StatusOr<ThickPortRefinementSummary> RefineRefractiveIndexThickPort(
   std::vector<int64_t> inliers;
   for (size_t i = 0; i < matches.size(); ++i) {
     double r = 0.0;
-    if (GeneralizedEpipolarResidual(stereo, matches[i], parameters.n,
-                                    parameters.gap_delta, &r) &&
+    if (residual(parameters, i, &r) &&
         std::abs(r) <= options.base.inlier_threshold_px) {
       inliers.push_back(static_cast<int64_t>(i));
     }
@@ -159,29 +200,59 @@ StatusOr<ThickPortRefinementSummary> RefineRefractiveIndexThickPort(
     return Status::Error(message.str());
   }
 
-  // Stage 2: least squares on the inliers, and its covariance.
-  ceres::Problem problem;
-  const ceres::Solver::Summary stage2 =
-      Solve(stereo, matches, inliers, RobustLoss::kNone, options, &parameters,
-            &problem);
-  if (!stage2.IsSolutionUsable()) {
-    return Status::Error("the least-squares refinement failed: " +
-                         stage2.message);
-  }
-  summary.num_iterations += static_cast<int>(stage2.iterations.size());
-  summary.n = parameters.n;
-  summary.cost = stage2.final_cost;
-  const int num_parameters = options.estimate_air_gap ? 2 : 1;
+  // Stage 2: least squares on the inliers, and its covariance. With the
+  // rotation's prior, its weight sigma_px^2 comes from the inliers'
+  // residuals, refined until it settles (two or three solves).
+  const int num_parameters =
+      1 + (options.estimate_air_gap ? 1 : 0) + (with_rotation ? 3 : 0);
   const int64_t dof = static_cast<int64_t>(inliers.size()) - num_parameters;
-  summary.sigma_px = std::sqrt(2.0 * summary.cost / static_cast<double>(dof));
+  const auto data_sigma_px = [&](const Parameters& at) {
+    double sum = 0.0;
+    for (const int64_t i : inliers) {
+      double r = 0.0;
+      if (residual(at, static_cast<size_t>(i), &r) && std::isfinite(r)) {
+        sum += r * r;
+      }
+    }
+    return std::sqrt(sum / static_cast<double>(dof));
+  };
+  double prior_sigma_px = with_rotation ? data_sigma_px(parameters) : 0.0;
+  constexpr int kMaxPriorSolves = 3;
+  constexpr double kPriorSigmaTolerance = 0.02;  // relative
+  std::unique_ptr<ceres::Problem> problem;
+  for (int solve = 0;; ++solve) {
+    problem = std::make_unique<ceres::Problem>();
+    const ceres::Solver::Summary stage2 =
+        Solve(stereo, matches, inliers, RobustLoss::kNone, options,
+              rotation_prior(prior_sigma_px), &parameters, problem.get());
+    if (!stage2.IsSolutionUsable()) {
+      return Status::Error("the least-squares refinement failed: " +
+                           stage2.message);
+    }
+    summary.num_iterations += static_cast<int>(stage2.iterations.size());
+    summary.sigma_px = data_sigma_px(parameters);
+    if (!with_rotation || solve + 1 >= kMaxPriorSolves ||
+        std::abs(summary.sigma_px - prior_sigma_px) <=
+            kPriorSigmaTolerance * summary.sigma_px) {
+      break;
+    }
+    prior_sigma_px = summary.sigma_px;
+  }
+  summary.n = parameters.n;
+  summary.cost =
+      0.5 * summary.sigma_px * summary.sigma_px * static_cast<double>(dof);
 
-  // The information on n alone (port known): sum (dr/dn)^2.
+  // The information on n alone (port and rotation known): sum (dr/dn)^2.
   double information = 0.0;
   for (const int64_t i : inliers) {
     using Jet = ceres::Jet<double, 1>;
     Jet r;
+    const Jet rotation[3] = {Jet(parameters.rotation[0]),
+                             Jet(parameters.rotation[1]),
+                             Jet(parameters.rotation[2])};
     if (GeneralizedEpipolarResidual(stereo, matches[i], Jet(parameters.n, 0),
-                                    Jet(parameters.gap_delta), &r)) {
+                                    Jet(parameters.gap_delta),
+                                    with_rotation ? rotation : nullptr, &r)) {
       information += r.v[0] * r.v[0];
     }
   }
@@ -193,46 +264,52 @@ StatusOr<ThickPortRefinementSummary> RefineRefractiveIndexThickPort(
   }
   summary.crlb = summary.sigma_px / std::sqrt(information);
 
-  ceres::Covariance::Options covariance_options;
-  covariance_options.algorithm_type = ceres::DENSE_SVD;
-  covariance_options.num_threads = options.base.num_threads;
-  ceres::Covariance covariance(covariance_options);
-  std::vector<std::pair<const double*, const double*>> blocks = {
-      {&parameters.n, &parameters.n}};
-  if (options.estimate_air_gap) {
-    blocks.emplace_back(&parameters.n, &parameters.gap_delta);
-    blocks.emplace_back(&parameters.gap_delta, &parameters.gap_delta);
+  // Without the rotation, n's (and the gap's) covariance from Ceres; with
+  // it, from the propagation below, which splits the prior's share from
+  // the pixel noise's.
+  if (!with_rotation) {
+    ceres::Covariance::Options covariance_options;
+    covariance_options.algorithm_type = ceres::DENSE_SVD;
+    covariance_options.num_threads = options.base.num_threads;
+    ceres::Covariance covariance(covariance_options);
+    std::vector<std::pair<const double*, const double*>> blocks = {
+        {&parameters.n, &parameters.n}};
+    if (options.estimate_air_gap) {
+      blocks.emplace_back(&parameters.n, &parameters.gap_delta);
+      blocks.emplace_back(&parameters.gap_delta, &parameters.gap_delta);
+    }
+    if (!covariance.Compute(blocks, problem.get())) {
+      return Status::Error(
+          options.estimate_air_gap
+              ? "the air gap cannot be separated from n with these "
+                "correspondences (singular covariance); give the gap instead"
+              : "the covariance of n is singular: the correspondences do not "
+                "observe n");
+    }
+    const double variance_scale = summary.sigma_px * summary.sigma_px;
+    double n_variance = 0.0;
+    covariance.GetCovarianceBlock(&parameters.n, &parameters.n, &n_variance);
+    summary.sigma_n = std::sqrt(n_variance * variance_scale);
+    if (options.estimate_air_gap) {
+      double n_gap = 0.0;
+      double gap_variance = 0.0;
+      covariance.GetCovarianceBlock(&parameters.n, &parameters.gap_delta,
+                                    &n_gap);
+      covariance.GetCovarianceBlock(&parameters.gap_delta,
+                                    &parameters.gap_delta, &gap_variance);
+      AirGapEstimate gap;
+      gap.left_air_gap = left_port.air_gap + parameters.gap_delta;
+      gap.right_air_gap = right_port.air_gap + parameters.gap_delta;
+      gap.sigma = std::sqrt(gap_variance * variance_scale);
+      gap.correlation_with_n = n_gap / std::sqrt(n_variance * gap_variance);
+      result.air_gap = gap;
+    }
+    summary.sigma_n_noise = summary.sigma_n;
   }
-  if (!covariance.Compute(blocks, &problem)) {
-    return Status::Error(
-        options.estimate_air_gap
-            ? "the air gap cannot be separated from n with these "
-              "correspondences (singular covariance); give the gap instead"
-            : "the covariance of n is singular: the correspondences do not "
-              "observe n");
-  }
-  const double variance_scale = summary.sigma_px * summary.sigma_px;
-  double n_variance = 0.0;
-  covariance.GetCovarianceBlock(&parameters.n, &parameters.n, &n_variance);
-  summary.sigma_n = std::sqrt(n_variance * variance_scale);
-  if (options.estimate_air_gap) {
-    double n_gap = 0.0;
-    double gap_variance = 0.0;
-    covariance.GetCovarianceBlock(&parameters.n, &parameters.gap_delta, &n_gap);
-    covariance.GetCovarianceBlock(&parameters.gap_delta, &parameters.gap_delta,
-                                  &gap_variance);
-    AirGapEstimate gap;
-    gap.left_air_gap = left_port.air_gap + parameters.gap_delta;
-    gap.right_air_gap = right_port.air_gap + parameters.gap_delta;
-    gap.sigma = std::sqrt(gap_variance * variance_scale);
-    gap.correlation_with_n = n_gap / std::sqrt(n_variance * gap_variance);
-    result.air_gap = gap;
-  }
-  summary.sigma_n_noise = summary.sigma_n;
 
   // The frames' consistency and the calibration's uncertainty
-  // (calibration_propagation.h), with cam1's rotation and the ports held at
-  // the solution's.
+  // (calibration_propagation.h), with the ports held at the solution's
+  // and cam1's rotation at the solution's correction.
   StatusOr<StereoRig> at = rig.WithPorts(
       [&] {
         FlatPort port = stereo.left_port;
@@ -253,22 +330,48 @@ StatusOr<ThickPortRefinementSummary> RefineRefractiveIndexThickPort(
       CalibrationParameterLayout::Of(*at, options.base.systematic_px);
   LocusNormalEquations equations(layout.Size());
   std::vector<LocusNormalEquations> per_frame;
+  const Eigen::Vector3d rotation(parameters.rotation[0], parameters.rotation[1],
+                                 parameters.rotation[2]);
   AccumulateLocusNormalEquations(*at, layout, raw, matches, inliers,
-                                 parameters.n, Eigen::Vector3d::Zero(),
-                                 &equations, &per_frame);
+                                 parameters.n, rotation, &equations,
+                                 &per_frame);
   summary.consistency = FrameConsistencyOf(per_frame, summary.sigma_px);
-  if (summary.consistency) {
-    summary.sigma_n_noise *= summary.consistency->inflation;
-  }
-  if (at->calibration_uncertainty() || layout.NumSystematic() > 0) {
+  const double inflation =
+      summary.consistency ? summary.consistency->inflation : 1.0;
+  if (with_rotation) {
     StatusOr<CalibrationPropagation> propagation = PropagateCalibration(
-        equations, layout,
-        at->calibration_uncertainty().value_or(CalibrationUncertainty()),
-        RotationMode::kHeld, summary.sigma_px);
+        equations, layout, uncertainty, mode, summary.sigma_px, inflation);
     if (!propagation.ok()) return propagation.status();
+    summary.sigma_n_noise = propagation->sigma_n_noise;
     summary.sigma_n_calibration = propagation->sigma_n_calibration;
     summary.sigma_n_systematic = propagation->sigma_n_systematic;
+    RotationCorrection correction;
+    correction.angle_axis = rotation;
+    for (int k = 0; k < 3; ++k) {
+      correction.sigma[k] =
+          std::sqrt(std::max(0.0, propagation->rotation_covariance(k, k)));
+    }
+    correction.correlation_with_n = propagation->rotation_correlation_with_n;
+    correction.multiple_correlation_with_n =
+        propagation->rotation_multiple_correlation;
+    correction.with_prior = true;
+    const StatusOr<StereoRig> turned = rig.WithCam1Moved(rotation);
+    if (!turned.ok()) return turned.status();
+    correction.cam1_from_cam0 = turned->right_from_left();
+    summary.rotation = correction;
     summary.calibration = *propagation;
+  } else {
+    summary.sigma_n_noise *= inflation;
+    if (at->calibration_uncertainty() || layout.NumSystematic() > 0) {
+      StatusOr<CalibrationPropagation> propagation = PropagateCalibration(
+          equations, layout,
+          at->calibration_uncertainty().value_or(CalibrationUncertainty()),
+          RotationMode::kHeld, summary.sigma_px);
+      if (!propagation.ok()) return propagation.status();
+      summary.sigma_n_calibration = propagation->sigma_n_calibration;
+      summary.sigma_n_systematic = propagation->sigma_n_systematic;
+      summary.calibration = *propagation;
+    }
   }
   summary.sigma_n =
       std::sqrt(summary.sigma_n_noise * summary.sigma_n_noise +

@@ -26,12 +26,18 @@
 // measured pixels from the locus of n, in pixels, and exactly 0 on exact
 // correspondences.
 //
-// Parameters: n, and gap_delta (meters) added to both cameras' air gaps,
-// for the joint estimation of the air gap with n.
+// Parameters: n, gap_delta (meters) added to both cameras' air gaps, for
+// the joint estimation of the air gap with n, and optionally the rotation
+// correction w (angle-axis, radians) of cam1 about its center, the
+// self-calibration of batch_refinement.h: cam1_from_cam0 becomes
+// (exp([w]x) R, exp([w]x) t), so that in cam0
+//
+//   d_r' = R^T exp(-[w]x) d_r,   o_r' = R^T (exp(-[w]x) o_r - t).
 #ifndef RCM_ESTIMATION_GENERALIZED_EPIPOLAR_ERROR_H_
 #define RCM_ESTIMATION_GENERALIZED_EPIPOLAR_ERROR_H_
 
 #include <ceres/autodiff_cost_function.h>
+#include <ceres/rotation.h>
 
 #include <Eigen/Core>
 #include <cmath>
@@ -56,12 +62,14 @@ struct ThickPortStereo {
 // 350 px focal length).
 inline constexpr double kNormalizedStep = 1e-6;
 
-// e of the header for the normalized points (xl, yl) and (xr, yr); false
-// when a ray misses its port.
+// e of the header for the normalized points (xl, yl) and (xr, yr), with
+// the rotation correction `rotation` (3, angle-axis) or none (nullptr);
+// false when a ray misses its port.
 template <typename T>
 bool GeneralizedEpipolarValue(const ThickPortStereo& stereo, const T& n,
-                              const T& gap_delta, const T& xl, const T& yl,
-                              const T& xr, const T& yr, T* e) {
+                              const T& gap_delta, const T* rotation,
+                              const T& xl, const T& yl, const T& xr,
+                              const T& yr, T* e) {
   T origin_l[3];
   T direction_l[3];
   T origin_r[3];
@@ -75,6 +83,15 @@ bool GeneralizedEpipolarValue(const ThickPortStereo& stereo, const T& n,
           n, T(right.air_gap) + gap_delta, T(right.glass_thickness),
           T(right.glass_index), right.normal, xr, yr, origin_r, direction_r)) {
     return false;
+  }
+  if (rotation != nullptr) {
+    // exp(-[w]x) of the right ray: cam1 turned back by the correction.
+    const T inverse[3] = {-rotation[0], -rotation[1], -rotation[2]};
+    T turned[3];
+    ceres::AngleAxisRotatePoint(inverse, direction_r, turned);
+    for (int i = 0; i < 3; ++i) direction_r[i] = turned[i];
+    ceres::AngleAxisRotatePoint(inverse, origin_r, turned);
+    for (int i = 0; i < 3; ++i) origin_r[i] = turned[i];
   }
   // The right ray in cam0: R^T d_r and R^T (o_r - t).
   const Eigen::Matrix3d& r = stereo.cam1_from_cam0.rotation;
@@ -103,18 +120,20 @@ bool GeneralizedEpipolarValue(const ThickPortStereo& stereo, const T& n,
   return true;
 }
 
-// r(n) of the header. False when a ray misses its port or the gradient
-// vanishes.
+// r(n) of the header, with the rotation correction `rotation` (3,
+// angle-axis) or none (nullptr). False when a ray misses its port or the
+// gradient vanishes.
 template <typename T>
 bool GeneralizedEpipolarResidual(const ThickPortStereo& stereo,
                                  const PreparedCorrespondence& match,
-                                 const T& n, const T& gap_delta, T* residual) {
+                                 const T& n, const T& gap_delta,
+                                 const T* rotation, T* residual) {
   using std::sqrt;
   T x[4] = {T(match.left_normalized[0]), T(match.left_normalized[1]),
             T(match.right_normalized[0]), T(match.right_normalized[1])};
   T e;
-  if (!GeneralizedEpipolarValue(stereo, n, gap_delta, x[0], x[1], x[2], x[3],
-                                &e)) {
+  if (!GeneralizedEpipolarValue(stereo, n, gap_delta, rotation, x[0], x[1],
+                                x[2], x[3], &e)) {
     return false;
   }
   // de/d(xl, yl, xr, yr) by central differences.
@@ -126,10 +145,10 @@ bool GeneralizedEpipolarResidual(const ThickPortStereo& stereo,
     minus[k] -= T(kNormalizedStep);
     T e_plus;
     T e_minus;
-    if (!GeneralizedEpipolarValue(stereo, n, gap_delta, plus[0], plus[1],
-                                  plus[2], plus[3], &e_plus) ||
-        !GeneralizedEpipolarValue(stereo, n, gap_delta, minus[0], minus[1],
-                                  minus[2], minus[3], &e_minus)) {
+    if (!GeneralizedEpipolarValue(stereo, n, gap_delta, rotation, plus[0],
+                                  plus[1], plus[2], plus[3], &e_plus) ||
+        !GeneralizedEpipolarValue(stereo, n, gap_delta, rotation, minus[0],
+                                  minus[1], minus[2], minus[3], &e_minus)) {
       return false;
     }
     gradient[k] = (e_plus - e_minus) / T(2.0 * kNormalizedStep);
@@ -147,7 +166,17 @@ bool GeneralizedEpipolarResidual(const ThickPortStereo& stereo,
   return true;
 }
 
-// Ceres functor: parameter blocks n (1) and gap_delta (1).
+// Without a rotation correction.
+template <typename T>
+bool GeneralizedEpipolarResidual(const ThickPortStereo& stereo,
+                                 const PreparedCorrespondence& match,
+                                 const T& n, const T& gap_delta, T* residual) {
+  return GeneralizedEpipolarResidual<T>(stereo, match, n, gap_delta, nullptr,
+                                        residual);
+}
+
+// Ceres functor: parameter blocks n (1) and gap_delta (1) and, for
+// CreateWithRotation, the rotation correction (angle-axis, 3).
 class GeneralizedEpipolarError {
  public:
   GeneralizedEpipolarError(const ThickPortStereo& stereo,
@@ -157,12 +186,26 @@ class GeneralizedEpipolarError {
   template <typename T>
   bool operator()(const T* n, const T* gap_delta, T* residual) const {
     return GeneralizedEpipolarResidual<T>(stereo_, match_, n[0], gap_delta[0],
-                                          residual);
+                                          nullptr, residual);
+  }
+
+  template <typename T>
+  bool operator()(const T* n, const T* gap_delta, const T* rotation,
+                  T* residual) const {
+    return GeneralizedEpipolarResidual<T>(stereo_, match_, n[0], gap_delta[0],
+                                          rotation, residual);
   }
 
   static ceres::CostFunction* Create(const ThickPortStereo& stereo,
                                      const PreparedCorrespondence& match) {
     return new ceres::AutoDiffCostFunction<GeneralizedEpipolarError, 1, 1, 1>(
+        new GeneralizedEpipolarError(stereo, match));
+  }
+
+  static ceres::CostFunction* CreateWithRotation(
+      const ThickPortStereo& stereo, const PreparedCorrespondence& match) {
+    return new ceres::AutoDiffCostFunction<GeneralizedEpipolarError, 1, 1, 1,
+                                           3>(
         new GeneralizedEpipolarError(stereo, match));
   }
 

@@ -15,9 +15,11 @@
 #ifndef RCM_ESTIMATION_REFINEMENT_OPTIONS_H_
 #define RCM_ESTIMATION_REFINEMENT_OPTIONS_H_
 
+#include <ceres/cost_function.h>
 #include <ceres/loss_function.h>
 #include <ceres/solver.h>
 
+#include <Eigen/Core>
 #include <optional>
 #include <string_view>
 
@@ -123,6 +125,15 @@ Status CheckNotPinnedAtUpperBound(double n, double sigma_n = 0.0);
 // A new Ceres loss of `loss` with scale `scale_px` (owned by the problem
 // it is given to); nullptr for kNone (least squares).
 ceres::LossFunction* NewLossFunction(RobustLoss loss, double scale_px);
+
+// The prior of cam1's rotation correction w (self_calibrate_rotation) as
+// a Ceres residual in pixels: with the prior's covariance Sigma = L L^T
+// (Cholesky, positive definite) and the pixel noise sigma_px,
+//   |sigma_px L^-1 w|^2 = sigma_px^2 w^T Sigma^-1 w,
+// the prior's negative log-likelihood in the units of the locus
+// residuals' sum of squares. Owned by the problem it is given to.
+ceres::CostFunction* NewRotationPrior(const Eigen::Matrix3d& covariance,
+                                      double sigma_px);
 
 }  // namespace rcm
 

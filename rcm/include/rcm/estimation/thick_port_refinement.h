@@ -10,7 +10,17 @@
 //   stage 1: min sum_i rho(r_i(n, g)^2) over all matches (Ceres, robust);
 //   stage 2: min sum_{inliers} r_i(n, g)^2, |r_i| <= inlier threshold;
 // with g the air-gap offset added to both ports' gaps when
-// options.estimate_air_gap (else 0). Uncertainty from stage 2:
+// options.estimate_air_gap (else 0). When the rig's calibration carries a
+// rotation covariance (a drift prior or a measured one) and
+// base.self_calibrate_rotation, cam1's rotation correction w is estimated
+// with n under that prior, as for the thin port (batch_refinement.h,
+// r_i(n, g, w), generalized_epipolar_error.h), and sigma_n splits as
+// there (calibration_propagation.h, RotationMode::kPrior); not together
+// with the air gap (then w is held and its uncertainty propagated). A
+// tilted port is the case that needs it: its tilt and cam1's rotation,
+// both fitted under water, trade against each other, so that w held at
+// the calibration's carries its whole marginal uncertainty into n, while
+// the data pin the combination the loci see. Uncertainty from stage 2:
 //   sigma_px^2 = sum r_i^2 / (N - p),   cov = sigma_px^2 (J^T J)^-1,
 //   crlb = sigma_px / sqrt(sum_i (dr_i/dn)^2)   (port known).
 // The air gap and n are strongly correlated (a larger gap shifts every ray
@@ -33,8 +43,9 @@
 namespace rcm {
 
 struct ThickPortRefinementOptions {
-  // Loss, thresholds, scan, iterations, threads, as for the thin port.
-  // refine_rotation is not supported with a thick port (Check fails).
+  // Loss, thresholds, scan, iterations, threads and the rotation's
+  // self-calibration, as for the thin port. refine_rotation (w without a
+  // prior) is not supported with a thick port (Check fails).
   RefinementOptions base;
   // Estimate an offset of the air gap (the same for both cameras) with n.
   bool estimate_air_gap = false;
@@ -53,8 +64,9 @@ struct AirGapEstimate {
 };
 
 struct ThickPortRefinementSummary {
-  // n, sigma_n, crlb, sigma_px, n_seed, n_robust, costs, inliers and
-  // counts as for the thin port (n_closed_form and rotation unset).
+  // n, sigma_n, crlb, sigma_px, n_seed, n_robust, costs, inliers, counts
+  // and the rotation correction (when self-calibrated) as for the thin
+  // port (n_closed_form unset).
   RefinementSummary refinement;
   // With options.estimate_air_gap.
   std::optional<AirGapEstimate> air_gap;
