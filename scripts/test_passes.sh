@@ -93,6 +93,24 @@ release_only=(
   'CalibrateCli.JsonOnStdoutAndAnOutputFolder'
   # [CrossValidation.NeedsTwoFolds, CalibrateCli.*]: the folds' table
   'CrossValidation.FlatBoardHasNoBowlRow'
+  # The heaviest end-to-end runs under the sanitizers (15-19 s each there,
+  # a third of that in Release), each beside a cheaper test of the same
+  # code that the sanitizer pass keeps:
+  # [UnderwaterCalibration.ExactSingleCamera, UnderwaterCli.TooFewViews]:
+  # one camera under water end to end
+  'UnderwaterCli.OneCameraGivesN'
+  # [LivePipeline.HoldKeepsTheMapsAndResetMovesThem, .RefusesBadPairs...]:
+  # the live pipeline through air, water and air
+  'LivePipeline.FollowsAirWaterAirAndItsMapsFollowN'
+  # [StereoFrontEndAcceptance.UnrectifiedRigN1345]: the same front end on
+  # the rectified rig
+  'StereoFrontEndAcceptance.RectifiedRigN1333'
+  # [BagStereoSource.*, CalibrateCli.FoldersToCamchainAndReport, the bad-input
+  # table's CalibrateCornersAndABag]: calibration from a bag
+  'CalibrateCli.BagGivesTheFoldersResult'
+  # [UnderwaterModelSelection.ExactAirGapChoosesAGap]: the selection on
+  # exact corners, with the bow
+  'UnderwaterModelSelection.ExactBowedBoardChoosesTheBow'
 )
 
 budgeted=(
