@@ -69,7 +69,7 @@ using calib::ImageSize;
 using calib::StereoCalibration;
 using calib::StereoView;
 
-constexpr char kUsage[] =
+constexpr char kCalibrateUsage[] =
     "rcm calibrate: calibrate a stereo rig in air from images of a target,\n"
     "or refine it under water\n\n"
     "usage:\n"
@@ -138,7 +138,7 @@ int RunCalibrate();
 extern const Subcommand kCalibrateCommand = {
     "calibrate",
     "air stereo calibration from target images (folders or a ROS1 bag)",
-    kUsage,
+    kCalibrateUsage,
     {__FILE__, kImageInputFlagsSource, kCalibrationInputFlagsSource,
      kTargetFlagsSource, kLensModelFlagSource, kUnderwaterFlagsSource,
      kAirGapFlagSource, kAirFlagSource, kAirViewsFlagsSource,

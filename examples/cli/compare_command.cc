@@ -34,7 +34,7 @@ DEFINE_double(inset, 0.05,
 namespace rcm::cli {
 namespace {
 
-constexpr char kUsage[] =
+constexpr char kCompareUsage[] =
     "rcm compare: the refractive index implied by an air and an underwater\n"
     "calibration of one camera\n\n"
     "usage:\n"
@@ -89,7 +89,7 @@ int RunCompare();
 extern const Subcommand kCompareCommand = {
     "compare",
     "n implied by an air and an underwater calibration of one camera",
-    kUsage,
+    kCompareUsage,
     {__FILE__, kAirFlagSource},
     RunCompare};
 

@@ -38,7 +38,7 @@ namespace {
 
 constexpr char kDefaultFolder[] = "rcm_demo";
 
-constexpr char kUsage[] =
+constexpr char kDemoUsage[] =
     "rcm demo: the main job on built-in data, end to end.\n\n"
     "usage: rcm demo [--out DIR] [--frames 20] [--n 1.333] [--seed 1]\n\n"
     "Simulates a short sequence of the paper's dataset rig (Alphasense, "
@@ -67,7 +67,7 @@ int RunDemo();
 extern const Subcommand kDemoCommand = {
     "demo",
     "simulate a dive, estimate n from the images, plot it (no input needed)",
-    kUsage,
+    kDemoUsage,
     {__FILE__, kSimulationFlagsSource, kIndexFlagSource},
     RunDemo};
 

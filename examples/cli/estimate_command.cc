@@ -120,7 +120,7 @@ DEFINE_double(mask_eta, 0.3,
 namespace rcm::cli {
 namespace {
 
-constexpr char kUsage[] =
+constexpr char kEstimateUsage[] =
     "rcm estimate: the refractive index n of the medium from the stereo\n"
     "images (folders or a ROS1 bag) or correspondences of a rig calibrated\n"
     "in air.\n\n"
@@ -923,7 +923,7 @@ int RunEstimate();
 extern const Subcommand kEstimateCommand = {
     "estimate",
     "refractive index n from stereo images or correspondences",
-    kUsage,
+    kEstimateUsage,
     {__FILE__, kRigFlagsSource, kImageInputFlagsSource, kAirGapFlagSource,
      kMediumFlagSource},
     RunEstimate};

@@ -36,7 +36,7 @@ DEFINE_double(grid_step, 4.0, "spacing of the fitted pixel grid, pixels");
 namespace rcm::cli {
 namespace {
 
-constexpr char kUsage[] =
+constexpr char kExportUsage[] =
     "rcm export: the conventional water-side camera models of a rig\n\n"
     "usage:\n"
     "  rcm export --calib camchain.yaml --n 1.333\n"
@@ -57,7 +57,7 @@ constexpr char kUsage[] =
     "--out FILE.yaml writes the camchain there and the others next to it\n"
     "as FILE-left.yaml, FILE-fit_error_left.png, ...";
 
-// Where the files go (see kUsage).
+// Where the files go (see kExportUsage).
 struct ExportPaths {
   std::string camchain;
   std::string prefix;  // the other files are prefix + "left.yaml", ...
@@ -123,7 +123,7 @@ extern const Subcommand kExportCommand = {
     "export",
     "conventional water-side models (equidistant, radtan) fitted to the "
     "refractive model",
-    kUsage,
+    kExportUsage,
     {__FILE__, kRigFlagsSource, kIndexFlagSource, kLensModelFlagSource,
      kReferenceDepthFlagSource},
     RunExport};

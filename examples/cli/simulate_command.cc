@@ -46,7 +46,7 @@ DEFINE_bool(overwrite, false,
 namespace rcm::cli {
 namespace {
 
-constexpr char kUsage[] =
+constexpr char kSimulateUsage[] =
     "rcm simulate: a synthetic underwater stereo sequence with ground "
     "truth.\n\n"
     "usage: rcm simulate --out DIR [--n 1.333 | --media water:30,air:30]\n"
@@ -87,7 +87,7 @@ int RunSimulate();
 extern const Subcommand kSimulateCommand = {
     "simulate",
     "synthetic stereo sequence through exact flat ports, with ground truth",
-    kUsage,
+    kSimulateUsage,
     {__FILE__, kSimulationFlagsSource, kIndexFlagSource, kRigFlagsSource,
      kTargetFlagsSource},
     RunSimulate};

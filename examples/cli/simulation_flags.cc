@@ -57,7 +57,7 @@ extern const char kSimulationFlagsSource[] = __FILE__;
 
 namespace {
 
-constexpr double kDegree = M_PI / 180.0;
+constexpr double kRadiansPerDegree = M_PI / 180.0;
 
 }  // namespace
 
@@ -72,7 +72,7 @@ Status ExtrinsicDriftFromFlag(SequenceOptions* options) {
                          "millimetres), e.g. 0.5,0,0");
   }
   const std::vector<double>& v = values.value();
-  options->cam1_drift.rotation = Eigen::Vector3d(v[0], v[1], v[2]) * kDegree;
+  options->cam1_drift.rotation = Eigen::Vector3d(v[0], v[1], v[2]) * kRadiansPerDegree;
   if (v.size() == 6) {
     options->cam1_drift.translation = Eigen::Vector3d(v[3], v[4], v[5]) * 1e-3;
   }

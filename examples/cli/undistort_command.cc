@@ -59,7 +59,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr char kUsage[] =
+constexpr char kUndistortUsage[] =
     "rcm undistort: refraction and lens corrected images of an underwater\n"
     "stereo rig calibrated in air, on ideal pinhole cameras in the water.\n\n"
     "usage: rcm undistort --calib RIG.yaml --n N --left DIR --right DIR "
@@ -427,7 +427,7 @@ extern const Subcommand kUndistortCommand = {
     "undistort",
     "refraction and lens corrected images (virtual pinholes) and their "
     "camchain",
-    kUsage,
+    kUndistortUsage,
     {__FILE__, kRigFlagsSource, kIndexFlagSource, kImageInputFlagsSource,
      kReferenceDepthFlagSource},
     RunUndistort};
