@@ -129,6 +129,24 @@ std::string Count(int64_t count, const char* singular, const char* plural) {
 
 }  // namespace
 
+RotationCorrection RotationCorrectionOf(
+    const CalibrationPropagation& propagation,
+    const Eigen::Vector3d& angle_axis, bool with_prior,
+    const Rigid3d& cam1_from_cam0) {
+  RotationCorrection correction;
+  correction.angle_axis = angle_axis;
+  for (int k = 0; k < 3; ++k) {
+    correction.sigma[k] =
+        std::sqrt(std::max(0.0, propagation.rotation_covariance(k, k)));
+  }
+  correction.correlation_with_n = propagation.rotation_correlation_with_n;
+  correction.multiple_correlation_with_n =
+      propagation.rotation_multiple_correlation;
+  correction.with_prior = with_prior;
+  correction.cam1_from_cam0 = cam1_from_cam0;
+  return correction;
+}
+
 StatusOr<RefinementSummary> RefineRefractiveIndex(
     const StereoRig& rig,
     const std::vector<StereoCorrespondence>& correspondences,
@@ -278,38 +296,32 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
     return std::sqrt(sum / static_cast<double>(dof));
   };
   const bool with_prior = mode == RotationMode::kPrior || options.n_prior;
-  double prior_sigma_px = with_prior ? data_sigma_px(parameters) : 0.0;
-  constexpr int kMaxPriorSolves = 3;
-  constexpr double kPriorSigmaTolerance = 0.02;  // relative
-  for (int solve = 0;; ++solve) {
-    ceres::Problem problem;
-    ceres::CostFunction* prior =
-        mode == RotationMode::kPrior
-            ? NewRotationPrior(uncertainty.RotationCovariance(),
-                               std::max(prior_sigma_px, 1e-6))
-            : nullptr;
-    const ceres::Solver::Summary stage2 = Solve(
-        essential, matches, inliers, RobustLoss::kNone, options, with_rotation,
-        prior,
-        options.n_prior
-            ? NewIndexPrior(*options.n_prior, std::max(prior_sigma_px, 1e-6))
-            : nullptr,
-        &parameters, &problem);
-    if (!stage2.IsSolutionUsable()) {
-      return Status::Error("the least-squares refinement failed: " +
-                           stage2.message);
-    }
-    summary.num_iterations += static_cast<int>(stage2.iterations.size());
-    summary.sigma_px = data_sigma_px(parameters);
-    summary.cost =
-        0.5 * summary.sigma_px * summary.sigma_px * static_cast<double>(dof);
-    if (!with_prior || solve + 1 >= kMaxPriorSolves ||
-        std::abs(summary.sigma_px - prior_sigma_px) <=
-            kPriorSigmaTolerance * summary.sigma_px) {
-      break;
-    }
-    prior_sigma_px = summary.sigma_px;
-  }
+  RCM_RETURN_IF_ERROR(SolveUntilThePriorWeightSettles(
+      with_prior,
+      [&](double prior_sigma_px) {
+        ceres::Problem problem;
+        ceres::CostFunction* prior =
+            mode == RotationMode::kPrior
+                ? NewRotationPrior(uncertainty.RotationCovariance(),
+                                   std::max(prior_sigma_px, 1e-6))
+                : nullptr;
+        const ceres::Solver::Summary stage2 = Solve(
+            essential, matches, inliers, RobustLoss::kNone, options,
+            with_rotation, prior,
+            options.n_prior ? NewIndexPrior(*options.n_prior,
+                                            std::max(prior_sigma_px, 1e-6))
+                            : nullptr,
+            &parameters, &problem);
+        if (!stage2.IsSolutionUsable()) {
+          return Status::Error("the least-squares refinement failed: " +
+                               stage2.message);
+        }
+        summary.num_iterations += static_cast<int>(stage2.iterations.size());
+        return Status::Ok();
+      },
+      [&] { return data_sigma_px(parameters); }, &summary.sigma_px));
+  summary.cost =
+      0.5 * summary.sigma_px * summary.sigma_px * static_cast<double>(dof);
   summary.n = parameters.n;
 
   // Uncertainty (calibration_propagation.h): the normal equations at the
@@ -349,18 +361,8 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
                              final_essential, inlier_matches, parameters.n));
 
   if (with_rotation) {
-    RotationCorrection correction;
-    correction.angle_axis = rotation;
-    for (int k = 0; k < 3; ++k) {
-      correction.sigma[k] =
-          std::sqrt(std::max(0.0, propagation->rotation_covariance(k, k)));
-    }
-    correction.correlation_with_n = propagation->rotation_correlation_with_n;
-    correction.multiple_correlation_with_n =
-        propagation->rotation_multiple_correlation;
-    correction.with_prior = mode == RotationMode::kPrior;
-    correction.cam1_from_cam0 = final_extrinsics;
-    summary.rotation = correction;
+    summary.rotation = RotationCorrectionOf(
+        *propagation, rotation, mode == RotationMode::kPrior, final_extrinsics);
   }
   if (rig.calibration_uncertainty() || layout.NumSystematic() > 0 ||
       options.n_prior) {

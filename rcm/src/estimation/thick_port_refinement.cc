@@ -216,28 +216,22 @@ StatusOr<ThickPortRefinementSummary> RefineRefractiveIndexThickPort(
     }
     return std::sqrt(sum / static_cast<double>(dof));
   };
-  double prior_sigma_px = with_rotation ? data_sigma_px(parameters) : 0.0;
-  constexpr int kMaxPriorSolves = 3;
-  constexpr double kPriorSigmaTolerance = 0.02;  // relative
   std::unique_ptr<ceres::Problem> problem;
-  for (int solve = 0;; ++solve) {
-    problem = std::make_unique<ceres::Problem>();
-    const ceres::Solver::Summary stage2 =
-        Solve(stereo, matches, inliers, RobustLoss::kNone, options,
-              rotation_prior(prior_sigma_px), &parameters, problem.get());
-    if (!stage2.IsSolutionUsable()) {
-      return Status::Error("the least-squares refinement failed: " +
-                           stage2.message);
-    }
-    summary.num_iterations += static_cast<int>(stage2.iterations.size());
-    summary.sigma_px = data_sigma_px(parameters);
-    if (!with_rotation || solve + 1 >= kMaxPriorSolves ||
-        std::abs(summary.sigma_px - prior_sigma_px) <=
-            kPriorSigmaTolerance * summary.sigma_px) {
-      break;
-    }
-    prior_sigma_px = summary.sigma_px;
-  }
+  RCM_RETURN_IF_ERROR(SolveUntilThePriorWeightSettles(
+      with_rotation,
+      [&](double prior_sigma_px) {
+        problem = std::make_unique<ceres::Problem>();
+        const ceres::Solver::Summary stage2 =
+            Solve(stereo, matches, inliers, RobustLoss::kNone, options,
+                  rotation_prior(prior_sigma_px), &parameters, problem.get());
+        if (!stage2.IsSolutionUsable()) {
+          return Status::Error("the least-squares refinement failed: " +
+                               stage2.message);
+        }
+        summary.num_iterations += static_cast<int>(stage2.iterations.size());
+        return Status::Ok();
+      },
+      [&] { return data_sigma_px(parameters); }, &summary.sigma_px));
   summary.n = parameters.n;
   summary.cost =
       0.5 * summary.sigma_px * summary.sigma_px * static_cast<double>(dof);
@@ -345,20 +339,10 @@ StatusOr<ThickPortRefinementSummary> RefineRefractiveIndexThickPort(
     summary.sigma_n_noise = propagation->sigma_n_noise;
     summary.sigma_n_calibration = propagation->sigma_n_calibration;
     summary.sigma_n_systematic = propagation->sigma_n_systematic;
-    RotationCorrection correction;
-    correction.angle_axis = rotation;
-    for (int k = 0; k < 3; ++k) {
-      correction.sigma[k] =
-          std::sqrt(std::max(0.0, propagation->rotation_covariance(k, k)));
-    }
-    correction.correlation_with_n = propagation->rotation_correlation_with_n;
-    correction.multiple_correlation_with_n =
-        propagation->rotation_multiple_correlation;
-    correction.with_prior = true;
     const StatusOr<StereoRig> turned = rig.WithCam1Moved(rotation);
     if (!turned.ok()) return turned.status();
-    correction.cam1_from_cam0 = turned->right_from_left();
-    summary.rotation = correction;
+    summary.rotation = RotationCorrectionOf(*propagation, rotation, true,
+                                            turned->right_from_left());
     summary.calibration = *propagation;
   } else {
     summary.sigma_n_noise *= inflation;

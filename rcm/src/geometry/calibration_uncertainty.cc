@@ -80,6 +80,7 @@ void CalibrationUncertainty::AddFocalDrift(
   };
   add(left_params, &left_lens_covariance);
   add(right_params, &right_lens_covariance);
+  source += (source.empty() ? "" : ", ") + DescribeFocalDrift(focal_sigma);
 }
 
 void CalibrationUncertainty::AddDrift(double rotation_sigma,

@@ -388,8 +388,6 @@ StatusOr<CalibrationUncertainty> PairCalibrationUncertainty(
       }
     }
     uncertainty.AddFocalDrift(focal, left_params, right_params);
-    uncertainty.source +=
-        ", " + CalibrationUncertainty::DescribeFocalDrift(focal);
   }
   return uncertainty;
 }

@@ -127,14 +127,10 @@ StatusOr<StereoRig> WithDefaultCalibrationUncertainty(
           ? CalibrationUncertainty::DriftPrior(options.drift_prior->first,
                                                options.drift_prior->second)
           : CalibrationUncertainty::DefaultDriftPrior();
-  const double focal = options.focal_drift.value_or(
-      1e-2 * CalibrationUncertainty::kDefaultFocalDriftPercent);
-  if (focal > 0.0) {
-    uncertainty.AddFocalDrift(focal, ParamsOf(rig.left()),
-                              ParamsOf(rig.right()));
-    uncertainty.source +=
-        ", " + CalibrationUncertainty::DescribeFocalDrift(focal);
-  }
+  uncertainty.AddFocalDrift(
+      options.focal_drift.value_or(
+          1e-2 * CalibrationUncertainty::kDefaultFocalDriftPercent),
+      ParamsOf(rig.left()), ParamsOf(rig.right()));
   return rig.WithCalibrationUncertainty(std::move(uncertainty));
 }
 

@@ -66,6 +66,14 @@ struct RotationCorrection {
   Rigid3d cam1_from_cam0;
 };
 
+// The report of a rotation correction `angle_axis` estimated with n: its
+// sigmas and correlations from the propagation at the solution (the thin
+// and the thick port's refinements), and the corrected extrinsics.
+RotationCorrection RotationCorrectionOf(
+    const CalibrationPropagation& propagation,
+    const Eigen::Vector3d& angle_axis, bool with_prior,
+    const Rigid3d& cam1_from_cam0);
+
 struct RefinementSummary {
   double n = 0.0;
   // Standard deviation of n, the total: pixel noise (sigma_n_noise, after

@@ -20,6 +20,7 @@
 #include <ceres/solver.h>
 
 #include <Eigen/Core>
+#include <cmath>
 #include <optional>
 #include <string_view>
 
@@ -134,6 +135,32 @@ ceres::LossFunction* NewLossFunction(RobustLoss loss, double scale_px);
 // residuals' sum of squares. Owned by the problem it is given to.
 ceres::CostFunction* NewRotationPrior(const Eigen::Matrix3d& covariance,
                                       double sigma_px);
+
+// Stage 2 of both refinements with priors in pixels of residual
+// (NewRotationPrior, the prior on n): a prior's weight needs the data's
+// pixel noise, so `solve(prior_sigma_px)` (a Status; it solves with the
+// priors weighted by prior_sigma_px) runs first at the data's sigma at the
+// start, `data_sigma_px()`, then again at the solution's, until the two
+// agree within 2 % (at most 3 solves; two or three in practice). Without
+// a prior, one solve (prior_sigma_px 0). `*sigma_px` is the data's sigma
+// at the last solution.
+template <typename Solve, typename DataSigma>
+Status SolveUntilThePriorWeightSettles(bool with_prior, const Solve& solve,
+                                       const DataSigma& data_sigma_px,
+                                       double* sigma_px) {
+  constexpr int kMaxSolves = 3;
+  constexpr double kTolerance = 0.02;  // relative
+  double prior_sigma_px = with_prior ? data_sigma_px() : 0.0;
+  for (int solves = 1;; ++solves) {
+    RCM_RETURN_IF_ERROR(solve(prior_sigma_px));
+    *sigma_px = data_sigma_px();
+    if (!with_prior || solves >= kMaxSolves ||
+        std::abs(*sigma_px - prior_sigma_px) <= kTolerance * *sigma_px) {
+      return Status::Ok();
+    }
+    prior_sigma_px = *sigma_px;
+  }
+}
 
 }  // namespace rcm
 

@@ -106,8 +106,9 @@ struct CalibrationUncertainty {
   // Adds the focal drift prior above, s_f = focal_sigma (relative, >= 0),
   // to each lens covariance; `left_params` and `right_params` are the
   // cameras' Camera::params() ([fx, fy, ...]). An empty lens covariance
-  // becomes s_f^2 g g^T (the cross blocks, when empty, stay uncorrelated).
-  // Does nothing when focal_sigma is 0.
+  // becomes s_f^2 g g^T (the cross blocks, when empty, stay uncorrelated),
+  // and `source` ends with DescribeFocalDrift. Does nothing when
+  // focal_sigma is 0.
   void AddFocalDrift(double focal_sigma, const Eigen::VectorXd& left_params,
                      const Eigen::VectorXd& right_params);
 
