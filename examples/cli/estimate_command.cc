@@ -106,6 +106,11 @@ DEFINE_bool(self_calibrate, true,
             "as its prior (the data decide it where they separate it from "
             "n); --noself-calibrate holds it at the calibration's and only "
             "propagates its uncertainty");
+DEFINE_bool(self_calibrate_focal, true,
+            "refine: estimate each camera's focal scale with n, with the "
+            "focal drift prior (--drift-prior's PCT) as its prior; "
+            "--noself-calibrate-focal holds the lenses at the calibration's "
+            "and only propagates the prior");
 DEFINE_double(systematic_px, -1.0,
               "the matches' systematic error floor, pixels: the standard "
               "deviation of each coefficient of a smooth low-order field "
@@ -352,6 +357,7 @@ RefinementOptions RefinementOptionsFromFlags() {
   options.inlier_threshold_px = FLAGS_inlier_threshold;
   options.refine_rotation = FLAGS_refine_rotation;
   options.self_calibrate_rotation = FLAGS_self_calibrate;
+  options.self_calibrate_focal = FLAGS_self_calibrate_focal;
   options.systematic_px =
       FLAGS_systematic_px >= 0.0
           ? FLAGS_systematic_px
@@ -497,6 +503,20 @@ StatusOr<Report> RunRefine(const StereoRig& rig,
          << "; correlation with n R = "
          << FormatFixed(rotation.multiple_correlation_with_n, 2);
     report.text_lines.push_back(line.str());
+  }
+  if (summary->focal) {
+    const FocalScaleCorrection& focal = *summary->focal;
+    report.extra["focal_scale"] = {
+        {"percent", {1e2 * focal.scale[0], 1e2 * focal.scale[1]}},
+        {"sigma_percent", {1e2 * focal.sigma[0], 1e2 * focal.sigma[1]}},
+        {"correlation_with_n",
+         {focal.correlation_with_n[0], focal.correlation_with_n[1]}}};
+    report.text_lines.push_back(
+        "  lenses     focal lengths self-calibrated: cam0 " +
+        FormatFixed(1e2 * focal.scale[0], 3) + " +- " +
+        FormatFixed(1e2 * focal.sigma[0], 3) + " %, cam1 " +
+        FormatFixed(1e2 * focal.scale[1], 3) + " +- " +
+        FormatFixed(1e2 * focal.sigma[1], 3) + " % since the calibration");
   }
   if (own_rows != nullptr) {
     report.rows = *own_rows;  // computed by the front end's pass

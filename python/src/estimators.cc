@@ -16,8 +16,8 @@
 #include "options.h"
 #include "rcm/estimation/batch_refinement.h"
 #include "rcm/estimation/closed_form.h"
-#include "rcm/estimation/online_estimator.h"
 #include "rcm/estimation/medium_prior.h"
+#include "rcm/estimation/online_estimator.h"
 #include "rcm/estimation/paper_online_estimator.h"
 #include "rcm/estimation/refinement_options.h"
 #include "rcm/estimation/sliding_window_estimator.h"
@@ -66,8 +66,8 @@ std::vector<OptionField> RefinementFields(RefinementOptions* o) {
                 "(n, sigma)");
           }
           try {
-            o->n_prior = IndexPrior{pair[0].cast<double>(),
-                                    pair[1].cast<double>()};
+            o->n_prior =
+                IndexPrior{pair[0].cast<double>(), pair[1].cast<double>()};
           } catch (const py::cast_error&) {
             ThrowTypeError("n_prior's pair must be two numbers (n, sigma)");
           }
@@ -86,6 +86,7 @@ std::vector<OptionField> RefinementFields(RefinementOptions* o) {
           DoubleOption("max_crlb_per_px", &o->max_crlb_per_px),
           BoolOption("refine_rotation", &o->refine_rotation),
           BoolOption("self_calibrate_rotation", &o->self_calibrate_rotation),
+          BoolOption("self_calibrate_focal", &o->self_calibrate_focal),
           DoubleOption("systematic_px", &o->systematic_px),
           IntOption("max_num_iterations", &o->max_num_iterations),
           IntOption("num_threads", &o->num_threads)};
@@ -136,6 +137,16 @@ py::object CalibrationDict(const std::optional<CalibrationPropagation>& c) {
   d["rotation_covariance"] = ToNumpy(c->rotation_covariance);
   d["rotation_correlation_with_n"] = ToNumpy(c->rotation_correlation_with_n);
   return std::move(d);
+}
+
+// FocalScaleCorrection as a dict (relative scales), or None.
+py::object FocalDict(const std::optional<FocalScaleCorrection>& f) {
+  if (!f) return py::none();
+  py::dict d;
+  d["scale"] = ToNumpy(Eigen::VectorXd(f->scale));
+  d["sigma"] = ToNumpy(Eigen::VectorXd(f->sigma));
+  d["correlation_with_n"] = ToNumpy(Eigen::VectorXd(f->correlation_with_n));
+  return d;
 }
 
 py::object RotationDict(const std::optional<RotationCorrection>& r) {
@@ -363,7 +374,10 @@ inliers (bool array, one per input match); inlier_indices (int64);
 n_closed_form (None when undefined), n_seed, n_robust; robust_cost, cost
 (Ceres' 1/2 sum of squares); num_correspondences, num_invalid (pixels that
 could not be undistorted), num_iterations (solver iterations, both stages);
-rotation, calibration, consistency (dicts or None).
+rotation, calibration, consistency (dicts or None); focal (dict of each
+camera's focal scale since the calibration, relative: scale, sigma,
+correlation_with_n, with a focal drift prior and self_calibrate_focal; or
+None).
 )doc")
       .def_readonly("n", &RefinementSummary::n)
       .def_readonly("sigma_n", &RefinementSummary::sigma_n)
@@ -400,6 +414,9 @@ rotation, calibration, consistency (dicts or None).
       .def_property_readonly(
           "rotation",
           [](const RefinementSummary& s) { return RotationDict(s.rotation); })
+      .def_property_readonly(
+          "focal",
+          [](const RefinementSummary& s) { return FocalDict(s.focal); })
       .def_property_readonly("calibration",
                              [](const RefinementSummary& s) {
                                return CalibrationDict(s.calibration);
@@ -424,7 +441,8 @@ Keyword options (RefinementOptions, same names and defaults):
   loss='cauchy' ('none', 'huber', 'cauchy'), loss_scale_px=1.0 (pixels),
   inlier_threshold_px=2.0 (pixels, inf keeps all), num_scan_points=51,
   min_inliers=10, max_crlb_per_px=0.1, refine_rotation=False,
-  self_calibrate_rotation=True, systematic_px=0.0 (pixels),
+  self_calibrate_rotation=True, self_calibrate_focal=True,
+  systematic_px=0.0 (pixels),
   n_prior=None (a prior on n: 'fresh', 'sea', 'N:SIGMA' or (n, sigma); with
   refine_rotation=True it gives cam1's turn on a narrow rig),
   max_num_iterations=100, num_threads=2.

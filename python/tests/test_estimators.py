@@ -190,7 +190,7 @@ def test_option_keywords():
         "loss": "cauchy", "loss_scale_px": 1.0, "inlier_threshold_px": 2.0,
         "num_scan_points": 51, "min_inliers": 10, "max_crlb_per_px": 0.1,
         "refine_rotation": False, "self_calibrate_rotation": True,
-        "systematic_px": 0.0, "max_num_iterations": 100, "num_threads": 2,
+        "self_calibrate_focal": True, "systematic_px": 0.0, "max_num_iterations": 100, "num_threads": 2,
         "n_prior": None}
 
 
@@ -208,6 +208,23 @@ def test_n_prior_of_the_medium(realistic_rig):
         assert result.calibration["variance_medium"] >= 0.0
     sea = rcm.refine_refractive_index(realistic_rig, matches, n_prior="sea")
     assert abs(sea.n - 1.3415) < 1e-6
+
+
+def test_focal_scales_self_calibrated(realistic_rig):
+    # Exact matches of the calibrated lenses on a rig with a focal drift
+    # prior (0.3 %): both focal scales come back zero (EXACT) with a sigma
+    # below the prior's, and are not estimated when switched off.
+    rig = realistic_rig.with_drift_prior(1e-3, 1e-4, focal_sigma=0.003)
+    matches = sample(realistic_rig, 1.333, frames=2, per_frame=200)
+    result = rcm.refine_refractive_index(rig, matches)
+    assert abs(result.n - 1.333) < EXACT
+    assert result.focal["scale"].shape == (2,)
+    assert np.abs(result.focal["scale"]).max() < EXACT
+    assert (result.focal["sigma"] > 0.0).all()
+    assert (result.focal["sigma"] <= 0.003).all()
+    held = rcm.refine_refractive_index(rig, matches,
+                                       self_calibrate_focal=False)
+    assert held.focal is None
 
 
 def test_options_change_the_estimate(realistic_rig):

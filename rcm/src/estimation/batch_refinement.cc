@@ -54,11 +54,63 @@ std::optional<double> ClosedFormSeed(
   return 0.5 * (lower + upper);
 }
 
-// The unknowns: n, and the rotation correction when it is refined.
+// The unknowns: n, the rotation correction when it is refined, and the
+// focal scales' step from the scales the matches were prepared with
+// (FocalScales).
 struct Parameters {
   double n = 1.0;
   double rotation[3] = {0.0, 0.0, 0.0};
+  double focal[2] = {0.0, 0.0};
 };
+
+// With the focal scales estimated: the scales e0 the matches are prepared
+// with (the rig's lenses scaled by 1 + e0) and the focal drift prior s_f.
+// A step d on top of them is the scale e = (1 + e0)(1 + d) - 1 =
+// e0 + (1 + e0) d, whose prior N(0, s_f^2) is, in pixels of residual,
+//
+//   sigma_px (1 + e0) / s_f (d - (-e0 / (1 + e0))).
+struct FocalScales {
+  Eigen::Vector2d prepared_with = Eigen::Vector2d::Zero();
+  double prior_sigma = 0.0;
+
+  Eigen::Vector2d Total(const double* step) const {
+    return prepared_with + (Eigen::Vector2d::Ones() + prepared_with)
+                               .cwiseProduct(Eigen::Vector2d(step[0], step[1]));
+  }
+  ceres::CostFunction* NewPrior(double sigma_px) const {
+    ceres::Matrix root_information = ceres::Matrix::Zero(2, 2);
+    ceres::Vector mean(2);
+    for (int c = 0; c < 2; ++c) {
+      root_information(c, c) =
+          sigma_px * (1.0 + prepared_with[c]) / prior_sigma;
+      mean[c] = -prepared_with[c] / (1.0 + prepared_with[c]);
+    }
+    return new ceres::NormalPrior(root_information, mean);
+  }
+};
+
+// `matches` (prepared for `rig`, from correspondences[source_index[i]])
+// prepared again with the rig's lenses scaled by `scale`; a match that no
+// longer prepares keeps its old preparation (a change of a few tenths of a
+// percent moves no pixel off the lens's domain in practice).
+void PrepareWithFocalScale(
+    const StereoRig& rig, const Eigen::Vector2d& scale,
+    const std::vector<StereoCorrespondence>& correspondences,
+    const std::vector<int64_t>& source_index,
+    std::vector<PreparedCorrespondence>* matches) {
+  const StatusOr<StereoRig> scaled = rig.WithFocalScaled(scale[0], scale[1]);
+  if (!scaled.ok()) return;
+  for (size_t i = 0; i < matches->size(); ++i) {
+    const StereoCorrespondence& correspondence =
+        correspondences[source_index[i]];
+    std::optional<PreparedCorrespondence> prepared =
+        PrepareCorrespondence(*scaled, correspondence);
+    if (prepared &&
+        PrepareFocalDerivatives(*scaled, correspondence, &*prepared)) {
+      (*matches)[i] = *prepared;
+    }
+  }
+}
 
 // The prior on n (RefinementOptions::n_prior) in pixels of residual:
 // sigma_px (n - mean) / sigma, as NewRotationPrior's.
@@ -72,14 +124,17 @@ ceres::CostFunction* NewIndexPrior(const IndexPrior& prior, double sigma_px) {
 
 // One Ceres problem over `indices` of `matches`, with the rotation
 // correction when `with_rotation` and its prior when `prior` is not null
-// (NewRotationPrior), and the prior on n when `n_prior` is not null
-// (NewIndexPrior); returns the summary.
+// (NewRotationPrior), the prior on n when `n_prior` is not null
+// (NewIndexPrior), and the focal scales' step with its prior when
+// `focal_prior` is not null (FocalScales::NewPrior; the rotation then held
+// at zero unless `with_rotation`); returns the summary.
 ceres::Solver::Summary Solve(const Eigen::Matrix3d& essential,
                              const std::vector<PreparedCorrespondence>& matches,
                              const std::vector<int64_t>& indices,
                              RobustLoss loss, const RefinementOptions& options,
                              bool with_rotation, ceres::CostFunction* prior,
                              ceres::CostFunction* n_prior,
+                             ceres::CostFunction* focal_prior,
                              Parameters* parameters, ceres::Problem* problem) {
   ceres::LossFunction* loss_function =
       NewLossFunction(loss, options.loss_scale_px);
@@ -89,8 +144,17 @@ ceres::Solver::Summary Solve(const Eigen::Matrix3d& essential,
   if (n_prior != nullptr) {
     problem->AddResidualBlock(n_prior, nullptr, &parameters->n);
   }
+  if (focal_prior != nullptr) {
+    problem->AddResidualBlock(focal_prior, nullptr, parameters->focal);
+  }
   for (const int64_t i : indices) {
-    if (with_rotation) {
+    if (focal_prior != nullptr) {
+      problem->AddResidualBlock(
+          SampsonCoplanarityError::CreateWithRotationAndFocal(essential,
+                                                              matches[i]),
+          loss_function, &parameters->n, parameters->rotation,
+          parameters->focal);
+    } else if (with_rotation) {
       problem->AddResidualBlock(
           SampsonCoplanarityError::CreateWithRotation(essential, matches[i]),
           loss_function, &parameters->n, parameters->rotation);
@@ -99,6 +163,9 @@ ceres::Solver::Summary Solve(const Eigen::Matrix3d& essential,
           SampsonCoplanarityError::Create(essential, matches[i]), loss_function,
           &parameters->n);
     }
+  }
+  if (focal_prior != nullptr && !with_rotation) {
+    problem->SetParameterBlockConstant(parameters->rotation);
   }
   problem->SetParameterLowerBound(&parameters->n, 0, 1.0);
   problem->SetParameterUpperBound(&parameters->n, 0, 2.0);
@@ -171,7 +238,9 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
   summary.num_correspondences = static_cast<int64_t>(correspondences.size());
   const PreparedCorrespondences prepared =
       PrepareCorrespondences(rig, correspondences);
-  const std::vector<PreparedCorrespondence>& matches = prepared.prepared;
+  // Prepared with the calibration's lenses; with the focal scales
+  // estimated, prepared again with each estimate of them.
+  std::vector<PreparedCorrespondence> matches = prepared.prepared;
   summary.num_invalid =
       summary.num_correspondences - static_cast<int64_t>(matches.size());
   if (static_cast<int>(matches.size()) < options.min_inliers) {
@@ -197,6 +266,27 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
           ? RotationMode::kPrior
           : RotationMode::kHeld;
   const bool with_rotation = mode != RotationMode::kHeld;
+  // The focal scales, estimated under the focal drift prior.
+  const CalibrationParameterLayout layout = CalibrationParameterLayout::Of(
+      rig, options.systematic_px, options.self_calibrate_focal);
+  const bool with_focal = layout.focal;
+  FocalScales focal;
+  focal.prior_sigma = uncertainty.focal_drift_sigma;
+  const auto new_focal_prior = [&](double sigma_px) {
+    return with_focal ? focal.NewPrior(sigma_px) : nullptr;
+  };
+  // Takes the solved focal step into the preparation of the matches.
+  const auto prepare_with_focal_step = [&](Parameters* at) {
+    focal.prepared_with = focal.Total(at->focal);
+    at->focal[0] = at->focal[1] = 0.0;
+    PrepareWithFocalScale(rig, focal.prepared_with, correspondences,
+                          prepared.source_index, &matches);
+  };
+  if (with_focal) {
+    // (The inverse lens Jacobians' derivatives in e, for any lens.)
+    PrepareWithFocalScale(rig, Eigen::Vector2d::Zero(), correspondences,
+                          prepared.source_index, &matches);
+  }
 
   // Seed and stage 1 (robust, all usable matches).
   summary.n_closed_form = ClosedFormSeed(matches);
@@ -205,7 +295,7 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
     candidate = std::clamp(*summary.n_closed_form, 1.0, 2.0);
   }
   Parameters parameters;
-  if (!with_rotation) {
+  if (!with_rotation && !with_focal) {
     // n alone: a 1-D search is exact and several times faster than a
     // Ceres solve of the robust cost, whose Gauss-Newton model converges
     // only linearly on it.
@@ -222,22 +312,22 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
     ceres::Problem problem;
     // The prior's weight needs the pixel noise, unknown before stage 2:
     // half the loss scale, which the options call about twice the noise.
+    const double prior_sigma_px = 0.5 * options.loss_scale_px;
     ceres::CostFunction* prior =
         mode == RotationMode::kPrior
-            ? NewRotationPrior(uncertainty.RotationCovariance(),
-                               0.5 * options.loss_scale_px)
+            ? NewRotationPrior(uncertainty.RotationCovariance(), prior_sigma_px)
             : nullptr;
     const ceres::Solver::Summary stage1 = Solve(
         essential, matches, all, options.loss, options, with_rotation, prior,
-        options.n_prior
-            ? NewIndexPrior(*options.n_prior, 0.5 * options.loss_scale_px)
-            : nullptr,
-        &parameters, &problem);
+        options.n_prior ? NewIndexPrior(*options.n_prior, prior_sigma_px)
+                        : nullptr,
+        new_focal_prior(prior_sigma_px), &parameters, &problem);
     if (!stage1.IsSolutionUsable()) {
       return Status::Error("the robust refinement failed: " + stage1.message);
     }
     summary.robust_cost = stage1.final_cost;
     summary.num_iterations += static_cast<int>(stage1.iterations.size());
+    if (with_focal) prepare_with_focal_step(&parameters);
   }
   summary.n_robust = parameters.n;
 
@@ -260,11 +350,14 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
             << options.min_inliers << " needed";
     return Status::Error(message.str());
   }
-  std::vector<PreparedCorrespondence> inlier_matches;
-  inlier_matches.reserve(inliers.size());
-  for (const int64_t i : inliers) inlier_matches.push_back(matches[i]);
+  const auto inlier_matches = [&] {
+    std::vector<PreparedCorrespondence> subset;
+    subset.reserve(inliers.size());
+    for (const int64_t i : inliers) subset.push_back(matches[i]);
+    return subset;
+  };
   const double information_per_px =
-      LocusInformation(robust_essential, inlier_matches, parameters.n);
+      LocusInformation(robust_essential, inlier_matches(), parameters.n);
   if (!(information_per_px > 0.0) ||
       1.0 / std::sqrt(information_per_px) > options.max_crlb_per_px) {
     std::ostringstream message;
@@ -280,46 +373,64 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
 
   // Stage 2: least squares on the inliers. With the prior, its weight
   // sigma_px^2 comes from the inliers' residuals, refined until it settles
-  // (two or three solves).
-  const int num_parameters = with_rotation ? 4 : 1;
+  // (two or three solves). With the focal scales, the matches are prepared
+  // again at each solution's scales and stage 2 repeated until the step
+  // vanishes (the first-order model of sampson_coplanarity_error.h is then
+  // exact at the solution; two or three passes).
+  const int num_parameters = 1 + (with_rotation ? 3 : 0) + (with_focal ? 2 : 0);
   const int64_t dof = static_cast<int64_t>(inliers.size()) - num_parameters;
   const auto data_sigma_px = [&](const Parameters& at) {
     const Rigid3d extrinsics =
         with_rotation ? CorrectedExtrinsics(rig.right_from_left(), at.rotation)
                       : rig.right_from_left();
-    const std::vector<double> residuals =
-        LocusResiduals(EssentialMatrix(extrinsics), inlier_matches, at.n);
+    const Eigen::Matrix3d corrected = EssentialMatrix(extrinsics);
     double sum = 0.0;
-    for (const double r : residuals) {
-      if (std::isfinite(r)) sum += r * r;
+    for (const int64_t i : inliers) {
+      double r = 0.0;
+      if (SampsonCoplanarityResidual<double>(
+              corrected, matches[i], at.n, nullptr,
+              with_focal ? at.focal : nullptr, &r) &&
+          std::isfinite(r)) {
+        sum += r * r;
+      }
     }
     return std::sqrt(sum / static_cast<double>(dof));
   };
-  const bool with_prior = mode == RotationMode::kPrior || options.n_prior;
-  RCM_RETURN_IF_ERROR(SolveUntilThePriorWeightSettles(
-      with_prior,
-      [&](double prior_sigma_px) {
-        ceres::Problem problem;
-        ceres::CostFunction* prior =
-            mode == RotationMode::kPrior
-                ? NewRotationPrior(uncertainty.RotationCovariance(),
-                                   std::max(prior_sigma_px, 1e-6))
-                : nullptr;
-        const ceres::Solver::Summary stage2 = Solve(
-            essential, matches, inliers, RobustLoss::kNone, options,
-            with_rotation, prior,
-            options.n_prior ? NewIndexPrior(*options.n_prior,
-                                            std::max(prior_sigma_px, 1e-6))
-                            : nullptr,
-            &parameters, &problem);
-        if (!stage2.IsSolutionUsable()) {
-          return Status::Error("the least-squares refinement failed: " +
-                               stage2.message);
-        }
-        summary.num_iterations += static_cast<int>(stage2.iterations.size());
-        return Status::Ok();
-      },
-      [&] { return data_sigma_px(parameters); }, &summary.sigma_px));
+  const bool with_prior =
+      mode == RotationMode::kPrior || options.n_prior || with_focal;
+  constexpr int kMaxFocalPasses = 4;
+  constexpr double kFocalStepTolerance = 1e-13;  // relative focal length
+  for (int pass = 0; pass < (with_focal ? kMaxFocalPasses : 1); ++pass) {
+    RCM_RETURN_IF_ERROR(SolveUntilThePriorWeightSettles(
+        with_prior,
+        [&](double prior_sigma_px) {
+          ceres::Problem problem;
+          const double weight_px = std::max(prior_sigma_px, 1e-6);
+          ceres::CostFunction* prior =
+              mode == RotationMode::kPrior
+                  ? NewRotationPrior(uncertainty.RotationCovariance(),
+                                     weight_px)
+                  : nullptr;
+          const ceres::Solver::Summary stage2 =
+              Solve(essential, matches, inliers, RobustLoss::kNone, options,
+                    with_rotation, prior,
+                    options.n_prior ? NewIndexPrior(*options.n_prior, weight_px)
+                                    : nullptr,
+                    new_focal_prior(weight_px), &parameters, &problem);
+          if (!stage2.IsSolutionUsable()) {
+            return Status::Error("the least-squares refinement failed: " +
+                                 stage2.message);
+          }
+          summary.num_iterations += static_cast<int>(stage2.iterations.size());
+          return Status::Ok();
+        },
+        [&] { return data_sigma_px(parameters); }, &summary.sigma_px));
+    if (!with_focal) break;
+    const double step =
+        std::max(std::abs(parameters.focal[0]), std::abs(parameters.focal[1]));
+    prepare_with_focal_step(&parameters);
+    if (step <= kFocalStepTolerance) break;
+  }
   summary.cost =
       0.5 * summary.sigma_px * summary.sigma_px * static_cast<double>(dof);
   summary.n = parameters.n;
@@ -338,13 +449,20 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
   raw.reserve(matches.size());
   for (const int64_t i : prepared.source_index)
     raw.push_back(correspondences[i]);
-  const CalibrationParameterLayout layout =
-      CalibrationParameterLayout::Of(rig, options.systematic_px);
+  // With the focal scales, the rows are taken on the rig with the
+  // estimated lenses (what `matches` are now prepared with).
+  StereoRig solved_rig = rig;
+  if (with_focal) {
+    StatusOr<StereoRig> scaled =
+        rig.WithFocalScaled(focal.prepared_with[0], focal.prepared_with[1]);
+    if (!scaled.ok()) return scaled.status();
+    solved_rig = *std::move(scaled);
+  }
   LocusNormalEquations equations(layout.Size());
   std::vector<LocusNormalEquations> per_frame;
-  AccumulateLocusNormalEquations(rig, layout, raw, matches, inliers,
-                                 parameters.n, rotation, &equations,
-                                 &per_frame);
+  AccumulateLocusNormalEquations(solved_rig, layout, raw, matches, inliers,
+                                 parameters.n, rotation, focal.prepared_with,
+                                 &equations, &per_frame);
   summary.consistency = FrameConsistencyOf(per_frame, summary.sigma_px);
   const double inflation =
       summary.consistency ? summary.consistency->inflation : 1.0;
@@ -358,11 +476,21 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
   summary.sigma_n_systematic = propagation->sigma_n_systematic;
   summary.crlb =
       summary.sigma_px / std::sqrt(LocusInformation(
-                             final_essential, inlier_matches, parameters.n));
+                             final_essential, inlier_matches(), parameters.n));
 
   if (with_rotation) {
     summary.rotation = RotationCorrectionOf(
         *propagation, rotation, mode == RotationMode::kPrior, final_extrinsics);
+  }
+  if (with_focal) {
+    FocalScaleCorrection correction;
+    correction.scale = focal.prepared_with;
+    for (int c = 0; c < 2; ++c) {
+      correction.sigma[c] =
+          std::sqrt(std::max(0.0, propagation->focal_scale_covariance(c, c)));
+    }
+    correction.correlation_with_n = propagation->focal_scale_correlation_with_n;
+    summary.focal = correction;
   }
   if (rig.calibration_uncertainty() || layout.NumSystematic() > 0 ||
       options.n_prior) {

@@ -82,8 +82,9 @@ std::vector<Difference> LensDifferences(
 
 }  // namespace
 
-CalibrationParameterLayout CalibrationParameterLayout::Of(
-    const StereoRig& rig, double systematic_px) {
+CalibrationParameterLayout CalibrationParameterLayout::Of(const StereoRig& rig,
+                                                          double systematic_px,
+                                                          bool estimate_focal) {
   CalibrationParameterLayout layout;
   layout.systematic_px = systematic_px;
   if (const std::optional<CalibrationUncertainty>& uncertainty =
@@ -94,6 +95,12 @@ CalibrationParameterLayout CalibrationParameterLayout::Of(
     if (uncertainty->right_lens_covariance.size() > 0) {
       layout.num_right_lens = rig.right().num_params();
     }
+    layout.focal = estimate_focal && uncertainty->focal_drift_sigma > 0.0 &&
+                   layout.num_left_lens > 0 && layout.num_right_lens > 0;
+  }
+  for (int k = 0; k < 2; ++k) {
+    layout.left_focal[k] = rig.left().params()[k];
+    layout.right_focal[k] = rig.right().params()[k];
   }
   return layout;
 }
@@ -153,7 +160,8 @@ void AccumulateLocusNormalEquations(
     const std::vector<StereoCorrespondence>& raw,
     const std::vector<PreparedCorrespondence>& matches,
     const std::vector<int64_t>& indices, double n,
-    const Eigen::Vector3d& rotation, LocusNormalEquations* equations,
+    const Eigen::Vector3d& rotation, const Eigen::Vector2d& focal_scale,
+    LocusNormalEquations* equations,
     std::vector<LocusNormalEquations>* per_frame) {
   const int size = layout.Size();
   // Pixels to [-1, 1] over the left image, for the systematic field.
@@ -214,6 +222,16 @@ void AccumulateLocusNormalEquations(
             (values[0] - values[1]) / (2.0 * lens[j].step);
       }
     }
+    if (layout.focal && defined) {
+      // d r / d e = g^T d r / d lens (d params / d e = g of the
+      // calibration's lenses, whatever the scale of the rig at hand).
+      for (int c = 0; c < 2; ++c) {
+        const int lens_column = c == 0 ? layout.LeftLens() : layout.RightLens();
+        const double* focal = c == 0 ? layout.left_focal : layout.right_focal;
+        row[layout.Focal() + c] =
+            focal[0] * row[lens_column] + focal[1] * row[lens_column + 1];
+      }
+    }
     if (layout.NumSystematic() > 0) {
       const double x = raw[i].left_pixel.x() / half_width - 1.0;
       const double y = raw[i].left_pixel.y() / half_height - 1.0;
@@ -224,7 +242,8 @@ void AccumulateLocusNormalEquations(
       }
     }
     if (!defined || !row.allFinite()) continue;
-    const double a = r - n * row[0] - rotation.dot(row.segment<3>(1));
+    double a = r - n * row[0] - rotation.dot(row.segment<3>(1));
+    if (layout.focal) a -= focal_scale.dot(row.segment<2>(layout.Focal()));
     equations->information.selfadjointView<Eigen::Lower>().rankUpdate(row);
     equations->gradient += r * row;
     equations->gradient_intercept += a * row;
@@ -384,7 +403,10 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
   result.mode = mode;
   result.source = uncertainty.source;
 
-  // The calibration's covariance in the layout's columns (n's is 0).
+  // The calibration's covariance in the layout's columns (n's is 0). With
+  // the focal scales estimated under the focal drift prior, the held lenses
+  // carry what the calibration measured only, and the prior is the focal
+  // columns' (P below).
   Eigen::MatrixXd calibration = Eigen::MatrixXd::Zero(size, size);
   calibration.block<6, 6>(1, 1) = uncertainty.extrinsics_covariance;
   if (layout.num_left_lens > 0) {
@@ -423,6 +445,18 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
     calibration(layout.Systematic() + k, layout.Systematic() + k) =
         layout.systematic_px * layout.systematic_px;
   }
+  const double focal_variance =
+      uncertainty.focal_drift_sigma * uncertainty.focal_drift_sigma;
+  if (layout.focal) {
+    // (CalibrationUncertainty::WithoutFocalDrift, in the layout's columns.)
+    for (int c = 0; c < 2; ++c) {
+      const int column = c == 0 ? layout.LeftLens() : layout.RightLens();
+      const Eigen::Vector2d g =
+          Eigen::Vector2d::Map(c == 0 ? layout.left_focal : layout.right_focal);
+      calibration.block<2, 2>(column, column) -=
+          focal_variance * g * g.transpose();
+    }
+  }
 
   const double m_nn = m(0, 0);
   if (!(m_nn > 0.0)) {
@@ -449,13 +483,18 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
     }
   }
 
-  // Estimated and held columns.
+  // Estimated and held columns: x = (n, w when estimated, e when the
+  // layout has the focal columns).
   std::vector<int> estimated = {0};
   std::vector<int> held;
   const bool rotation_estimated = mode != RotationMode::kHeld;
   for (int k = 1; k < size; ++k) {
-    (rotation_estimated && k <= 3 ? estimated : held).push_back(k);
+    const bool estimated_column =
+        (rotation_estimated && k <= 3) || (layout.focal && k >= layout.Focal());
+    (estimated_column ? estimated : held).push_back(k);
   }
+  const int focal_x =
+      layout.focal ? static_cast<int>(estimated.size()) - 2 : -1;
   const int nx = static_cast<int>(estimated.size());
   const int np = static_cast<int>(held.size());
   const double variance = sigma_px * sigma_px;
@@ -486,12 +525,21 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
       return Status::Error(
           "the rotation prior is singular: give every axis a drift sigma > 0");
     }
-    prior.bottomRightCorner<3, 3>() = ldlt.solve(Eigen::Matrix3d::Identity());
+    prior.block<3, 3>(1, 1) = ldlt.solve(Eigen::Matrix3d::Identity());
   }
   Eigen::MatrixXd n_prior = Eigen::MatrixXd::Zero(nx, nx);
   if (n_prior_sigma > 0.0)
     n_prior(0, 0) = 1.0 / (n_prior_sigma * n_prior_sigma);
   prior += n_prior;
+  Eigen::MatrixXd focal_prior = Eigen::MatrixXd::Zero(nx, nx);
+  if (layout.focal) {
+    if (!(focal_variance > 0.0)) {
+      return Status::Error("the focal scales need a focal drift prior > 0");
+    }
+    focal_prior.block<2, 2>(focal_x, focal_x) =
+        Eigen::Matrix2d::Identity() / focal_variance;
+  }
+  prior += focal_prior;
   // In the sigma^2-scaled form, stable down to exact data (sigma = 0):
   // H' = sigma^2 H = A + sigma^2 P, S = H'^-1 B.
   const Eigen::MatrixXd h = a + variance * prior;
@@ -507,6 +555,8 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
       variance * variance * h_inverse * prior * h_inverse;
   const Eigen::MatrixXd from_n_prior =
       variance * variance * h_inverse * n_prior * h_inverse;
+  const Eigen::MatrixXd from_focal_prior =
+      variance * variance * h_inverse * focal_prior * h_inverse;
   const Eigen::MatrixXd s = h_inverse * b;
   // The estimate's error is H'^-1 (B dp - sigma^2 P_w dw) for held
   // parameters off by dp and a rotation off its prior by dw (P_w the
@@ -516,7 +566,7 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
   //   cross = -sigma^2 (S Sigma_pw P_w^T H'^-1 + its transpose).
   Eigen::MatrixXd cross = Eigen::MatrixXd::Zero(nx, nx);
   if (mode == RotationMode::kPrior && !sigma_pw.isZero(0.0)) {
-    const Eigen::MatrixXd p_w = prior.rightCols(3);  // x = (n, w)
+    const Eigen::MatrixXd p_w = prior.middleCols(1, 3);  // x = (n, w, ...)
     const Eigen::MatrixXd half =
         -variance * s * sigma_pw * p_w.transpose() * h_inverse;
     cross = half + half.transpose();
@@ -556,7 +606,9 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
   result.variance_translation =
       from_held(0, 0) - shares[0] - shares[2] - shares[3];
   result.variance_medium = from_n_prior(0, 0);
-  result.variance_rotation += from_prior(0, 0) - from_n_prior(0, 0);
+  result.variance_lenses += from_focal_prior(0, 0);
+  result.variance_rotation +=
+      from_prior(0, 0) - from_n_prior(0, 0) - from_focal_prior(0, 0);
 
   const double noise_variance = noise(0, 0) * noise_inflation * noise_inflation;
   const double calibration_variance = std::max(
@@ -569,14 +621,24 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
       std::sqrt(std::max(0.0, noise_variance) + calibration_variance +
                 std::max(0.0, result.variance_systematic));
 
+  const Eigen::MatrixXd total =
+      noise * noise_inflation * noise_inflation + from_prior + from_held;
+  const auto correlation_with_n = [&total](int k) {
+    const double denominator = std::sqrt(total(0, 0) * total(k, k));
+    return denominator > 0.0 ? total(0, k) / denominator : 0.0;
+  };
   if (rotation_estimated) {
-    const Eigen::MatrixXd total =
-        noise * noise_inflation * noise_inflation + from_prior + from_held;
-    result.rotation_covariance = total.bottomRightCorner<3, 3>();
+    result.rotation_covariance = total.block<3, 3>(1, 1);
     for (int k = 0; k < 3; ++k) {
-      const double denominator = std::sqrt(total(0, 0) * total(1 + k, 1 + k));
-      result.rotation_correlation_with_n[k] =
-          denominator > 0.0 ? total(0, 1 + k) / denominator : 0.0;
+      result.rotation_correlation_with_n[k] = correlation_with_n(1 + k);
+    }
+  }
+  if (layout.focal) {
+    result.focal_estimated = true;
+    result.focal_scale_covariance = total.block<2, 2>(focal_x, focal_x);
+    for (int k = 0; k < 2; ++k) {
+      result.focal_scale_correlation_with_n[k] =
+          correlation_with_n(focal_x + k);
     }
   }
   return result;

@@ -75,8 +75,12 @@ FrameFit FitFrame(const StereoRig& rig,
   Rigid3d extrinsics = rig.right_from_left();
   std::vector<int64_t> chosen;  // indices into `matches`
   if (SelfCalibrates(rig, options)) {
+    // (The frame's lenses are held here: the online estimators propagate
+    // the focal drift prior.)
+    RefinementOptions frame_options = options;
+    frame_options.self_calibrate_focal = false;
     const StatusOr<RefinementSummary> own =
-        RefineRefractiveIndex(rig, frame_matches, options);
+        RefineRefractiveIndex(rig, frame_matches, frame_options);
     if (own.ok() && own->rotation) {
       fit.n_robust = own->n_robust;
       rotation = own->rotation->angle_axis;
@@ -139,8 +143,8 @@ FrameFit FitFrame(const StereoRig& rig,
     for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int64_t>(i);
     AccumulateLocusNormalEquations(
         rig, layout, raw, kept, all,
-        fit.estimate.ok() ? fit.estimate->n : fit.n_robust,
-        rotation, &fit.normal_equations);
+        fit.estimate.ok() ? fit.estimate->n : fit.n_robust, rotation,
+        Eigen::Vector2d::Zero(), &fit.normal_equations);
   }
   if (fit.estimate.ok()) {
     FrameFit::Model model;
@@ -160,9 +164,9 @@ FrameFit FitFrame(const StereoRig& rig,
   return fit;
 }
 
-StatusOr<PooledLocusEstimate> FrameEstimateOf(const StereoRig& rig,
-                                              const FrameFit& fit,
-                                              const RefinementOptions& options) {
+StatusOr<PooledLocusEstimate> FrameEstimateOf(
+    const StereoRig& rig, const FrameFit& fit,
+    const RefinementOptions& options) {
   if (!fit.estimate.ok()) return fit.estimate.status();
   FrameEstimateSums own;
   if (fit.model) {
@@ -237,10 +241,10 @@ StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
   }
   estimate.sigma_n_calibration = propagation->sigma_n_calibration;
   estimate.sigma_n_systematic = propagation->sigma_n_systematic;
-  estimate.sigma_n = std::sqrt(
-      estimate.sigma_n_noise * estimate.sigma_n_noise +
-      estimate.sigma_n_calibration * estimate.sigma_n_calibration +
-      estimate.sigma_n_systematic * estimate.sigma_n_systematic);
+  estimate.sigma_n =
+      std::sqrt(estimate.sigma_n_noise * estimate.sigma_n_noise +
+                estimate.sigma_n_calibration * estimate.sigma_n_calibration +
+                estimate.sigma_n_systematic * estimate.sigma_n_systematic);
   estimate.locus.sigma_n = estimate.sigma_n;
   estimate.calibration = *propagation;
   RCM_RETURN_IF_ERROR(CheckNotPinnedAtUpperBound(n, estimate.sigma_n));

@@ -45,7 +45,56 @@ std::optional<PreparedCorrespondence> PrepareCorrespondence(
                                    prepared.right_normalized_from_pixel)) {
     return std::nullopt;
   }
+  // d(x, y)/de (the header).
+  const auto focal_direction =
+      [](const Camera& camera, const Eigen::Vector2d& pixel,
+         const double* normalized_from_pixel, double* direction) {
+        const double du = pixel.x() - camera.params()[2];
+        const double dv = pixel.y() - camera.params()[3];
+        direction[0] =
+            -(normalized_from_pixel[0] * du + normalized_from_pixel[1] * dv);
+        direction[1] =
+            -(normalized_from_pixel[2] * du + normalized_from_pixel[3] * dv);
+      };
+  focal_direction(rig.left(), correspondence.left_pixel,
+                  prepared.left_normalized_from_pixel,
+                  prepared.left_focal_direction);
+  focal_direction(rig.right(), correspondence.right_pixel,
+                  prepared.right_normalized_from_pixel,
+                  prepared.right_focal_direction);
+  for (int k = 0; k < 4; ++k) {
+    prepared.left_normalized_from_pixel_focal[k] =
+        -prepared.left_normalized_from_pixel[k];
+    prepared.right_normalized_from_pixel_focal[k] =
+        -prepared.right_normalized_from_pixel[k];
+  }
   return prepared;
+}
+
+bool PrepareFocalDerivatives(const StereoRig& rig,
+                             const StereoCorrespondence& correspondence,
+                             PreparedCorrespondence* prepared) {
+  constexpr double kFocalStep = 1e-6;
+  const StatusOr<StereoRig> plus = rig.WithFocalScaled(kFocalStep, kFocalStep);
+  const StatusOr<StereoRig> minus =
+      rig.WithFocalScaled(-kFocalStep, -kFocalStep);
+  if (!plus.ok() || !minus.ok()) return false;
+  const std::optional<PreparedCorrespondence> up =
+      PrepareCorrespondence(*plus, correspondence);
+  const std::optional<PreparedCorrespondence> down =
+      PrepareCorrespondence(*minus, correspondence);
+  if (!up || !down) return false;
+  for (int k = 0; k < 4; ++k) {
+    prepared->left_normalized_from_pixel_focal[k] =
+        (up->left_normalized_from_pixel[k] -
+         down->left_normalized_from_pixel[k]) /
+        (2.0 * kFocalStep);
+    prepared->right_normalized_from_pixel_focal[k] =
+        (up->right_normalized_from_pixel[k] -
+         down->right_normalized_from_pixel[k]) /
+        (2.0 * kFocalStep);
+  }
+  return true;
 }
 
 PreparedCorrespondences PrepareCorrespondences(

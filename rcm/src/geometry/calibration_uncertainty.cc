@@ -64,6 +64,18 @@ std::string CalibrationUncertainty::DescribeFocalDrift(double focal_sigma) {
   return text.str();
 }
 
+namespace {
+
+// g = [fx, fy, 0, ..., 0] of a camera's params (the header).
+Eigen::VectorXd FocalDirection(const Eigen::VectorXd& params) {
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(params.size());
+  const Eigen::Index head = std::min<Eigen::Index>(2, params.size());
+  g.head(head) = params.head(head);
+  return g;
+}
+
+}  // namespace
+
 void CalibrationUncertainty::AddFocalDrift(
     double focal_sigma, const Eigen::VectorXd& left_params,
     const Eigen::VectorXd& right_params) {
@@ -73,14 +85,31 @@ void CalibrationUncertainty::AddFocalDrift(
     const Eigen::Index size = params.size();
     if (covariance->size() == 0)
       *covariance = Eigen::MatrixXd::Zero(size, size);
-    Eigen::VectorXd g = Eigen::VectorXd::Zero(size);
-    g.head(std::min<Eigen::Index>(2, size)) =
-        params.head(std::min<Eigen::Index>(2, size));
+    const Eigen::VectorXd g = FocalDirection(params);
     *covariance += focal_sigma * focal_sigma * g * g.transpose();
   };
   add(left_params, &left_lens_covariance);
   add(right_params, &right_lens_covariance);
+  focal_drift_sigma = std::hypot(focal_drift_sigma, focal_sigma);
   source += (source.empty() ? "" : ", ") + DescribeFocalDrift(focal_sigma);
+}
+
+CalibrationUncertainty CalibrationUncertainty::WithoutFocalDrift(
+    const Eigen::VectorXd& left_params,
+    const Eigen::VectorXd& right_params) const {
+  CalibrationUncertainty measured = *this;
+  if (focal_drift_sigma == 0.0) return measured;
+  const double variance = focal_drift_sigma * focal_drift_sigma;
+  const auto remove = [variance](const Eigen::VectorXd& params,
+                                 Eigen::MatrixXd* covariance) {
+    if (covariance->rows() != params.size()) return;
+    const Eigen::VectorXd g = FocalDirection(params);
+    *covariance -= variance * g * g.transpose();
+  };
+  remove(left_params, &measured.left_lens_covariance);
+  remove(right_params, &measured.right_lens_covariance);
+  measured.focal_drift_sigma = 0.0;
+  return measured;
 }
 
 void CalibrationUncertainty::AddDrift(double rotation_sigma,
@@ -125,6 +154,9 @@ Eigen::MatrixXd CalibrationUncertainty::JointCovariance() const {
 
 Status CalibrationUncertainty::Check(int left_num_params,
                                      int right_num_params) const {
+  if (!(focal_drift_sigma >= 0.0) || !std::isfinite(focal_drift_sigma)) {
+    return Status::Error("the focal drift prior is not a finite sigma >= 0");
+  }
   RCM_RETURN_IF_ERROR(CheckCovarianceMatrix(extrinsics_covariance,
                                             "cam1_from_cam0 covariance"));
   const Eigen::MatrixXd* lenses[2] = {&left_lens_covariance,

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 #include <utility>
+#include <vector>
 
 namespace rcm {
 
@@ -50,6 +51,29 @@ StatusOr<StereoRig> StereoRig::WithCam1Moved(
   moved.rotation = delta * right_from_left_.rotation;
   moved.translation = delta * right_from_left_.translation + translation;
   StatusOr<StereoRig> rig = Create(left_, right_, moved);
+  if (!rig.ok()) return rig.status();
+  rig->ports_ = ports_;
+  rig->calibration_uncertainty_ = calibration_uncertainty_;
+  return rig;
+}
+
+StatusOr<StereoRig> StereoRig::WithFocalScaled(double left_scale,
+                                               double right_scale) const {
+  const double scales[2] = {left_scale, right_scale};
+  Camera cameras[2] = {left_, right_};
+  for (int c = 0; c < 2; ++c) {
+    if (!std::isfinite(scales[c]) || !(scales[c] > -1.0)) {
+      return Status::Error("a focal scale is not finite or not above -1");
+    }
+    std::vector<double> params(cameras[c].params(),
+                               cameras[c].params() + cameras[c].num_params());
+    params[0] *= 1.0 + scales[c];
+    params[1] *= 1.0 + scales[c];
+    StatusOr<Camera> scaled = cameras[c].WithParams(params.data());
+    if (!scaled.ok()) return scaled.status();
+    cameras[c] = *std::move(scaled);
+  }
+  StatusOr<StereoRig> rig = Create(cameras[0], cameras[1], right_from_left_);
   if (!rig.ok()) return rig.status();
   rig->ports_ = ports_;
   rig->calibration_uncertainty_ = calibration_uncertainty_;

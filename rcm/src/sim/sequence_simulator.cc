@@ -72,23 +72,11 @@ Status LensChange::Check() const {
 
 StatusOr<StereoRig> LensChange::Apply(const StereoRig& rig) const {
   RCM_RETURN_IF_ERROR(Check());
-  std::array<Camera, 2> cameras = {rig.left(), rig.right()};
-  for (int c = 0; c < 2; ++c) {
-    std::vector<double> params(cameras[c].params(),
-                               cameras[c].params() + cameras[c].num_params());
-    params[0] *= 1.0 + focal_scale[c];
-    params[1] *= 1.0 + focal_scale[c];
-    StatusOr<Camera> changed = cameras[c].WithParams(params.data());
-    if (!changed.ok()) return changed.status().WithContext("lens change");
-    cameras[c] = *std::move(changed);
-  }
   StatusOr<StereoRig> changed =
-      StereoRig::Create(cameras[0], cameras[1], rig.right_from_left());
+      rig.WithFocalScaled(focal_scale[0], focal_scale[1]);
   if (!changed.ok()) return changed.status().WithContext("lens change");
-  if (rig.ports()) {
-    return changed->WithPorts(rig.ports()->left, rig.ports()->right);
-  }
-  return changed;
+  // (The changed lenses are the truth: no calibration uncertainty.)
+  return changed->WithCalibrationUncertainty(std::nullopt);
 }
 
 Status SequenceOptions::Check() const {

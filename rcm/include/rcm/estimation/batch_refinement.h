@@ -74,6 +74,15 @@ RotationCorrection RotationCorrectionOf(
     const Eigen::Vector3d& angle_axis, bool with_prior,
     const Rigid3d& cam1_from_cam0);
 
+// Each camera's focal scale e (focal lengths times 1 + e since the
+// calibration), estimated with n under the focal drift prior
+// (RefinementOptions::self_calibrate_focal).
+struct FocalScaleCorrection {
+  Eigen::Vector2d scale = Eigen::Vector2d::Zero();  // (left, right), relative
+  Eigen::Vector2d sigma = Eigen::Vector2d::Zero();  // their standard deviations
+  Eigen::Vector2d correlation_with_n = Eigen::Vector2d::Zero();
+};
+
 struct RefinementSummary {
   double n = 0.0;
   // Standard deviation of n, the total: pixel noise (sigma_n_noise, after
@@ -105,6 +114,8 @@ struct RefinementSummary {
   int num_iterations = 0;           // solver iterations, both stages
   // With refine_rotation, or self-calibration with a rotation prior.
   std::optional<RotationCorrection> rotation;
+  // With self_calibrate_focal and a focal drift prior (thin ports).
+  std::optional<FocalScaleCorrection> focal;
   // The propagation of the calibration's uncertainty, when the rig has one
   // (sensitivities, shares, observability of the rotation).
   std::optional<CalibrationPropagation> calibration;

@@ -24,6 +24,11 @@
 //
 // which add over frames (LocusNormalEquations).
 //
+// With the focal scales estimated (batch_refinement.h,
+// self_calibrate_focal), x gains (e_l, e_r) under the focal drift prior,
+// P_ee = 1 / s_f^2, and the held lenses carry the calibration's measured
+// covariance without it (CalibrationUncertainty::WithoutFocalDrift).
+//
 // Estimated x = [n] or [n, w], the rest p held at the calibration and
 // perturbed by its covariance Sigma_p; with A = M_xx, B = M_xp, pixel noise
 // sigma and, when w is estimated with the drift prior, P = Sigma_ww^-1
@@ -46,10 +51,10 @@
 //
 //            - H^-1 (B Sigma_pw diag(0, P) / sigma^2 + transpose) H^-1,
 //
-// Sigma_pw the held columns' covariance with w. sigma_n is the square root of the (n, n)
-// entry; sigma_n_noise of the first term's, sigma_n_calibration of the
-// other two. With w held (online estimators without self-calibration),
-// w is part of p.
+// Sigma_pw the held columns' covariance with w. sigma_n is the square root of
+// the (n, n) entry; sigma_n_noise of the first term's, sigma_n_calibration of
+// the other two. With w held (online estimators without self-calibration), w is
+// part of p.
 //
 // Sensitivities with everything but n held: dn/dq = -M_nq / M_nn for each
 // q of w and dt (what a stale calibration does to an n estimated alone).
@@ -108,42 +113,59 @@ namespace rcm {
 // Columns of j_i: n, w (3), dt (3), the lens parameters of each camera
 // whose covariance the rig's calibration uncertainty has, then with a
 // systematic error floor the kNumSystematic coefficients of the systematic
-// residual field (the file comment).
+// residual field (the file comment), then with the focal scales estimated
+// the two focal scales (e_l, e_r) of calibration_uncertainty.h's focal
+// drift, each the combination g^T (d r / d lens) of its camera's lens
+// columns, g = [fx, fy, 0, ...] of the calibration's lenses.
 struct CalibrationParameterLayout {
   static constexpr int kN = 0;
   static constexpr int kRotation = 1;
   static constexpr int kTranslation = 4;
   static constexpr int kNumSystematic = 6;
+  static constexpr int kNumFocal = 2;
   int num_left_lens = 0;
   int num_right_lens = 0;
   // Standard deviation of each systematic coefficient, pixels; 0: none.
   double systematic_px = 0.0;
+  // The focal scales' columns (estimated under the focal drift prior).
+  bool focal = false;
+  // Each camera's calibrated focal lengths (fx, fy), for g.
+  double left_focal[2] = {0.0, 0.0};
+  double right_focal[2] = {0.0, 0.0};
 
-  // The layout of `rig`: lens columns for the lens covariances it has, and
-  // the systematic field's when systematic_px > 0.
+  // The layout of `rig`: lens columns for the lens covariances it has, the
+  // systematic field's when systematic_px > 0, and the focal scales' when
+  // `estimate_focal` and the rig's uncertainty has a focal drift prior
+  // (CalibrationUncertainty::focal_drift_sigma > 0) and both lenses'
+  // columns.
   static CalibrationParameterLayout Of(const StereoRig& rig,
-                                       double systematic_px = 0.0);
+                                       double systematic_px = 0.0,
+                                       bool estimate_focal = false);
   int LeftLens() const { return 7; }
   int RightLens() const { return 7 + num_left_lens; }
   int Systematic() const { return 7 + num_left_lens + num_right_lens; }
   int NumSystematic() const { return systematic_px > 0.0 ? kNumSystematic : 0; }
-  int Size() const { return Systematic() + NumSystematic(); }
+  int Focal() const { return Systematic() + NumSystematic(); }
+  int NumFocal() const { return focal ? kNumFocal : 0; }
+  int Size() const { return Focal() + NumFocal(); }
 };
 
 // The sums M, g, C above, of a set of residuals. Fixed-capacity storage
 // (no heap), so that the online estimators' memory stays constant.
 struct LocusNormalEquations {
-  static constexpr int kMaxSize =
-      7 + 2 * kMaxLensParams + CalibrationParameterLayout::kNumSystematic;
+  static constexpr int kMaxSize = 7 + 2 * kMaxLensParams +
+                                  CalibrationParameterLayout::kNumSystematic +
+                                  CalibrationParameterLayout::kNumFocal;
   using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0,
                                kMaxSize, kMaxSize>;
   using Vector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxSize, 1>;
 
   Matrix information;  // M
   Vector gradient;     // g
-  // The affine model of each residual about x = (n, w) = 0: with x_i =
-  // (n_i, w_i) where row i was taken, a_i = r_i - j_i[n, w] . x_i, so that
-  // r_i(x) ~ a_i + j_i[n, w] . x. Sums over rows taken at different points
+  // The affine model of each residual about x = (n, w, e) = 0: with x_i =
+  // (n_i, w_i, e_i) where row i was taken (e_i the focal scales, with the
+  // layout's focal columns), a_i = r_i - j_i[n, w, e] . x_i, so that
+  // r_i(x) ~ a_i + j_i[n, w, e] . x. Sums over rows taken at different points
   // (frames, each linearized at its own estimate) then give the quadratic
   // model sum_i r_i(x)^2 ~ A + 2 intercept[n, w] . x + x^T M[n, w] x of
   // all of them (online_estimator.h).
@@ -171,12 +193,12 @@ struct LocusNormalEquations {
 // expands into the sums kept here; the same test as the per-frame
 // FrameConsistencyOf to first order.
 struct FrameEstimateSums {
-  double s0 = 0.0;                                  // sum G_f
-  double s1 = 0.0;                                  // sum G_f n_f
-  double s2 = 0.0;                                  // sum G_f n_f^2
-  Eigen::Vector3d b = Eigen::Vector3d::Zero();      // sum b_f
-  Eigen::Vector3d bn = Eigen::Vector3d::Zero();     // sum b_f n_f
-  Eigen::Matrix3d bb = Eigen::Matrix3d::Zero();     // sum b_f b_f^T / G_f
+  double s0 = 0.0;                               // sum G_f
+  double s1 = 0.0;                               // sum G_f n_f
+  double s2 = 0.0;                               // sum G_f n_f^2
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();   // sum b_f
+  Eigen::Vector3d bn = Eigen::Vector3d::Zero();  // sum b_f n_f
+  Eigen::Matrix3d bb = Eigen::Matrix3d::Zero();  // sum b_f b_f^T / G_f
   int frames = 0;
 
   void Add(double n_f, double information,
@@ -188,16 +210,19 @@ struct FrameEstimateSums {
 // Adds the rows j_i of `matches[indices]` at (n, w) for `rig` in
 // `layout` (CalibrationParameterLayout::Of(rig, ...)); `raw` are the
 // correspondences they were prepared from, same indexing, for the lens and
-// systematic columns. Residuals that are undefined at (n, w) or at a
-// difference step are skipped. Per-frame sums (for the consistency test)
-// go to `per_frame` when it is not null: one entry per distinct
+// systematic columns. With the layout's focal columns, `rig` and `matches`
+// are the calibration's lenses scaled by (1 + focal_scale) (the solution's)
+// and the layout the calibration's. Residuals that are undefined at (n, w)
+// or at a difference step are skipped. Per-frame sums (for the consistency
+// test) go to `per_frame` when it is not null: one entry per distinct
 // raw[i].frame, in order of first appearance.
 void AccumulateLocusNormalEquations(
     const StereoRig& rig, const CalibrationParameterLayout& layout,
     const std::vector<StereoCorrespondence>& raw,
     const std::vector<PreparedCorrespondence>& matches,
     const std::vector<int64_t>& indices, double n,
-    const Eigen::Vector3d& rotation, LocusNormalEquations* equations,
+    const Eigen::Vector3d& rotation, const Eigen::Vector2d& focal_scale,
+    LocusNormalEquations* equations,
     std::vector<LocusNormalEquations>* per_frame = nullptr);
 
 // The self-calibration of cam1's rotation on the quadratic model of
@@ -233,10 +258,10 @@ const char* RotationModeName(RotationMode mode);
 
 // The frames' agreement (the file comment).
 struct FrameConsistency {
-  int frames = 0;           // with information on n
+  int frames = 0;  // with information on n
   double chi_squared = 0.0;
-  int dof = 0;              // frames - 1
-  double p_value = 1.0;     // upper tail probability of chi_squared
+  int dof = 0;           // frames - 1
+  double p_value = 1.0;  // upper tail probability of chi_squared
   // sqrt(chi^2 / dof) when p_value < kInflationP, else 1.
   double inflation = 1.0;
   static constexpr double kInflationP = 0.01;
@@ -287,6 +312,12 @@ struct CalibrationPropagation {
   // correlation of each component with n.
   Eigen::Matrix3d rotation_covariance = Eigen::Matrix3d::Zero();
   Eigen::Vector3d rotation_correlation_with_n = Eigen::Vector3d::Zero();
+  // With the focal scales estimated (the layout's focal columns): their
+  // covariance (relative^2) and correlations with n. Their prior's share
+  // is part of variance_lenses.
+  bool focal_estimated = false;
+  Eigen::Matrix2d focal_scale_covariance = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d focal_scale_correlation_with_n = Eigen::Vector2d::Zero();
 };
 
 // The propagation above from the sums at the solution. `noise_inflation`

@@ -23,12 +23,36 @@ struct PreparedCorrespondence {
   // inverse of Camera::ImageFromNormalizedJacobian.
   double left_normalized_from_pixel[4] = {0.0, 0.0, 0.0, 0.0};
   double right_normalized_from_pixel[4] = {0.0, 0.0, 0.0, 0.0};
+  // d normalized / d e of each camera at its pixel, for a change of the
+  // camera's focal lengths by the factor (1 + e) (the focal drift of
+  // calibration_uncertainty.h): every lens model maps u = fx x_d + cx,
+  // v = fy y_d + cy, so the pixel of a fixed normalized point moves by
+  // (u - cx, v - cy) de and the normalized point of a fixed pixel by
+  //
+  //   d(x, y)/de = -(d(x, y)/d(u, v)) (u - cx, v - cy).
+  double left_focal_direction[2] = {0.0, 0.0};
+  double right_focal_direction[2] = {0.0, 0.0};
+  // d/de of each camera's d normalized / d pixel above, row-major: for a
+  // lens without distortion -d(x, y)/d(u, v) (it scales with 1 / (1 + e));
+  // PrepareFocalDerivatives gives it for any lens.
+  double left_normalized_from_pixel_focal[4] = {0.0, 0.0, 0.0, 0.0};
+  double right_normalized_from_pixel_focal[4] = {0.0, 0.0, 0.0, 0.0};
 };
 
 // nullopt when a pixel cannot be undistorted or the lens map is not
 // invertible there (non-finite inputs included).
 std::optional<PreparedCorrespondence> PrepareCorrespondence(
     const StereoRig& rig, const StereoCorrespondence& correspondence);
+
+// The derivatives in e of `prepared`'s inverse lens Jacobians for any lens
+// model, by central differences of the preparation on `rig` with the focal
+// lengths scaled by 1 +- kFocalStep (the undistortion converges to ~1e-14,
+// so their error is ~1e-8 relative, ample for the Sampson normalization's
+// derivative). False (and `prepared` unchanged) where a moved pixel does
+// not prepare.
+bool PrepareFocalDerivatives(const StereoRig& rig,
+                             const StereoCorrespondence& correspondence,
+                             PreparedCorrespondence* prepared);
 
 // The correspondences that could be prepared, with the index of each in the
 // input, in input order.

@@ -82,6 +82,15 @@ struct RefinementOptions {
   // it. false: the rotation is held at the calibration's and its
   // uncertainty only propagated into sigma_n. Ignored with refine_rotation.
   bool self_calibrate_rotation = true;
+  // Self-calibration of lenses that changed: when the rig's calibration
+  // uncertainty has a focal drift prior (CalibrationUncertainty::
+  // focal_drift_sigma > 0, the default of an air calibration), estimate
+  // each camera's focal scale (1 + e) with n, the prior N(0, s_f^2) on each
+  // e (batch_refinement.h). false: the focal lengths are held at the
+  // calibration's and the prior only propagated into sigma_n. The batch
+  // refinement of thin ports only; the online estimators and the thick
+  // port propagate it.
+  bool self_calibrate_focal = true;
   // A systematic error floor of the matches, pixels, >= 0
   // (calibration_propagation.h): the standard deviation of each
   // coefficient of a smooth field of low order added to every residual,

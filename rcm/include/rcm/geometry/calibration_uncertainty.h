@@ -84,6 +84,12 @@ struct CalibrationUncertainty {
   // relative position the extrinsics tie: the difference of the principal
   // points is known far better than either.)
   Eigen::MatrixXd lens_cross_covariance;
+  // The focal drift prior s_f that the lens covariances contain
+  // (AddFocalDrift; several add as the root of the sum of squares), 0 when
+  // none: an estimator that estimates each camera's focal scale under this
+  // prior (batch_refinement.h) takes s_f^2 g g^T back out of the lens
+  // covariances it holds (WithoutFocalDrift).
+  double focal_drift_sigma = 0.0;
   // Where the numbers come from, in words, for reports: e.g. "default drift
   // prior 0.1 deg, 0.1 mm per axis" or "camchain-covariance.yaml + drift
   // prior 0.1 deg, 0.1 mm per axis".
@@ -111,6 +117,13 @@ struct CalibrationUncertainty {
   // focal_sigma is 0.
   void AddFocalDrift(double focal_sigma, const Eigen::VectorXd& left_params,
                      const Eigen::VectorXd& right_params);
+
+  // The lens covariances without the focal drift prior (s_f^2 g g^T taken
+  // back out of each, focal_drift_sigma 0): what the calibration measured.
+  // `left_params` and `right_params` as for AddFocalDrift.
+  CalibrationUncertainty WithoutFocalDrift(
+      const Eigen::VectorXd& left_params,
+      const Eigen::VectorXd& right_params) const;
 
   Eigen::Matrix3d RotationCovariance() const {
     return extrinsics_covariance.topLeftCorner<3, 3>();

@@ -36,11 +36,13 @@ class StereoRig {
   const std::optional<Ports>& ports() const { return ports_; }
   // True when a port has an air gap, glass or a tilted normal.
   bool HasThickPort() const {
-    return ports_.has_value() && (!ports_->left.IsThin() || !ports_->right.IsThin());
+    return ports_.has_value() &&
+           (!ports_->left.IsThin() || !ports_->right.IsThin());
   }
   // A copy of the rig with ports (normals normalized). Errors: a port
   // that fails FlatPort::Check, prefixed "left port: " or "right port: ".
-  StatusOr<StereoRig> WithPorts(const FlatPort& left, const FlatPort& right) const;
+  StatusOr<StereoRig> WithPorts(const FlatPort& left,
+                                const FlatPort& right) const;
 
   // How well the calibration is known (calibration_uncertainty.h): read
   // with the rig from a file (stereo_rig_file.h: the calibration's
@@ -63,10 +65,19 @@ class StereoRig {
   // the cam1 frame), then cam1_from_cam0's translation changed by dt
   // (meters, cam1 frame). The convention of the rotation correction
   // (sampson_coplanarity_error.h) and of `rcm simulate --extrinsic-drift`.
-  // Ports and the calibration uncertainty are kept. Fails as Create does (non-finite, zero baseline).
-  StatusOr<StereoRig> WithCam1Moved(const Eigen::Vector3d& rotation,
-                                    const Eigen::Vector3d& translation =
-                                        Eigen::Vector3d::Zero()) const;
+  // Ports and the calibration uncertainty are kept. Fails as Create does
+  // (non-finite, zero baseline).
+  StatusOr<StereoRig> WithCam1Moved(
+      const Eigen::Vector3d& rotation,
+      const Eigen::Vector3d& translation = Eigen::Vector3d::Zero()) const;
+
+  // A copy of the rig whose cameras' focal lengths (fx, fy, the first two
+  // of Camera::params for every lens model) are scaled by (1 + left_scale)
+  // and (1 + right_scale): a lens change since the calibration
+  // (calibration_uncertainty.h's focal drift). Ports and the calibration
+  // uncertainty are kept. Fails when a scale is not finite or not above -1.
+  StatusOr<StereoRig> WithFocalScaled(double left_scale,
+                                      double right_scale) const;
 
   const Camera& left() const { return left_; }
   const Camera& right() const { return right_; }
