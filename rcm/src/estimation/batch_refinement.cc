@@ -90,13 +90,19 @@ struct FocalScales {
 };
 
 // `matches` (prepared for `rig`, from correspondences[source_index[i]])
-// prepared again with the rig's lenses scaled by `scale`; a match that no
+// prepared again with the rig's lenses scaled by `scale`; with
+// `derivatives`, the inverse lens Jacobians' derivatives in e too
+// (PrepareFocalDerivatives, two more preparations), else those of the
+// previous preparation kept (the refinement computes them once, after the
+// robust stage: the scale then moves by a fraction of a percent, which
+// changes them by as small a fraction; the coordinates and the residuals,
+// which set the solution, are always prepared anew). A match that no
 // longer prepares keeps its old preparation (a change of a few tenths of a
 // percent moves no pixel off the lens's domain in practice).
 void PrepareWithFocalScale(
     const StereoRig& rig, const Eigen::Vector2d& scale,
     const std::vector<StereoCorrespondence>& correspondences,
-    const std::vector<int64_t>& source_index,
+    const std::vector<int64_t>& source_index, bool derivatives,
     std::vector<PreparedCorrespondence>* matches) {
   const StatusOr<StereoRig> scaled = rig.WithFocalScaled(scale[0], scale[1]);
   if (!scaled.ok()) return;
@@ -105,10 +111,19 @@ void PrepareWithFocalScale(
         correspondences[source_index[i]];
     std::optional<PreparedCorrespondence> prepared =
         PrepareCorrespondence(*scaled, correspondence);
-    if (prepared &&
-        PrepareFocalDerivatives(*scaled, correspondence, &*prepared)) {
-      (*matches)[i] = *prepared;
+    if (!prepared) continue;
+    PreparedCorrespondence& match = (*matches)[i];
+    if (derivatives) {
+      if (!PrepareFocalDerivatives(*scaled, correspondence, &*prepared)) {
+        continue;
+      }
+    } else {
+      std::copy_n(match.left_normalized_from_pixel_focal, 4,
+                  prepared->left_normalized_from_pixel_focal);
+      std::copy_n(match.right_normalized_from_pixel_focal, 4,
+                  prepared->right_normalized_from_pixel_focal);
     }
+    match = *prepared;
   }
 }
 
@@ -275,18 +290,18 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
   const auto new_focal_prior = [&](double sigma_px) {
     return with_focal ? focal.NewPrior(sigma_px) : nullptr;
   };
-  // Takes the solved focal step into the preparation of the matches.
+  // Takes the solved focal step into the preparation of the matches. The
+  // robust stage takes the inverse lens Jacobians' derivatives of a lens
+  // without distortion (PrepareCorrespondence's); the first preparation
+  // after it gives every lens its own.
+  int focal_preparations = 0;
   const auto prepare_with_focal_step = [&](Parameters* at) {
     focal.prepared_with = focal.Total(at->focal);
     at->focal[0] = at->focal[1] = 0.0;
     PrepareWithFocalScale(rig, focal.prepared_with, correspondences,
-                          prepared.source_index, &matches);
+                          prepared.source_index, focal_preparations++ == 0,
+                          &matches);
   };
-  if (with_focal) {
-    // (The inverse lens Jacobians' derivatives in e, for any lens.)
-    PrepareWithFocalScale(rig, Eigen::Vector2d::Zero(), correspondences,
-                          prepared.source_index, &matches);
-  }
 
   // Seed and stage 1 (robust, all usable matches).
   summary.n_closed_form = ClosedFormSeed(matches);
@@ -398,8 +413,14 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
   };
   const bool with_prior =
       mode == RotationMode::kPrior || options.n_prior || with_focal;
-  constexpr int kMaxFocalPasses = 4;
-  constexpr double kFocalStepTolerance = 1e-13;  // relative focal length
+  // The passes stop when the step is a thousandth of the prior's sigma
+  // (3e-6 for the default 0.3 %), or after two: the robust stage leaves the
+  // scales off by the square of the change (~1e-5), the first pass's step
+  // takes that out and leaves its square (~1e-10), and on exact data the
+  // second's is ~1e-20. With noise, later passes would only follow the
+  // prior's weight, re-estimated each pass, by ~1e-6, far inside sigma.
+  constexpr int kMaxFocalPasses = 2;
+  const double focal_step_tolerance = 1e-3 * focal.prior_sigma;
   for (int pass = 0; pass < (with_focal ? kMaxFocalPasses : 1); ++pass) {
     RCM_RETURN_IF_ERROR(SolveUntilThePriorWeightSettles(
         with_prior,
@@ -429,7 +450,7 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
     const double step =
         std::max(std::abs(parameters.focal[0]), std::abs(parameters.focal[1]));
     prepare_with_focal_step(&parameters);
-    if (step <= kFocalStepTolerance) break;
+    if (step <= focal_step_tolerance) break;
   }
   summary.cost =
       0.5 * summary.sigma_px * summary.sigma_px * static_cast<double>(dof);
