@@ -12,6 +12,7 @@
 #include <sstream>
 #include <utility>
 
+#include "rcm/estimation/bounded_index_solve.h"
 #include "rcm/estimation/calibration_propagation.h"
 #include "rcm/estimation/closed_form.h"
 #include "rcm/estimation/cramer_rao_bound.h"
@@ -187,9 +188,8 @@ ceres::Solver::Summary Solve(const Eigen::Matrix3d& essential,
 
   const ceres::Solver::Options solver_options =
       RefinementSolverOptions(options);
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver_options, problem, &summary);
-  return summary;
+  return SolveWithBoundedIndex(solver_options, problem, &parameters->n, 1.0,
+                               2.0);
 }
 
 // cam1_from_cam0 with cam1 rotated about its center by `rotation`

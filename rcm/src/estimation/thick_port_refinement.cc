@@ -8,6 +8,7 @@
 #include <sstream>
 #include <utility>
 
+#include "rcm/estimation/bounded_index_solve.h"
 #include "rcm/estimation/calibration_propagation.h"
 #include "rcm/estimation/generalized_epipolar_error.h"
 #include "rcm/estimation/prepared_correspondence.h"
@@ -81,9 +82,8 @@ ceres::Solver::Summary Solve(const ThickPortStereo& stereo,
   }
   const ceres::Solver::Options solver_options =
       RefinementSolverOptions(options.base);
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver_options, problem, &summary);
-  return summary;
+  return SolveWithBoundedIndex(solver_options, problem, &parameters->n, 1.0,
+                               2.0);
 }
 
 }  // namespace
