@@ -340,10 +340,19 @@ void BindPooledFields(Class& cls) {
       .def_property_readonly(
           "calibration",
           [](const Estimate& e) { return CalibrationDict(e.calibration); })
-      .def_property_readonly("rotation", [](const Estimate& e) -> py::object {
-        if (!e.rotation) return py::none();
-        return ToNumpy(*e.rotation);
-      });
+      .def_property_readonly("rotation",
+                             [](const Estimate& e) -> py::object {
+                               if (!e.rotation) return py::none();
+                               return ToNumpy(*e.rotation);
+                             })
+      .def_property_readonly(
+          "focal_scale",
+          [](const Estimate& e) -> py::object {
+            if (!e.focal_scale) return py::none();
+            return ToNumpy(*e.focal_scale);
+          },
+          "Self-calibrated focal scales (left, right), relative (focal "
+          "lengths times 1 + e since the calibration), or None.");
 }
 
 const char* DecisionName(SlidingWindowRefractiveIndexEstimator::Decision d) {

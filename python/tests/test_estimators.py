@@ -227,6 +227,25 @@ def test_focal_scales_self_calibrated(realistic_rig):
     assert held.focal is None
 
 
+def test_online_self_calibrates_the_focal_scales(realistic_rig):
+    # The online estimator estimates the focal scales with n and cam1's
+    # rotation on the frames' quadratic models: exact frames of the
+    # calibrated lenses give zero scales (EXACT); without a focal drift
+    # prior there are none.
+    rig = realistic_rig.with_drift_prior(1e-3, 1e-4, focal_sigma=0.003)
+    exact = sample(realistic_rig, 1.333, frames=3, per_frame=200, seed=8)
+    online = rcm.OnlineEstimator(rig)
+    for frame in exact.split_frames():
+        estimate = online.add_frame(frame)
+    assert abs(estimate.n - 1.333) < EXACT
+    assert estimate.focal_scale.shape == (2,)
+    assert np.abs(estimate.focal_scale).max() < EXACT
+    no_prior = rcm.OnlineEstimator(realistic_rig.with_drift_prior(1e-3, 1e-4))
+    for frame in exact.split_frames():
+        estimate = no_prior.add_frame(frame)
+    assert estimate.focal_scale is None
+
+
 def test_options_change_the_estimate(realistic_rig):
     exact = sample(realistic_rig, 1.333, frames=2, per_frame=200, seed=4)
     noisy = rcm.add_pixel_noise(exact, 0.5, seed=3)

@@ -689,6 +689,52 @@ TEST(CalibrationPropagation, LensChangeSelfCalibratedExactly) {
   }
 }
 
+// The same lens change and turn, frame by frame: the online and window
+// estimators self-calibrate the focal scales and the turn on the frames'
+// quadratic models (the dataset's fisheye rig), each frame's linearized at
+// its own estimate, which
+// exact data make exact.
+TEST(CalibrationPropagation, LensChangeSelfCalibratedExactlyFrameByFrame) {
+  const StereoRig nominal = test::AlphasenseRealisticRig();
+  LensChange change;
+  change.focal_scale = {0.003, -0.002};
+  const Eigen::Vector3d turn = Eigen::Vector3d(0.05, 0.12, -0.03) * kDegree;
+  const StereoRig truth =
+      change.Apply(nominal).value().WithCam1Moved(turn).value();
+  const std::vector<StereoCorrespondence> data =
+      Frames(truth, kTrueN, 0.6, 6.0, 4, 150, 32);
+  std::vector<std::vector<StereoCorrespondence>> frames(4);
+  for (const StereoCorrespondence& match : data) {
+    frames[match.frame].push_back(match);
+  }
+  const StereoRig calibrated =
+      WithDefaultCalibrationUncertainty(nominal).value();
+  OnlineRefractiveIndexEstimator online =
+      OnlineRefractiveIndexEstimator::Create(calibrated, RefinementOptions())
+          .value();
+  SlidingWindowRefractiveIndexEstimator window =
+      SlidingWindowRefractiveIndexEstimator::Create(
+          calibrated, RefinementOptions(), SlidingWindowOptions())
+          .value();
+  for (int f = 0; f < 4; ++f) {
+    const auto update = online.AddFrame(frames[f]);
+    ASSERT_TRUE(update.frame_estimate.ok())
+        << update.frame_estimate.status().message();
+    EXPECT_NEAR(update.frame_estimate->n, kTrueN, kExactTolerance);
+    window.AddFrame(f, frames[f]);
+  }
+  for (const PooledLocusEstimate& estimate :
+       {static_cast<PooledLocusEstimate>(online.Current().value()),
+        static_cast<PooledLocusEstimate>(window.Current().value())}) {
+    EXPECT_NEAR(estimate.n, kTrueN, kExactTolerance);
+    ASSERT_TRUE(estimate.focal_scale.has_value());
+    EXPECT_NEAR((*estimate.focal_scale)[0], 0.003, kExactTolerance);
+    EXPECT_NEAR((*estimate.focal_scale)[1], -0.002, kExactTolerance);
+    ASSERT_TRUE(estimate.rotation.has_value());
+    EXPECT_LT((*estimate.rotation - turn).norm(), kExactTolerance);
+  }
+}
+
 // Lenses that changed since the calibration, mixed with the drift: each
 // camera's focal lengths scaled by a draw of the default focal drift prior
 // (0.3 %). Without that prior a 0.3 % change of one camera moves the pool's
@@ -702,25 +748,12 @@ TEST(CalibrationPropagation, LensChangeSelfCalibratedExactly) {
 // as before: pool sd 0.70, board 47 of 100 refused at the bound and the
 // rest sd 0.52 with sigma_n 0.4-0.6.)
 //
-// The online and window estimators hold the lenses and propagate the
-// prior: its residuals stay in the fit and raise the pixel-noise estimate,
-// which weakens the data against the rotation's prior, so that the
-// lenses' share comes out larger than the error it covers: z sd 0.69
-// (window; each frame 0.75) in the pool, means 0.2-0.3, sigma_n about
-// 1.4x conservative, below the band. The test holds what is true of them:
-// no estimate off beyond its sigma (sd <= 1.3), and the sigma not wider
-// than 1.8x the error (sd >= 0.55).
-void ExpectCovered(const ZStatistics& z, const char* what) {
-  std::printf(
-      "%s: %d trials, %d refused, z mean %.2f sd %.2f, mean sigma_n "
-      "%.5f\n",
-      what, z.trials, z.failed, z.mean, z.sd, z.mean_sigma);
-  EXPECT_EQ(z.failed, 0) << what;
-  if (!test::ChecksStatistics()) return;
-  EXPECT_GE(z.sd, 0.55) << what;
-  EXPECT_LE(z.sd, 1.3) << what;
-  EXPECT_LE(std::abs(z.mean), 0.5) << what;
-}
+// The online and window estimators estimate them too, on the frames'
+// quadratic models (SelfCalibrateQuadratic). Measured: window z mean -0.21
+// sd 1.09 in the pool, each frame sd 0.98. (Held and propagated, as
+// before: sd 0.69, each frame 0.75, sigma_n about 1.4x wider than the
+// error: the lens change's residuals raised the pixel-noise estimate,
+// which weakened the data against the rotation's prior.)
 
 TEST(CalibrationPropagation, MonteCarloRefineSigmaHonestUnderALensChangePool) {
   ExpectHonest(MonteCarloRefine(DriftScenes()[0], false, true),
@@ -730,11 +763,17 @@ TEST(CalibrationPropagation, MonteCarloRefineSigmaHonestUnderALensChangeBoard) {
   ExpectHonest(MonteCarloRefine(DriftScenes()[1], false, true),
                "refine, lenses changed, board");
 }
-TEST(CalibrationPropagation, MonteCarloWindowSigmaCoversALensChangePool) {
+TEST(CalibrationPropagation, MonteCarloWindowSigmaHonestUnderALensChangePool) {
   ZStatistics frames;
-  ExpectCovered(MonteCarloFrameByFrame(DriftScenes()[0], true, &frames, true),
-                "window, lenses changed, pool");
-  ExpectCovered(frames, "each frame, lenses changed, pool");
+  ExpectHonest(MonteCarloFrameByFrame(DriftScenes()[0], true, &frames, true),
+               "window, lenses changed, pool");
+  ExpectHonest(frames, "each frame, lenses changed, pool");
+}
+TEST(CalibrationPropagation, MonteCarloWindowSigmaHonestUnderALensChangeBoard) {
+  ZStatistics frames;
+  ExpectHonest(MonteCarloFrameByFrame(DriftScenes()[1], true, &frames, true),
+               "window, lenses changed, board");
+  ExpectHonest(frames, "each frame, lenses changed, board");
 }
 
 // A drifted rig whose n, estimated with the rotation held, is pinned at the

@@ -277,33 +277,57 @@ void AccumulateLocusNormalEquations(
 
 QuadraticSelfCalibration SelfCalibrateQuadratic(
     const LocusNormalEquations& equations,
-    const Eigen::Matrix3d& rotation_covariance, double sigma_px) {
-  const Eigen::Matrix4d m = equations.information.topLeftCorner<4, 4>();
-  const Eigen::Vector4d intercept = equations.gradient_intercept.head<4>();
-  const Eigen::Matrix3d prior =
+    const CalibrationParameterLayout& layout,
+    const Eigen::Matrix3d& rotation_covariance, double focal_sigma,
+    double sigma_px) {
+  // x = (n, w[, e]): its columns in the layout, and its prior.
+  using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
+  using Vector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
+  int columns[6] = {0, 1, 2, 3, 0, 0};
+  int size = 4;
+  if (layout.focal) {
+    columns[size++] = layout.Focal();
+    columns[size++] = layout.Focal() + 1;
+  }
+  Matrix m(size, size);
+  Vector intercept(size);
+  for (int r = 0; r < size; ++r) {
+    intercept[r] = equations.gradient_intercept[columns[r]];
+    for (int c = 0; c < size; ++c) {
+      m(r, c) = equations.information(columns[r], columns[c]);
+    }
+  }
+  Matrix prior = Matrix::Zero(size, size);
+  prior.block<3, 3>(1, 1) =
       rotation_covariance.ldlt().solve(Eigen::Matrix3d::Identity());
+  if (layout.focal) {
+    prior.block<2, 2>(4, 4) =
+        Eigen::Matrix2d::Identity() / (focal_sigma * focal_sigma);
+  }
   const double dof =
-      static_cast<double>(std::max<int64_t>(equations.count - 4, 1));
+      static_cast<double>(std::max<int64_t>(equations.count - size, 1));
   constexpr int kMaxPasses = 6;
   constexpr double kVarianceTolerance = 1e-3;  // relative
   QuadraticSelfCalibration result;
   double variance = sigma_px * sigma_px;
   for (int pass = 0; pass < kMaxPasses; ++pass) {
-    Eigen::Matrix4d h = m;
-    h.bottomRightCorner<3, 3>() += variance * prior;
-    Eigen::Vector4d x = -h.ldlt().solve(intercept);
+    const Matrix h = m + variance * prior;
+    Vector x = -h.ldlt().solve(intercept);
     if (!(x[0] >= 1.0 && x[0] <= 2.0)) {
-      // n on its bound, the rotation solved there.
+      // n on its bound, the rest solved there.
       x[0] = std::clamp(x[0], 1.0, 2.0);
-      x.tail<3>() = -h.bottomRightCorner<3, 3>().ldlt().solve(
-          intercept.tail<3>() + m.block<3, 1>(1, 0) * x[0]);
+      x.tail(size - 1) = -h.bottomRightCorner(size - 1, size - 1)
+                              .ldlt()
+                              .solve(intercept.tail(size - 1) +
+                                     m.block(1, 0, size - 1, 1) * x[0]);
     }
     const double data =
         std::max(0.0, equations.intercept_squares + 2.0 * intercept.dot(x) +
                           x.dot(m * x));
     const double updated = data / dof;
     result.n = x[0];
-    result.rotation = x.tail<3>();
+    result.rotation = x.segment<3>(1);
+    if (layout.focal) result.focal_scale = x.segment<2>(4);
     const bool settled =
         std::abs(updated - variance) <= kVarianceTolerance * updated;
     variance = updated;
@@ -360,33 +384,33 @@ std::optional<FrameConsistency> FrameConsistencyOf(
 }
 
 void FrameEstimateSums::Add(double n_f, double information,
-                            const Eigen::Vector3d& rotation_coupling) {
+                            const SelfCalibrationVector& coupling) {
   s0 += information;
   s1 += information * n_f;
   s2 += information * n_f * n_f;
-  b += rotation_coupling;
-  bn += rotation_coupling * n_f;
+  b += coupling;
+  bn += coupling * n_f;
   if (information > 0.0) {
-    bb += rotation_coupling * rotation_coupling.transpose() / information;
+    bb += coupling * coupling.transpose() / information;
   }
   ++frames;
 }
 
-double FrameEstimateSums::WeightedSquares(double n,
-                                          const Eigen::Vector3d& w) const {
-  // sum G_f (n_f - n)^2 - 2 (n_f - n) b_f . w + (b_f . w)^2 / G_f.
-  return s2 - 2.0 * n * s1 + n * n * s0 - 2.0 * (bn - n * b).dot(w) +
-         w.dot(bb * w);
+double FrameEstimateSums::WeightedSquares(
+    double n, const SelfCalibrationVector& x) const {
+  // sum G_f (n_f - n)^2 - 2 (n_f - n) b_f . x + (b_f . x)^2 / G_f.
+  return s2 - 2.0 * n * s1 + n * n * s0 - 2.0 * (bn - n * b).dot(x) +
+         x.dot(bb * x);
 }
 
 std::optional<FrameConsistency> FrameConsistencyOf(
     const FrameEstimateSums& sums, double n, double sigma_px,
-    const Eigen::Vector3d& rotation) {
+    const SelfCalibrationVector& x) {
   FrameConsistency consistency;
   consistency.frames = sums.frames;
   // Rounding can take the difference of large sums a little below zero.
   consistency.chi_squared =
-      std::max(0.0, sums.WeightedSquares(n, rotation)) / (sigma_px * sigma_px);
+      std::max(0.0, sums.WeightedSquares(n, x)) / (sigma_px * sigma_px);
   return Finish(consistency, sigma_px);
 }
 

@@ -53,10 +53,8 @@ FrameFit FitFrame(const StereoRig& rig,
   FrameFit fit;
   const Eigen::Matrix3d essential = EssentialMatrix(rig.right_from_left());
   fit.correspondences = static_cast<int64_t>(frame_matches.size());
-  const PreparedCorrespondences prepared =
-      PrepareCorrespondences(rig, frame_matches);
-  const std::vector<PreparedCorrespondence>& matches = prepared.prepared;
-  fit.usable = static_cast<int64_t>(matches.size());
+  PreparedCorrespondences prepared = PrepareCorrespondences(rig, frame_matches);
+  fit.usable = static_cast<int64_t>(prepared.prepared.size());
   if (fit.usable < options.min_inliers) {
     std::ostringstream message;
     message << "frame skipped: " << fit.usable << " usable matches of "
@@ -69,22 +67,35 @@ FrameFit FitFrame(const StereoRig& rig,
 
   // Stage 1 on the frame alone, and its inliers: with self-calibration,
   // the batch refinement of the frame (robust stage with cam1's rotation
-  // and its prior, inliers classified with the rotation); otherwise, or
-  // when that fails, n alone with the rotation held.
+  // and its prior, and the focal scales with theirs, inliers classified
+  // with them); otherwise, or when that fails, n alone with the rotation
+  // and the lenses held.
+  const CalibrationParameterLayout layout = SelfCalibrationLayout(rig, options);
   Eigen::Vector3d rotation = Eigen::Vector3d::Zero();
+  Eigen::Vector2d focal_scale = Eigen::Vector2d::Zero();
   Rigid3d extrinsics = rig.right_from_left();
-  std::vector<int64_t> chosen;  // indices into `matches`
+  StereoRig frame_rig = rig;    // the lenses at the frame's focal scales
+  bool own_lenses = false;      // frame_rig's are not the calibration's
+  std::vector<int64_t> chosen;  // indices into prepared.prepared
   if (SelfCalibrates(rig, options)) {
-    // (The frame's lenses are held here: the online estimators propagate
-    // the focal drift prior.)
     RefinementOptions frame_options = options;
-    frame_options.self_calibrate_focal = false;
+    frame_options.self_calibrate_focal = layout.focal;
     const StatusOr<RefinementSummary> own =
         RefineRefractiveIndex(rig, frame_matches, frame_options);
     if (own.ok() && own->rotation) {
       fit.n_robust = own->n_robust;
       rotation = own->rotation->angle_axis;
       extrinsics = own->rotation->cam1_from_cam0;
+      if (own->focal) {
+        StatusOr<StereoRig> scaled =
+            rig.WithFocalScaled(own->focal->scale[0], own->focal->scale[1]);
+        if (scaled.ok()) {
+          focal_scale = own->focal->scale;
+          frame_rig = *std::move(scaled);
+          own_lenses = true;
+          prepared = PrepareCorrespondences(frame_rig, frame_matches);
+        }
+      }
       // Its inliers are indices into the frame, increasing, as are
       // prepared.source_index.
       for (size_t i = 0, k = 0; i < prepared.source_index.size(); ++i) {
@@ -101,14 +112,23 @@ FrameFit FitFrame(const StereoRig& rig,
   }
   if (chosen.empty()) {
     rotation.setZero();
+    focal_scale.setZero();
     extrinsics = rig.right_from_left();
-    fit.n_robust = MinimizeRobustLocusCost(essential, matches, options);
-    chosen = ClassifyLocusInliers(extrinsics, matches, fit.n_robust, options);
+    if (own_lenses) {
+      own_lenses = false;
+      frame_rig = rig;
+      prepared = PrepareCorrespondences(rig, frame_matches);
+    }
+    fit.n_robust =
+        MinimizeRobustLocusCost(essential, prepared.prepared, options);
+    chosen = ClassifyLocusInliers(extrinsics, prepared.prepared, fit.n_robust,
+                                  options);
   }
+  const std::vector<PreparedCorrespondence>& inlier_pool = prepared.prepared;
   std::vector<PreparedCorrespondence> inlier_matches;
   std::vector<int64_t> inlier_sources;
   for (const int64_t i : chosen) {
-    inlier_matches.push_back(matches[i]);
+    inlier_matches.push_back(inlier_pool[i]);
     inlier_sources.push_back(prepared.source_index[i]);
   }
   std::vector<int64_t> rejected;
@@ -127,14 +147,13 @@ FrameFit FitFrame(const StereoRig& rig,
     fit.inliers.push_back(inlier_sources[i]);
     kept.push_back(inlier_matches[i]);
   }
-  // n at the frame's own rotation (the calibration's, or self-calibrated).
+  // n at the frame's own rotation and lenses (the calibration's, or
+  // self-calibrated).
   fit.estimate = EstimateFromLocusCost(fit.cost, options);
 
   // The calibration's share and the self-calibration need the inliers'
   // normal equations, taken at the frame's own estimate.
   if (rig.calibration_uncertainty() || options.systematic_px > 0.0) {
-    const CalibrationParameterLayout layout =
-        CalibrationParameterLayout::Of(rig, options.systematic_px);
     fit.normal_equations = LocusNormalEquations(layout.Size());
     std::vector<StereoCorrespondence> raw;
     raw.reserve(fit.inliers.size());
@@ -142,9 +161,9 @@ FrameFit FitFrame(const StereoRig& rig,
     std::vector<int64_t> all(kept.size());
     for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int64_t>(i);
     AccumulateLocusNormalEquations(
-        rig, layout, raw, kept, all,
+        frame_rig, layout, raw, kept, all,
         fit.estimate.ok() ? fit.estimate->n : fit.n_robust, rotation,
-        Eigen::Vector2d::Zero(), &fit.normal_equations);
+        focal_scale, &fit.normal_equations);
   }
   if (fit.estimate.ok()) {
     FrameFit::Model model;
@@ -152,8 +171,14 @@ FrameFit FitFrame(const StereoRig& rig,
     if ((rig.calibration_uncertainty() || options.systematic_px > 0.0) &&
         information > 0.0) {
       model.information = information;
-      model.rotation_coupling =
+      model.coupling.head<3>() =
           fit.normal_equations.information.block<3, 1>(1, 0);
+      const CalibrationParameterLayout layout =
+          SelfCalibrationLayout(rig, options);
+      if (layout.focal) {
+        model.coupling.tail<2>() =
+            fit.normal_equations.information.block<2, 1>(layout.Focal(), 0);
+      }
       model.n = -fit.normal_equations.gradient_intercept[0] / information;
     } else {
       model.n = fit.estimate->n;
@@ -170,7 +195,7 @@ StatusOr<PooledLocusEstimate> FrameEstimateOf(
   if (!fit.estimate.ok()) return fit.estimate.status();
   FrameEstimateSums own;
   if (fit.model) {
-    own.Add(fit.model->n, fit.model->information, fit.model->rotation_coupling);
+    own.Add(fit.model->n, fit.model->information, fit.model->coupling);
   }
   const StatusOr<CalibratedLocusEstimate> calibrated = EstimateWithCalibration(
       rig, fit.cost, fit.normal_equations, own, options);
@@ -181,6 +206,14 @@ StatusOr<PooledLocusEstimate> FrameEstimateOf(
 bool SelfCalibrates(const StereoRig& rig, const RefinementOptions& options) {
   return options.self_calibrate_rotation && rig.calibration_uncertainty() &&
          !rig.calibration_uncertainty()->RotationCovariance().isZero(0.0);
+}
+
+CalibrationParameterLayout SelfCalibrationLayout(
+    const StereoRig& rig, const RefinementOptions& options) {
+  return CalibrationParameterLayout::Of(rig, options.systematic_px,
+                                        options.self_calibrate_focal &&
+                                            SelfCalibrates(rig, options) &&
+                                            !rig.HasThickPort());
 }
 
 StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
@@ -204,18 +237,23 @@ StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
   }
   const CalibrationUncertainty uncertainty =
       rig.calibration_uncertainty().value_or(CalibrationUncertainty());
-  const CalibrationParameterLayout layout =
-      CalibrationParameterLayout::Of(rig, options.systematic_px);
+  const CalibrationParameterLayout layout = SelfCalibrationLayout(rig, options);
   LocusNormalEquations at_solution = normal_equations;
   const bool self_calibrate = SelfCalibrates(rig, options);
   Eigen::Vector3d rotation = Eigen::Vector3d::Zero();
+  Eigen::Vector2d focal_scale = Eigen::Vector2d::Zero();
   if (self_calibrate) {
     const QuadraticSelfCalibration pooled = SelfCalibrateQuadratic(
-        normal_equations, uncertainty.RotationCovariance(), locus->sigma_px);
+        normal_equations, layout, uncertainty.RotationCovariance(),
+        uncertainty.focal_drift_sigma, locus->sigma_px);
     estimate.locus.n = pooled.n;
     estimate.locus.sigma_px = pooled.sigma_px;
     rotation = pooled.rotation;
     estimate.rotation = rotation;
+    if (layout.focal) {
+      focal_scale = pooled.focal_scale;
+      estimate.focal_scale = focal_scale;
+    }
   } else {
     // n alone: the information on n at the estimate, from the interpolant.
     at_solution.information(0, 0) = cost.Information(locus->n);
@@ -223,8 +261,8 @@ StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
   const double n = estimate.locus.n;
   const double sigma_px = estimate.locus.sigma_px;
   estimate.locus.crlb = sigma_px / std::sqrt(cost.Information(n));
-  estimate.consistency =
-      FrameConsistencyOf(frame_estimates, n, sigma_px, rotation);
+  estimate.consistency = FrameConsistencyOf(
+      frame_estimates, n, sigma_px, SelfCalibrationOf(rotation, focal_scale));
   const double inflation =
       estimate.consistency ? estimate.consistency->inflation : 1.0;
   StatusOr<CalibrationPropagation> propagation = PropagateCalibration(
@@ -264,6 +302,7 @@ PooledLocusEstimate PooledEstimateOf(const CalibratedLocusEstimate& estimate) {
   pooled.consistency = estimate.consistency;
   pooled.calibration = estimate.calibration;
   pooled.rotation = estimate.rotation;
+  pooled.focal_scale = estimate.focal_scale;
   return pooled;
 }
 
@@ -271,8 +310,7 @@ OnlineRefractiveIndexEstimator::OnlineRefractiveIndexEstimator(
     const StereoRig& rig, const RefinementOptions& options)
     : rig_(rig),
       options_(options),
-      normal_equations_(
-          CalibrationParameterLayout::Of(rig, options.systematic_px).Size()) {}
+      normal_equations_(SelfCalibrationLayout(rig, options).Size()) {}
 
 StatusOr<OnlineRefractiveIndexEstimator> OnlineRefractiveIndexEstimator::Create(
     const StereoRig& rig, const RefinementOptions& options) {
@@ -309,7 +347,7 @@ OnlineRefractiveIndexEstimator::AddFrame(
     }
     if (fit.model) {
       frame_estimates_.Add(fit.model->n, fit.model->information,
-                           fit.model->rotation_coupling);
+                           fit.model->coupling);
     }
     update.inliers = std::move(fit.inliers);
   }

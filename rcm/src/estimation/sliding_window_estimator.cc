@@ -44,8 +44,7 @@ SlidingWindowRefractiveIndexEstimator::SlidingWindowRefractiveIndexEstimator(
       options_(options),
       window_options_(window_options),
       window_(window_options.window_frames),
-      window_normal_equations_(
-          CalibrationParameterLayout::Of(rig, options.systematic_px).Size()) {
+      window_normal_equations_(SelfCalibrationLayout(rig, options).Size()) {
   pending_.reserve(window_options.confirm_frames);
 }
 
@@ -81,7 +80,7 @@ void SlidingWindowRefractiveIndexEstimator::ResumWindow() {
       window_normal_equations_.Add(frame.normal_equations);
     }
     window_estimates_.Add(frame.model.n, frame.model.information,
-                          frame.model.rotation_coupling);
+                          frame.model.coupling);
   }
 }
 
@@ -125,7 +124,11 @@ SlidingWindowRefractiveIndexEstimator::AddFrame(
     // With a self-calibrated window, the frame's own n at the window's
     // rotation (FrameFit::Model).
     LocusEstimate own = frame_cost.estimate;
-    if (window->rotation) own.n = frame_cost.model.At(*window->rotation);
+    if (window->rotation) {
+      own.n = frame_cost.model.At(SelfCalibrationOf(
+          *window->rotation,
+          window->focal_scale.value_or(Eigen::Vector2d::Zero())));
+    }
     update.z = ChangeStatistic(own, window->n, window->sigma_n_noise);
   }
   if (!update.z || *update.z <= window_options_.change_threshold) {

@@ -182,29 +182,43 @@ struct LocusNormalEquations {
   void Add(const LocusNormalEquations& other);
 };
 
-// Sums over frames of their own estimates n_f (cam1's rotation held), for
-// the consistency test of frames whose residuals are no longer at hand.
-// With G_f = sum (dr/dn)^2 and b_f = sum dr/dn dr/dw of the frame's
-// inliers, a frame's own estimate at the pooled rotation w is
-// n_f - b_f . w / G_f to first order, and
+// The unknowns self-calibrated beside n: cam1's rotation w (radians) and
+// the focal scales e = (e_l, e_r) (relative), zero where not estimated.
+using SelfCalibrationVector = Eigen::Matrix<double, 5, 1>;
+inline SelfCalibrationVector SelfCalibrationOf(
+    const Eigen::Vector3d& rotation,
+    const Eigen::Vector2d& focal_scale = Eigen::Vector2d::Zero()) {
+  SelfCalibrationVector x;
+  x << rotation, focal_scale;
+  return x;
+}
+
+// Sums over frames of their own estimates n_f (cam1's rotation and the
+// focal scales held), for the consistency test of frames whose residuals
+// are no longer at hand. With G_f = sum (dr/dn)^2 and b_f = sum dr/dn
+// dr/dx of the frame's inliers (x = (w, e), SelfCalibrationVector), a
+// frame's own estimate at the pooled x is n_f - b_f . x / G_f to first
+// order, and
 //
-//   chi^2 = sum_f G_f (n_f - b_f . w / G_f - n)^2 / sigma^2
+//   chi^2 = sum_f G_f (n_f - b_f . x / G_f - n)^2 / sigma^2
 //
 // expands into the sums kept here; the same test as the per-frame
 // FrameConsistencyOf to first order.
 struct FrameEstimateSums {
-  double s0 = 0.0;                               // sum G_f
-  double s1 = 0.0;                               // sum G_f n_f
-  double s2 = 0.0;                               // sum G_f n_f^2
-  Eigen::Vector3d b = Eigen::Vector3d::Zero();   // sum b_f
-  Eigen::Vector3d bn = Eigen::Vector3d::Zero();  // sum b_f n_f
-  Eigen::Matrix3d bb = Eigen::Matrix3d::Zero();  // sum b_f b_f^T / G_f
+  using Matrix = Eigen::Matrix<double, 5, 5>;
+  double s0 = 0.0;                                           // sum G_f
+  double s1 = 0.0;                                           // sum G_f n_f
+  double s2 = 0.0;                                           // sum G_f n_f^2
+  SelfCalibrationVector b = SelfCalibrationVector::Zero();   // sum b_f
+  SelfCalibrationVector bn = SelfCalibrationVector::Zero();  // sum b_f n_f
+  Matrix bb = Matrix::Zero();  // sum b_f b_f^T / G_f
   int frames = 0;
 
-  void Add(double n_f, double information,
-           const Eigen::Vector3d& rotation_coupling = Eigen::Vector3d::Zero());
-  // chi^2 sigma^2 above at (n, w).
-  double WeightedSquares(double n, const Eigen::Vector3d& rotation) const;
+  void Add(
+      double n_f, double information,
+      const SelfCalibrationVector& coupling = SelfCalibrationVector::Zero());
+  // chi^2 sigma^2 above at (n, x).
+  double WeightedSquares(double n, const SelfCalibrationVector& x) const;
 };
 
 // Adds the rows j_i of `matches[indices]` at (n, w) for `rig` in
@@ -225,25 +239,30 @@ void AccumulateLocusNormalEquations(
     LocusNormalEquations* equations,
     std::vector<LocusNormalEquations>* per_frame = nullptr);
 
-// The self-calibration of cam1's rotation on the quadratic model of
-// `equations` (their rows' affine models, gradient_intercept): the MAP
-// estimate of x = (n, w) with the prior P = rotation_covariance^-1,
+// The self-calibration of cam1's rotation (and, with the layout's focal
+// columns, of the focal scales) on the quadratic model of `equations`
+// (their rows' affine models, gradient_intercept): the MAP estimate of
+// x = (n, w[, e]) with the priors P_ww = rotation_covariance^-1 and
+// P_ee = I / focal_sigma^2,
 //
-//   x = -(M[n, w] + diag(0, sigma^2 P))^-1 intercept[n, w],
+//   x = -(M[x] + diag(0, sigma^2 P))^-1 intercept[x],
 //
-// with sigma^2 = (A + 2 intercept . x + x^T M x) / (N - 4) re-estimated
+// with sigma^2 = (A + 2 intercept . x + x^T M x) / (N - dim x) re-estimated
 // from the model's residual (N = equations.count) until it settles (a
-// few passes from `sigma_px`), and n held in [1, 2] (w then solved at the
-// bound). Used by the online estimators (online_estimator.h); the batch
-// refinement solves the nonlinear problem instead.
+// few passes from `sigma_px`), and n held in [1, 2] (the rest then solved
+// at the bound). Used by the online estimators (online_estimator.h); the
+// batch refinement solves the nonlinear problem instead.
 struct QuadraticSelfCalibration {
   double n = 1.0;
   Eigen::Vector3d rotation = Eigen::Vector3d::Zero();
+  Eigen::Vector2d focal_scale = Eigen::Vector2d::Zero();
   double sigma_px = 0.0;
 };
 QuadraticSelfCalibration SelfCalibrateQuadratic(
     const LocusNormalEquations& equations,
-    const Eigen::Matrix3d& rotation_covariance, double sigma_px);
+    const CalibrationParameterLayout& layout,
+    const Eigen::Matrix3d& rotation_covariance, double focal_sigma,
+    double sigma_px);
 
 // How cam1's rotation w is treated.
 enum class RotationMode {
@@ -271,11 +290,11 @@ struct FrameConsistency {
 // solution; nullopt for fewer than two frames with information on n.
 std::optional<FrameConsistency> FrameConsistencyOf(
     const std::vector<LocusNormalEquations>& per_frame, double sigma_px);
-// From the frames' own estimates at the pooled n and rotation w (zero when
-// it is held); nullopt for fewer than two frames.
+// From the frames' own estimates at the pooled n and x = (w, e) (zero
+// where held); nullopt for fewer than two frames.
 std::optional<FrameConsistency> FrameConsistencyOf(
     const FrameEstimateSums& sums, double n, double sigma_px,
-    const Eigen::Vector3d& rotation = Eigen::Vector3d::Zero());
+    const SelfCalibrationVector& x = SelfCalibrationVector::Zero());
 // P(chi^2_dof > chi_squared), Wilson-Hilferty; dof >= 1.
 double ChiSquaredUpperTail(double chi_squared, int dof);
 

@@ -45,7 +45,8 @@
 // LocusCostFunction::kNumNodes residual evaluations per inlier, plus two
 // 1-D minimizations of interpolants that do not depend on the data size:
 // measured 1.7 ms per frame of 200 matches (estimation_benchmark), about
-// half of it in the cost function's evaluations. State: a fixed number of doubles.
+// half of it in the cost function's evaluations. State: a fixed number of
+// doubles.
 #ifndef RCM_ESTIMATION_ONLINE_ESTIMATOR_H_
 #define RCM_ESTIMATION_ONLINE_ESTIMATOR_H_
 
@@ -99,6 +100,9 @@ struct PooledLocusEstimate {
   // The self-calibrated rotation of cam1 (angle-axis, radians, the
   // convention of StereoRig::WithCam1Moved), when it is estimated.
   std::optional<Eigen::Vector3d> rotation;
+  // The self-calibrated focal scales (e_l, e_r), relative, when they are
+  // estimated (SelfCalibrationLayout).
+  std::optional<Eigen::Vector2d> focal_scale;
 };
 
 // A LocusEstimate with the uncertainty of the calibration and the frames'
@@ -123,13 +127,12 @@ struct PooledLocusEstimate {
 // near the frames' own estimates, not over all of [1, 2] (far away its
 // concave quadratic would win), so the minimum is searched within 0.15
 // of the estimate with the rotation held, the interval moved along (up to
-// three times) while the minimum sits on one of its inner ends. The neglected second
-// order in w is ~f |w|^2 / 2 in pixels (0.002 px at 0.15 degree and
-// f = 500 px). Inliers are the frames' own, classified with the rotation
-// held, so a drift that moves matches beyond the inlier threshold
-// (about inlier_threshold / f radians) loses them: the batch refinement
-// classifies with the rotation estimated. Otherwise the rotation is held
-// and its uncertainty propagated.
+// three times) while the minimum sits on one of its inner ends. The neglected
+// second order in w is ~f |w|^2 / 2 in pixels (0.002 px at 0.15 degree and f =
+// 500 px). Inliers are the frames' own, classified with the rotation held, so a
+// drift that moves matches beyond the inlier threshold (about inlier_threshold
+// / f radians) loses them: the batch refinement classifies with the rotation
+// estimated. Otherwise the rotation is held and its uncertainty propagated.
 struct CalibratedLocusEstimate {
   double sigma_n_systematic = 0.0;  // options.systematic_px's share
   // n, sigma_px and crlb at the solution (n alone, or with the rotation);
@@ -138,6 +141,9 @@ struct CalibratedLocusEstimate {
   // The self-calibrated rotation of cam1 (angle-axis, radians, the
   // convention of StereoRig::WithCam1Moved), when it is estimated.
   std::optional<Eigen::Vector3d> rotation;
+  // The self-calibrated focal scales (e_l, e_r), relative, when they are
+  // estimated (SelfCalibrationLayout).
+  std::optional<Eigen::Vector2d> focal_scale;
   double sigma_n = 0.0;
   double sigma_n_noise = 0.0;
   double sigma_n_calibration = 0.0;
@@ -148,11 +154,17 @@ struct CalibratedLocusEstimate {
 // without a calibration uncertainty ignores the former. An n pinned at the
 // upper bound is an error (CheckNotPinnedAtUpperBound), never a number.
 bool SelfCalibrates(const StereoRig& rig, const RefinementOptions& options);
+// The layout of the frames' normal equations (calibration_propagation.h):
+// with self-calibration (SelfCalibrates) and options.self_calibrate_focal,
+// the focal scales' columns when the rig has a focal drift prior, so that
+// the online estimators estimate them with n and the rotation as the
+// batch refinement does.
+CalibrationParameterLayout SelfCalibrationLayout(
+    const StereoRig& rig, const RefinementOptions& options);
 StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
     const StereoRig& rig, const LocusCostFunction& cost,
     const LocusNormalEquations& normal_equations,
-    const FrameEstimateSums& frame_estimates,
-    const RefinementOptions& options);
+    const FrameEstimateSums& frame_estimates, const RefinementOptions& options);
 // Its fields as the estimators report them.
 PooledLocusEstimate PooledEstimateOf(const CalibratedLocusEstimate& estimate);
 
@@ -167,11 +179,13 @@ struct FrameFit {
   // n_f, sigma_f from C_f, G_f alone; the error says why there is none.
   StatusOr<LocusEstimate> estimate = Status::Error("frame not fitted");
   // With a rig that has a calibration uncertainty: the inliers' normal
-  // equations (calibration_propagation.h) at n_f (n_robust without an own
-  // estimate) and cam1's rotation held; empty (all zero) otherwise.
+  // equations (calibration_propagation.h, SelfCalibrationLayout) at n_f
+  // (n_robust without an own estimate) and the frame's own self-calibrated
+  // rotation and focal scales (the lenses scaled by them); empty (all
+  // zero) otherwise.
   LocusNormalEquations normal_equations;
-  // The frame's own n as the consistency test sees it, n_f(w) = n - b .
-  // w / information to first order in cam1's rotation w (FrameEstimateSums,
+  // The frame's own n as the consistency test sees it, n_f(x) = n - b .
+  // x / information to first order in x = (w, e) (FrameEstimateSums,
   // calibration_propagation.h): from normal_equations' model when there is
   // one (linearized at the frame's own self-calibrated estimate), else the
   // own estimate with C_f's information and b = 0. Unset without an own
@@ -179,10 +193,10 @@ struct FrameFit {
   struct Model {
     double n = 0.0;
     double information = 0.0;
-    Eigen::Vector3d rotation_coupling = Eigen::Vector3d::Zero();
-    double At(const Eigen::Vector3d& rotation) const {
-      return information > 0.0 ? n - rotation_coupling.dot(rotation) / information
-                               : n;
+    // b = sum dr/dn dr/dx, x = (w, e) (SelfCalibrationVector).
+    SelfCalibrationVector coupling = SelfCalibrationVector::Zero();
+    double At(const SelfCalibrationVector& x) const {
+      return information > 0.0 ? n - coupling.dot(x) / information : n;
     }
   };
   std::optional<Model> model;
