@@ -8,8 +8,9 @@
 namespace rcm {
 namespace {
 
-// Stops the solver once *n has been on a bound for `pinned` iterations in
-// a row (the parameters are updated every iteration).
+// Stops the solver once *n has been within kPinnedDistance of a bound for
+// `pinned` iterations in a row (the parameters are updated every
+// iteration).
 class PinnedIndexCallback : public ceres::IterationCallback {
  public:
   PinnedIndexCallback(const double* n, double lower, double upper, int pinned)
@@ -17,8 +18,9 @@ class PinnedIndexCallback : public ceres::IterationCallback {
 
   ceres::CallbackReturnType operator()(
       const ceres::IterationSummary& /*summary*/) override {
-    // Ceres' projection puts n exactly on the bound.
-    on_bound_ = (*n_ == lower_ || *n_ == upper_) ? on_bound_ + 1 : 0;
+    const bool near_bound = *n_ - lower_ <= kPinnedDistance ||
+                            upper_ - *n_ <= kPinnedDistance;
+    on_bound_ = near_bound ? on_bound_ + 1 : 0;
     if (on_bound_ >= pinned_) {
       stopped_ = true;
       return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
@@ -48,15 +50,15 @@ ceres::Solver::Summary SolveWithBoundedIndex(
   first.callbacks.push_back(&callback);
   ceres::Solver::Summary summary;
   ceres::Solve(first, problem, &summary);
-  const bool on_bound = *n == lower || *n == upper;
-  if (!summary.IsSolutionUsable() || !callback.stopped() || !on_bound ||
+  if (!summary.IsSolutionUsable() || !callback.stopped() ||
       problem->IsParameterBlockConstant(n)) {
     return summary;
   }
   std::vector<ceres::IterationSummary> iterations = summary.iterations;
 
   // 2. n held on its bound, the other parameters solved.
-  const bool at_lower = *n == lower;
+  const bool at_lower = *n - lower <= upper - *n;
+  *n = at_lower ? lower : upper;
   if (problem->NumParameterBlocks() > 1) {
     problem->SetParameterBlockConstant(n);
     ceres::Solver::Summary held;
