@@ -517,6 +517,7 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
       options.n_prior) {
     summary.calibration = *propagation;
   }
+  summary.normal_equations = std::move(equations);
 
   // An estimate pinned at the upper bound is a failure, not a number.
   RCM_RETURN_IF_ERROR(CheckNotPinnedAtUpperBound(summary.n, summary.sigma_n));

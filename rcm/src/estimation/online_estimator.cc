@@ -77,6 +77,8 @@ FrameFit FitFrame(const StereoRig& rig,
   StereoRig frame_rig = rig;    // the lenses at the frame's focal scales
   bool own_lenses = false;      // frame_rig's are not the calibration's
   std::vector<int64_t> chosen;  // indices into prepared.prepared
+  // The refinement's normal equations over its inliers (`chosen`).
+  std::optional<LocusNormalEquations> own_equations;
   if (SelfCalibrates(rig, options)) {
     RefinementOptions frame_options = options;
     frame_options.self_calibrate_focal = layout.focal;
@@ -108,9 +110,13 @@ FrameFit FitFrame(const StereoRig& rig,
           chosen.push_back(static_cast<int64_t>(i));
         }
       }
+      if (chosen.size() == own->inliers.size()) {
+        own_equations = own->normal_equations;
+      }
     }
   }
   if (chosen.empty()) {
+    own_equations.reset();
     rotation.setZero();
     focal_scale.setZero();
     extrinsics = rig.right_from_left();
@@ -153,7 +159,13 @@ FrameFit FitFrame(const StereoRig& rig,
 
   // The calibration's share and the self-calibration need the inliers'
   // normal equations, taken at the frame's own estimate.
-  if (rig.calibration_uncertainty() || options.systematic_px > 0.0) {
+  // The refinement's, when the frame keeps all its inliers (the rows are
+  // the same; the refinement took them at its own n, which the intercepts
+  // carry to first order); else taken here.
+  if (own_equations && rejected.empty() &&
+      own_equations->information.rows() == layout.Size()) {
+    fit.normal_equations = *std::move(own_equations);
+  } else if (rig.calibration_uncertainty() || options.systematic_px > 0.0) {
     fit.normal_equations = LocusNormalEquations(layout.Size());
     std::vector<StereoCorrespondence> raw;
     raw.reserve(fit.inliers.size());

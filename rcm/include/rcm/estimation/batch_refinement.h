@@ -121,6 +121,10 @@ struct RefinementSummary {
   std::optional<CalibrationPropagation> calibration;
   // The frames' agreement, with two or more frames.
   std::optional<FrameConsistency> consistency;
+  // The inliers' normal equations at the solution, over the layout of the
+  // propagation (thin ports; calibration_propagation.h), for callers that
+  // pool refinements (the online estimators' frames).
+  std::optional<LocusNormalEquations> normal_equations;
 };
 
 // A rig with a thick port (StereoRig::HasThickPort, from a camchain's port
