@@ -29,6 +29,14 @@
 // with too few inliers or too little information for an estimate of its
 // own still adds its inliers to the running sums, as the batch would.
 //
+// With self-calibration (SelfCalibrates), each frame is fitted by the batch
+// refinement of that frame (cam1's rotation and, with a focal drift prior,
+// the focal scales, each under its prior), its normal equations taken at
+// its own estimate on its own scaled lenses, and the pooled estimate is
+// the MAP of the frames' quadratic models (SelfCalibrateQuadratic over
+// x = (n, w, e)); the frames' consistency test couples each frame's n to
+// (w, e) (FrameEstimateSums).
+//
 // Equivalence with the batch (RefineRefractiveIndex on all frames' matches
 // at once): the batch classifies inliers at its global robust estimate,
 // this estimator at each frame's own. The two inlier sets coincide unless a

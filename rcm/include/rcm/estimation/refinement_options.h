@@ -87,9 +87,10 @@ struct RefinementOptions {
   // focal_drift_sigma > 0, the default of an air calibration), estimate
   // each camera's focal scale (1 + e) with n, the prior N(0, s_f^2) on each
   // e (batch_refinement.h). false: the focal lengths are held at the
-  // calibration's and the prior only propagated into sigma_n. The batch
-  // refinement of thin ports only; the online estimators and the thick
-  // port's refinement propagate it.
+  // calibration's and the prior only propagated into sigma_n. Thin ports:
+  // the batch refinement, and the online estimators (with
+  // self_calibrate_rotation, on the frames' quadratic models); the thick
+  // port's refinement propagates it.
   bool self_calibrate_focal = true;
   // A systematic error floor of the matches, pixels, >= 0
   // (calibration_propagation.h): the standard deviation of each
