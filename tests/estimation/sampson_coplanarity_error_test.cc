@@ -4,6 +4,7 @@
 #include <ceres/rotation.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <random>
@@ -198,6 +199,84 @@ TEST(SampsonCoplanarityError, CeresJacobianMatchesCentralDifferences) {
       EXPECT_NEAR(analytic[k], numeric,
                   kTolerance * std::max(1.0, std::abs(numeric)))
           << "parameter " << k;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace rcm
+
+namespace rcm {
+namespace {
+
+// PrepareCorrespondenceSide is PrepareCorrespondence's half for one
+// camera, bit for bit, and leaves the other half as it was.
+TEST(PreparedCorrespondence, OneSideIsTheSameHalfAndLeavesTheOther) {
+  for (const StereoRig& rig : TestRigs()) {
+    for (const StereoCorrespondence& match :
+         test::ExactMatches(rig, 1.333, 50)) {
+      const PreparedCorrespondence both =
+          PrepareCorrespondence(rig, match).value();
+      PreparedCorrespondence left = both;
+      std::fill_n(left.left_normalized, 2, -7.0);
+      std::fill_n(left.left_normalized_from_pixel, 4, -7.0);
+      std::fill_n(left.left_focal_direction, 2, -7.0);
+      std::fill_n(left.left_normalized_from_pixel_focal, 4, -7.0);
+      ASSERT_TRUE(
+          PrepareCorrespondenceSide(rig.left(), match.left_pixel, 0, &left));
+      PreparedCorrespondence right = both;
+      std::fill_n(right.right_normalized, 2, -7.0);
+      std::fill_n(right.right_normalized_from_pixel, 4, -7.0);
+      ASSERT_TRUE(
+          PrepareCorrespondenceSide(rig.right(), match.right_pixel, 1, &right));
+      for (const PreparedCorrespondence* side : {&left, &right}) {
+        for (int k = 0; k < 2; ++k) {
+          EXPECT_EQ(side->left_normalized[k], both.left_normalized[k]);
+          EXPECT_EQ(side->right_normalized[k], both.right_normalized[k]);
+          EXPECT_EQ(side->left_focal_direction[k],
+                    both.left_focal_direction[k]);
+          EXPECT_EQ(side->right_focal_direction[k],
+                    both.right_focal_direction[k]);
+        }
+        for (int k = 0; k < 4; ++k) {
+          EXPECT_EQ(side->left_normalized_from_pixel[k],
+                    both.left_normalized_from_pixel[k]);
+          EXPECT_EQ(side->right_normalized_from_pixel[k],
+                    both.right_normalized_from_pixel[k]);
+          EXPECT_EQ(side->left_normalized_from_pixel_focal[k],
+                    both.left_normalized_from_pixel_focal[k]);
+          EXPECT_EQ(side->right_normalized_from_pixel_focal[k],
+                    both.right_normalized_from_pixel_focal[k]);
+        }
+      }
+    }
+  }
+}
+
+TEST(PreparedCorrespondence, OneSideRejectsAPixelThatDoesNotPrepare) {
+  const StereoRig rig = test::AlphasenseRealisticRig();
+  PreparedCorrespondence prepared;
+  EXPECT_FALSE(PrepareCorrespondenceSide(rig.left(), Eigen::Vector2d(NAN, 10.0),
+                                         0, &prepared));
+  EXPECT_FALSE(PrepareCorrespondenceSide(
+      rig.right(), Eigen::Vector2d(1e9, -1e9), 1, &prepared));
+}
+
+// The focal derivatives with the stepped rigs made once are those made per
+// match.
+TEST(PreparedCorrespondence, FocalStepRigsMadeOnceGiveTheSameDerivatives) {
+  const StereoRig rig = test::AlphasenseRealisticRig();
+  const FocalStepRigs steps = FocalStepRigs::Of(rig).value();
+  for (const StereoCorrespondence& match : test::ExactMatches(rig, 1.333, 20)) {
+    PreparedCorrespondence once = PrepareCorrespondence(rig, match).value();
+    PreparedCorrespondence each = once;
+    ASSERT_TRUE(PrepareFocalDerivatives(steps, match, &once));
+    ASSERT_TRUE(PrepareFocalDerivatives(rig, match, &each));
+    for (int k = 0; k < 4; ++k) {
+      EXPECT_EQ(once.left_normalized_from_pixel_focal[k],
+                each.left_normalized_from_pixel_focal[k]);
+      EXPECT_EQ(once.right_normalized_from_pixel_focal[k],
+                each.right_normalized_from_pixel_focal[k]);
     }
   }
 }

@@ -107,6 +107,12 @@ void PrepareWithFocalScale(
     std::vector<PreparedCorrespondence>* matches) {
   const StatusOr<StereoRig> scaled = rig.WithFocalScaled(scale[0], scale[1]);
   if (!scaled.ok()) return;
+  std::optional<FocalStepRigs> steps;  // made once, not per match
+  if (derivatives) {
+    StatusOr<FocalStepRigs> made = FocalStepRigs::Of(*scaled);
+    if (!made.ok()) return;
+    steps = *std::move(made);
+  }
   for (size_t i = 0; i < matches->size(); ++i) {
     const StereoCorrespondence& correspondence =
         correspondences[source_index[i]];
@@ -115,7 +121,7 @@ void PrepareWithFocalScale(
     if (!prepared) continue;
     PreparedCorrespondence& match = (*matches)[i];
     if (derivatives) {
-      if (!PrepareFocalDerivatives(*scaled, correspondence, &*prepared)) {
+      if (!PrepareFocalDerivatives(*steps, correspondence, &*prepared)) {
         continue;
       }
     } else {

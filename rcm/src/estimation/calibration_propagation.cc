@@ -47,10 +47,12 @@ std::optional<Camera> MovedCamera(const Camera& camera, int index,
   return *moved;
 }
 
-// One finite-difference column: the rig moved both ways and the step.
+// One finite-difference column: one camera's lens (side 0: left, 1:
+// right) moved both ways, and the step.
 struct Difference {
-  std::optional<StereoRig> plus;
-  std::optional<StereoRig> minus;
+  int side = 0;
+  std::optional<Camera> plus;
+  std::optional<Camera> minus;
   double step = 0.0;
 };
 
@@ -62,18 +64,10 @@ std::vector<Difference> LensDifferences(
     const int count = c == 0 ? layout.num_left_lens : layout.num_right_lens;
     for (int j = 0; j < count; ++j) {
       Difference difference;
+      difference.side = c;
       difference.step = kLensStepScale * (1.0 + std::abs(camera.params()[j]));
-      for (const double sign : {1.0, -1.0}) {
-        const std::optional<Camera> moved =
-            MovedCamera(camera, j, sign * difference.step);
-        if (!moved) continue;
-        StatusOr<StereoRig> moved_rig =
-            c == 0
-                ? StereoRig::Create(*moved, rig.right(), rig.right_from_left())
-                : StereoRig::Create(rig.left(), *moved, rig.right_from_left());
-        if (!moved_rig.ok()) continue;
-        (sign > 0.0 ? difference.plus : difference.minus) = *moved_rig;
-      }
+      difference.plus = MovedCamera(camera, j, difference.step);
+      difference.minus = MovedCamera(camera, j, -difference.step);
       differences.push_back(std::move(difference));
     }
   }
@@ -207,15 +201,20 @@ void AccumulateLocusNormalEquations(
       }
     }
     for (size_t j = 0; j < lens.size() && defined; ++j) {
+      // The match with the moved camera's half prepared again (the other
+      // camera's is the match's own).
       double values[2];
       for (int s = 0; s < 2 && defined; ++s) {
-        const std::optional<StereoRig>& moved_rig =
+        const std::optional<Camera>& moved_camera =
             s == 0 ? lens[j].plus : lens[j].minus;
-        const std::optional<PreparedCorrespondence> prepared =
-            moved_rig ? PrepareCorrespondence(*moved_rig, raw[i])
-                      : std::nullopt;
-        defined = prepared.has_value() &&
-                  model.Residual(*prepared, n, &values[s], nullptr);
+        PreparedCorrespondence prepared = match;
+        defined =
+            moved_camera.has_value() &&
+            PrepareCorrespondenceSide(
+                *moved_camera,
+                lens[j].side == 0 ? raw[i].left_pixel : raw[i].right_pixel,
+                lens[j].side, &prepared) &&
+            model.Residual(prepared, n, &values[s], nullptr);
       }
       if (defined) {
         row[layout.LeftLens() + static_cast<int>(j)] =

@@ -26,75 +26,87 @@ bool NormalizedFromPixelJacobian(const Camera& camera,
 
 }  // namespace
 
+bool PrepareCorrespondenceSide(const Camera& camera,
+                               const Eigen::Vector2d& pixel, int side,
+                               PreparedCorrespondence* prepared) {
+  double* normalized =
+      side == 0 ? prepared->left_normalized : prepared->right_normalized;
+  double* normalized_from_pixel = side == 0
+                                      ? prepared->left_normalized_from_pixel
+                                      : prepared->right_normalized_from_pixel;
+  double* focal_direction = side == 0 ? prepared->left_focal_direction
+                                      : prepared->right_focal_direction;
+  double* normalized_from_pixel_focal =
+      side == 0 ? prepared->left_normalized_from_pixel_focal
+                : prepared->right_normalized_from_pixel_focal;
+  Eigen::Vector2d point;
+  if (!pixel.allFinite() ||
+      !camera.NormalizedFromImage(pixel.data(), point.data()) ||
+      !point.allFinite()) {
+    return false;
+  }
+  double jacobian[4];
+  if (!NormalizedFromPixelJacobian(camera, point, jacobian)) return false;
+  normalized[0] = point.x();
+  normalized[1] = point.y();
+  // d(x, y)/de (the header).
+  const double du = pixel.x() - camera.params()[2];
+  const double dv = pixel.y() - camera.params()[3];
+  focal_direction[0] = -(jacobian[0] * du + jacobian[1] * dv);
+  focal_direction[1] = -(jacobian[2] * du + jacobian[3] * dv);
+  for (int k = 0; k < 4; ++k) {
+    normalized_from_pixel[k] = jacobian[k];
+    normalized_from_pixel_focal[k] = -jacobian[k];
+  }
+  return true;
+}
+
 std::optional<PreparedCorrespondence> PrepareCorrespondence(
     const StereoRig& rig, const StereoCorrespondence& correspondence) {
-  const std::optional<NormalizedCorrespondence> normalized =
-      rig.Normalize(correspondence);
-  if (!normalized || !normalized->left.allFinite() ||
-      !normalized->right.allFinite()) {
-    return std::nullopt;
-  }
   PreparedCorrespondence prepared;
-  prepared.left_normalized[0] = normalized->left.x();
-  prepared.left_normalized[1] = normalized->left.y();
-  prepared.right_normalized[0] = normalized->right.x();
-  prepared.right_normalized[1] = normalized->right.y();
-  if (!NormalizedFromPixelJacobian(rig.left(), normalized->left,
-                                   prepared.left_normalized_from_pixel) ||
-      !NormalizedFromPixelJacobian(rig.right(), normalized->right,
-                                   prepared.right_normalized_from_pixel)) {
+  if (!PrepareCorrespondenceSide(rig.left(), correspondence.left_pixel, 0,
+                                 &prepared) ||
+      !PrepareCorrespondenceSide(rig.right(), correspondence.right_pixel, 1,
+                                 &prepared)) {
     return std::nullopt;
-  }
-  // d(x, y)/de (the header).
-  const auto focal_direction =
-      [](const Camera& camera, const Eigen::Vector2d& pixel,
-         const double* normalized_from_pixel, double* direction) {
-        const double du = pixel.x() - camera.params()[2];
-        const double dv = pixel.y() - camera.params()[3];
-        direction[0] =
-            -(normalized_from_pixel[0] * du + normalized_from_pixel[1] * dv);
-        direction[1] =
-            -(normalized_from_pixel[2] * du + normalized_from_pixel[3] * dv);
-      };
-  focal_direction(rig.left(), correspondence.left_pixel,
-                  prepared.left_normalized_from_pixel,
-                  prepared.left_focal_direction);
-  focal_direction(rig.right(), correspondence.right_pixel,
-                  prepared.right_normalized_from_pixel,
-                  prepared.right_focal_direction);
-  for (int k = 0; k < 4; ++k) {
-    prepared.left_normalized_from_pixel_focal[k] =
-        -prepared.left_normalized_from_pixel[k];
-    prepared.right_normalized_from_pixel_focal[k] =
-        -prepared.right_normalized_from_pixel[k];
   }
   return prepared;
 }
 
-bool PrepareFocalDerivatives(const StereoRig& rig,
+StatusOr<FocalStepRigs> FocalStepRigs::Of(const StereoRig& rig) {
+  StatusOr<StereoRig> plus = rig.WithFocalScaled(kStep, kStep);
+  if (!plus.ok()) return plus.status();
+  StatusOr<StereoRig> minus = rig.WithFocalScaled(-kStep, -kStep);
+  if (!minus.ok()) return minus.status();
+  return FocalStepRigs{*std::move(plus), *std::move(minus)};
+}
+
+bool PrepareFocalDerivatives(const FocalStepRigs& rigs,
                              const StereoCorrespondence& correspondence,
                              PreparedCorrespondence* prepared) {
-  constexpr double kFocalStep = 1e-6;
-  const StatusOr<StereoRig> plus = rig.WithFocalScaled(kFocalStep, kFocalStep);
-  const StatusOr<StereoRig> minus =
-      rig.WithFocalScaled(-kFocalStep, -kFocalStep);
-  if (!plus.ok() || !minus.ok()) return false;
   const std::optional<PreparedCorrespondence> up =
-      PrepareCorrespondence(*plus, correspondence);
+      PrepareCorrespondence(rigs.plus, correspondence);
   const std::optional<PreparedCorrespondence> down =
-      PrepareCorrespondence(*minus, correspondence);
+      PrepareCorrespondence(rigs.minus, correspondence);
   if (!up || !down) return false;
   for (int k = 0; k < 4; ++k) {
     prepared->left_normalized_from_pixel_focal[k] =
         (up->left_normalized_from_pixel[k] -
          down->left_normalized_from_pixel[k]) /
-        (2.0 * kFocalStep);
+        (2.0 * FocalStepRigs::kStep);
     prepared->right_normalized_from_pixel_focal[k] =
         (up->right_normalized_from_pixel[k] -
          down->right_normalized_from_pixel[k]) /
-        (2.0 * kFocalStep);
+        (2.0 * FocalStepRigs::kStep);
   }
   return true;
+}
+
+bool PrepareFocalDerivatives(const StereoRig& rig,
+                             const StereoCorrespondence& correspondence,
+                             PreparedCorrespondence* prepared) {
+  const StatusOr<FocalStepRigs> rigs = FocalStepRigs::Of(rig);
+  return rigs.ok() && PrepareFocalDerivatives(*rigs, correspondence, prepared);
 }
 
 PreparedCorrespondences PrepareCorrespondences(

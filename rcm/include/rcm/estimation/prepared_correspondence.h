@@ -12,6 +12,7 @@
 
 #include "rcm/geometry/stereo_correspondence.h"
 #include "rcm/geometry/stereo_rig.h"
+#include "rcm/util/status.h"
 
 namespace rcm {
 
@@ -44,6 +45,15 @@ struct PreparedCorrespondence {
 std::optional<PreparedCorrespondence> PrepareCorrespondence(
     const StereoRig& rig, const StereoCorrespondence& correspondence);
 
+// One camera's half of PrepareCorrespondence (side 0: left, 1: right),
+// written into `prepared`, the other half untouched: the lens columns of
+// the propagation move one camera's parameters at a time
+// (calibration_propagation.h). False, `prepared` partly written, where
+// PrepareCorrespondence would give nullopt for this side.
+bool PrepareCorrespondenceSide(const Camera& camera,
+                               const Eigen::Vector2d& pixel, int side,
+                               PreparedCorrespondence* prepared);
+
 // The derivatives in e of `prepared`'s inverse lens Jacobians for any lens
 // model, by central differences of the preparation on `rig` with the focal
 // lengths scaled by 1 +- kFocalStep (the undistortion converges to ~1e-14,
@@ -51,6 +61,19 @@ std::optional<PreparedCorrespondence> PrepareCorrespondence(
 // derivative). False (and `prepared` unchanged) where a moved pixel does
 // not prepare.
 bool PrepareFocalDerivatives(const StereoRig& rig,
+                             const StereoCorrespondence& correspondence,
+                             PreparedCorrespondence* prepared);
+
+// The rig with both cameras' focal lengths scaled by 1 +- kStep, made once
+// for many PrepareFocalDerivatives (making a camera checks its lens, which
+// costs more than preparing a match).
+struct FocalStepRigs {
+  static constexpr double kStep = 1e-6;
+  static StatusOr<FocalStepRigs> Of(const StereoRig& rig);
+  StereoRig plus;
+  StereoRig minus;
+};
+bool PrepareFocalDerivatives(const FocalStepRigs& rigs,
                              const StereoCorrespondence& correspondence,
                              PreparedCorrespondence* prepared);
 
