@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "rcm/io/stereo_rig_file.h"
@@ -39,25 +40,30 @@ const StereoRig& LiveRig() {
   return rig;
 }
 
-// kPairs rendered pairs in the medium of index n (1: air, where the robot
-// starts, and where n sits at the bound of [1, 2]; 1.333: water).
-std::vector<SequenceFrame> RenderPairs(double n) {
+// The rendered pairs of a simulated sequence through `media`.
+std::vector<SequenceFrame> RenderPairs(std::vector<MediaSegment> media) {
   SequenceOptions options;
-  options.media = {MediaSegment{n, kPairs}};
+  options.media = std::move(media);
+  int frames = 0;
+  for (const MediaSegment& segment : options.media) frames += segment.frames;
   std::unique_ptr<SequenceSimulator> simulator =
       SequenceSimulator::Create(AlphasenseFrontRectifiedRig(), options).value();
   std::vector<SequenceFrame> out;
-  for (int i = 0; i < kPairs; ++i) out.push_back(simulator->Frame(i).value());
+  for (int i = 0; i < frames; ++i) out.push_back(simulator->Frame(i).value());
   return out;
 }
 
+// kPairs pairs in air (where the robot starts, and where n sits at the
+// bound of [1, 2]) and in water.
 const std::vector<SequenceFrame>& WaterPairs() {
-  static const std::vector<SequenceFrame> frames = RenderPairs(1.333);
+  static const std::vector<SequenceFrame> frames =
+      RenderPairs({MediaSegment{1.333, kPairs}});
   return frames;
 }
 
 const std::vector<SequenceFrame>& AirPairs() {
-  static const std::vector<SequenceFrame> frames = RenderPairs(1.0);
+  static const std::vector<SequenceFrame> frames =
+      RenderPairs({MediaSegment{1.0, kPairs}});
   return frames;
 }
 
@@ -97,17 +103,8 @@ BENCHMARK(BM_LivePipelinePair)
 // decide whether a live node keeps up (the mean hides the pairs around a
 // change of medium, when the window restarts).
 void BM_LiveAirWaterAirSequence(benchmark::State& state) {
-  static const std::vector<SequenceFrame> frames = [] {
-    SequenceOptions options;
-    options.media = {MediaSegment{1.0, 6}, MediaSegment{1.333, 10},
-                     MediaSegment{1.0, 6}};
-    std::unique_ptr<SequenceSimulator> simulator =
-        SequenceSimulator::Create(AlphasenseFrontRectifiedRig(), options)
-            .value();
-    std::vector<SequenceFrame> out;
-    for (int i = 0; i < 22; ++i) out.push_back(simulator->Frame(i).value());
-    return out;
-  }();
+  static const std::vector<SequenceFrame> frames = RenderPairs(
+      {MediaSegment{1.0, 6}, MediaSegment{1.333, 10}, MediaSegment{1.0, 6}});
   double worst_estimate_ms = 0.0;
   double worst_match_ms = 0.0;
   for (auto _ : state) {

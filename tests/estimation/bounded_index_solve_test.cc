@@ -57,52 +57,61 @@ LinearProblem ProblemWithMinimumAt(double n_free) {
   return p;
 }
 
-void Build(const LinearProblem& p, double* n, double* w,
-           ceres::Problem* problem) {
+// Which block the caller holds constant.
+enum class Held { kNone, kW, kN };
+
+struct Solved {
+  double n = 0.0;
+  Eigen::Vector2d w = Eigen::Vector2d::Zero();
+  ceres::Solver::Summary summary;
+  bool n_constant_after = false;  // n's block still constant afterwards
+};
+
+// Solves `p` from (n, w) with n bounded to [1, 2], by SolveWithBoundedIndex
+// with the refinement's solver options.
+Solved SolveFrom(const LinearProblem& p, double n, const Eigen::Vector2d& w,
+                 Held held = Held::kNone,
+                 int pinned_iterations = kPinnedIterations) {
+  Solved solved;
+  solved.n = n;
+  solved.w = w;
+  ceres::Problem problem;
   for (int i = 0; i < 6; ++i) {
-    problem->AddResidualBlock(
-        LinearResidual::Create(p.a.row(i).transpose(), p.b[i]), nullptr, n, w);
+    problem.AddResidualBlock(
+        LinearResidual::Create(p.a.row(i).transpose(), p.b[i]), nullptr,
+        &solved.n, solved.w.data());
   }
-  problem->SetParameterLowerBound(n, 0, 1.0);
-  problem->SetParameterUpperBound(n, 0, 2.0);
+  problem.SetParameterLowerBound(&solved.n, 0, 1.0);
+  problem.SetParameterUpperBound(&solved.n, 0, 2.0);
+  if (held == Held::kW) problem.SetParameterBlockConstant(solved.w.data());
+  if (held == Held::kN) problem.SetParameterBlockConstant(&solved.n);
+  RefinementOptions refinement;
+  solved.summary =
+      SolveWithBoundedIndex(RefinementSolverOptions(refinement), &problem,
+                            &solved.n, 1.0, 2.0, pinned_iterations);
+  solved.n_constant_after = problem.IsParameterBlockConstant(&solved.n);
+  return solved;
 }
 
-ceres::Solver::Options Options() {
-  RefinementOptions refinement;
-  return RefinementSolverOptions(refinement);
+// n exactly on `bound`, w the least squares of the rest there.
+void ExpectConstrainedMinimum(const LinearProblem& p, double bound,
+                              const Solved& solved) {
+  ASSERT_TRUE(solved.summary.IsSolutionUsable()) << solved.summary.message;
+  const Eigen::Vector2d w_expected =
+      p.a.rightCols<2>().colPivHouseholderQr().solve(p.b - bound * p.a.col(0));
+  EXPECT_EQ(solved.n, bound);
+  EXPECT_NEAR(solved.w[0], w_expected[0], kExactTolerance);
+  EXPECT_NEAR(solved.w[1], w_expected[1], kExactTolerance);
 }
 
 TEST(BoundedIndexSolve, MinimumBelowTheLowerBoundEndsOnItExactly) {
   const LinearProblem p = ProblemWithMinimumAt(0.97);
-  double n = 1.2;
-  double w[2] = {0.0, 0.0};
-  ceres::Problem problem;
-  Build(p, &n, w, &problem);
-  const ceres::Solver::Summary summary =
-      SolveWithBoundedIndex(Options(), &problem, &n, 1.0, 2.0);
-  ASSERT_TRUE(summary.IsSolutionUsable()) << summary.message;
-  // The constrained minimum: n = 1, w the least squares of the rest.
-  const Eigen::Vector2d w_expected =
-      p.a.rightCols<2>().colPivHouseholderQr().solve(p.b - p.a.col(0));
-  EXPECT_EQ(n, 1.0);
-  EXPECT_NEAR(w[0], w_expected[0], kExactTolerance);
-  EXPECT_NEAR(w[1], w_expected[1], kExactTolerance);
+  ExpectConstrainedMinimum(p, 1.0, SolveFrom(p, 1.2, {0.0, 0.0}));
 }
 
 TEST(BoundedIndexSolve, MinimumAboveTheUpperBoundEndsOnItExactly) {
   const LinearProblem p = ProblemWithMinimumAt(2.05);
-  double n = 1.5;
-  double w[2] = {0.0, 0.0};
-  ceres::Problem problem;
-  Build(p, &n, w, &problem);
-  const ceres::Solver::Summary summary =
-      SolveWithBoundedIndex(Options(), &problem, &n, 1.0, 2.0);
-  ASSERT_TRUE(summary.IsSolutionUsable()) << summary.message;
-  const Eigen::Vector2d w_expected =
-      p.a.rightCols<2>().colPivHouseholderQr().solve(p.b - 2.0 * p.a.col(0));
-  EXPECT_EQ(n, 2.0);
-  EXPECT_NEAR(w[0], w_expected[0], kExactTolerance);
-  EXPECT_NEAR(w[1], w_expected[1], kExactTolerance);
+  ExpectConstrainedMinimum(p, 2.0, SolveFrom(p, 1.5, {0.0, 0.0}));
 }
 
 // Started on the bound and stopped there at once (pinned_iterations 1: the
@@ -113,46 +122,30 @@ TEST(BoundedIndexSolve, InteriorMinimumFromTheBoundIsReleased) {
   const LinearProblem p = ProblemWithMinimumAt(1.02);
   const Eigen::Vector3d x_expected = p.a.colPivHouseholderQr().solve(p.b);
   ASSERT_GT(x_expected[0], 1.0);
-  double n = 1.0;
-  double w[2] = {3.0, -4.0};
-  ceres::Problem problem;
-  Build(p, &n, w, &problem);
-  const ceres::Solver::Summary summary = SolveWithBoundedIndex(
-      Options(), &problem, &n, 1.0, 2.0, /*pinned_iterations=*/1);
-  ASSERT_TRUE(summary.IsSolutionUsable()) << summary.message;
-  EXPECT_NEAR(n, x_expected[0], kExactTolerance);
-  EXPECT_NEAR(w[0], x_expected[1], kExactTolerance);
-  EXPECT_NEAR(w[1], x_expected[2], kExactTolerance);
+  const Solved solved = SolveFrom(p, 1.0, {3.0, -4.0}, Held::kNone,
+                                  /*pinned_iterations=*/1);
+  ASSERT_TRUE(solved.summary.IsSolutionUsable()) << solved.summary.message;
+  EXPECT_NEAR(solved.n, x_expected[0], kExactTolerance);
+  EXPECT_NEAR(solved.w[0], x_expected[1], kExactTolerance);
+  EXPECT_NEAR(solved.w[1], x_expected[2], kExactTolerance);
 }
 
 // n alone (the refinement without self-calibration): nothing to hold the
 // rest at; the bound is the answer.
 TEST(BoundedIndexSolve, IndexAloneStaysOnTheBound) {
   const LinearProblem p = ProblemWithMinimumAt(0.97);
-  double n = 1.3;
-  double w[2] = {0.3, -0.2};
-  ceres::Problem problem;
-  Build(p, &n, w, &problem);
-  problem.SetParameterBlockConstant(w);
-  const ceres::Solver::Summary summary =
-      SolveWithBoundedIndex(Options(), &problem, &n, 1.0, 2.0);
-  ASSERT_TRUE(summary.IsSolutionUsable()) << summary.message;
-  EXPECT_EQ(n, 1.0);
+  const Solved solved = SolveFrom(p, 1.3, {0.3, -0.2}, Held::kW);
+  ASSERT_TRUE(solved.summary.IsSolutionUsable()) << solved.summary.message;
+  EXPECT_EQ(solved.n, 1.0);
 }
 
 // A held n (the caller's choice) is left alone.
 TEST(BoundedIndexSolve, ConstantIndexIsNotTouched) {
   const LinearProblem p = ProblemWithMinimumAt(0.97);
-  double n = 1.0;
-  double w[2] = {0.0, 0.0};
-  ceres::Problem problem;
-  Build(p, &n, w, &problem);
-  problem.SetParameterBlockConstant(&n);
-  const ceres::Solver::Summary summary =
-      SolveWithBoundedIndex(Options(), &problem, &n, 1.0, 2.0);
-  ASSERT_TRUE(summary.IsSolutionUsable()) << summary.message;
-  EXPECT_EQ(n, 1.0);
-  EXPECT_TRUE(problem.IsParameterBlockConstant(&n));
+  const Solved solved = SolveFrom(p, 1.0, {0.0, 0.0}, Held::kN);
+  ASSERT_TRUE(solved.summary.IsSolutionUsable()) << solved.summary.message;
+  EXPECT_EQ(solved.n, 1.0);
+  EXPECT_TRUE(solved.n_constant_after);
 }
 
 }  // namespace

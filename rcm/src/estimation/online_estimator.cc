@@ -82,7 +82,7 @@ FrameFit FitFrame(const StereoRig& rig,
   if (SelfCalibrates(rig, options)) {
     RefinementOptions frame_options = options;
     frame_options.self_calibrate_focal = layout.focal;
-    const StatusOr<RefinementSummary> own =
+    StatusOr<RefinementSummary> own =
         RefineRefractiveIndex(rig, frame_matches, frame_options);
     if (own.ok() && own->rotation) {
       fit.n_robust = own->n_robust;
@@ -111,7 +111,7 @@ FrameFit FitFrame(const StereoRig& rig,
         }
       }
       if (chosen.size() == own->inliers.size()) {
-        own_equations = own->normal_equations;
+        own_equations = std::move(own->normal_equations);
       }
     }
   }
