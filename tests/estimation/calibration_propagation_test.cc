@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <string>
 
 #include "rcm/estimation/batch_refinement.h"
 #include "rcm/estimation/cramer_rao_bound.h"
@@ -13,6 +14,7 @@
 #include "rcm/estimation/sliding_window_estimator.h"
 #include "rcm/geometry/epipolar.h"
 #include "rcm/io/stereo_rig_file.h"
+#include "rcm/sim/exposure_delay.h"
 #include "rcm/sim/sequence_simulator.h"
 #include "rcm/sim/stereo_sampler.h"
 #include "support/test_budget.h"
@@ -31,8 +33,10 @@ constexpr double kExactTolerance = 1e-9;
 std::vector<StereoCorrespondence> Frames(const StereoRig& rig, double n,
                                          double min_depth, double max_depth,
                                          int frames, int per_frame,
-                                         uint64_t seed) {
+                                         uint64_t seed,
+                                         const ExposureDelay& delay = {}) {
   StereoSamplerOptions options;
+  options.exposure_delay = delay;
   options.n = n;
   options.min_depth = min_depth;
   options.max_depth = max_depth;
@@ -475,7 +479,8 @@ struct ZStatistics {
 // estimate reads for a camchain without a sidecar).
 template <typename Estimate>
 ZStatistics MonteCarloWithDrift(const DriftScene& scene, int trials,
-                                uint64_t seed, bool lenses, Estimate estimate) {
+                                uint64_t seed, bool lenses, Estimate estimate,
+                                const ExposureDelay& delay = {}) {
   std::mt19937_64 rng(seed);
   const StereoRig calibrated =
       lenses ? WithDefaultCalibrationUncertainty(scene.rig).value()
@@ -488,7 +493,7 @@ ZStatistics MonteCarloWithDrift(const DriftScene& scene, int trials,
     if (lenses) truth = DrawLensChange(truth, &rng);
     std::vector<StereoCorrespondence> data =
         Frames(truth, kTrueN, scene.min_depth, scene.max_depth, scene.frames,
-               scene.per_frame, seed + 100 + t);
+               scene.per_frame, seed + 100 + t, delay);
     AddPixelNoise(0.3, seed + 1000 + t, &data);
     double n = 0.0;
     double sigma = 0.0;
@@ -510,7 +515,8 @@ ZStatistics MonteCarloWithDrift(const DriftScene& scene, int trials,
 }
 
 ZStatistics MonteCarloRefine(const DriftScene& scene,
-                             bool free_rotation = false, bool lenses = false) {
+                             bool free_rotation = false, bool lenses = false,
+                             const ExposureDelay& delay = {}) {
   RefinementOptions options;
   options.refine_rotation = free_rotation;
   return MonteCarloWithDrift(
@@ -524,7 +530,8 @@ ZStatistics MonteCarloRefine(const DriftScene& scene,
         *n = summary->n;
         *sigma = summary->sigma_n;
         return true;
-      });
+      },
+      delay);
 }
 
 // The online and sliding-window estimators self-calibrate too, from the
@@ -534,7 +541,8 @@ ZStatistics MonteCarloRefine(const DriftScene& scene,
 // frame alone) over the trials.
 ZStatistics MonteCarloFrameByFrame(const DriftScene& scene, bool window,
                                    ZStatistics* frames = nullptr,
-                                   bool lenses = false) {
+                                   bool lenses = false,
+                                   const ExposureDelay& delay = {}) {
   double frame_sum = 0.0;
   double frame_sum2 = 0.0;
   double frame_sigma = 0.0;
@@ -581,10 +589,12 @@ ZStatistics MonteCarloFrameByFrame(const DriftScene& scene, bool window,
           *sigma = current->sigma_n;
         }
         return true;
-      });
+      },
+      delay);
   if (frames != nullptr) {
     frames->trials = frame_trials;
-    frames->failed = pooled.trials * scene.frames - frame_trials;
+    frames->failed =
+        (pooled.trials + pooled.failed) * scene.frames - frame_trials;
     frames->mean = frame_sum / frame_trials;
     frames->sd =
         std::sqrt(frame_sum2 / frame_trials - frames->mean * frames->mean);
@@ -774,6 +784,43 @@ TEST(CalibrationPropagation, MonteCarloWindowSigmaHonestUnderALensChangeBoard) {
   ExpectHonest(MonteCarloFrameByFrame(DriftScenes()[1], true, &frames, true),
                "window, lenses changed, board");
   ExpectHonest(frames, "each frame, lenses changed, board");
+}
+
+// Cameras not triggered together (exposure_delay.h), as on boards that
+// read two camera modules: the right image 10 ms after the left, with the
+// rig turning at 5 deg/s and moving at 0.05 m/s per axis (sd, drawn per
+// frame), so cam1 sees each frame's scene turned by ~0.05 deg and moved by
+// ~0.5 mm, as much as the drift prior, differently in every frame. The
+// frames then disagree beyond their pixel noise (chi-square of the frames'
+// own n) and the consistency inflation must carry it: the same Monte Carlo
+// as for the drift, for the batch and for each frame's own estimate,
+// whose noise share the window's inflation widens (FrameEstimateOf).
+// (The window's pooled estimate is not checked here: under a rotation
+// that changes from frame to frame its linearized self-calibration is
+// biased, z mean +1.5 on the pool; an open item of issue 30.)
+ExposureDelay HandHeldDelay() {
+  ExposureDelay delay;
+  delay.delay = 0.010;
+  delay.angular_speed_sd = 5.0 * kDegree;
+  delay.speed_sd = 0.05;
+  return delay;
+}
+TEST(CalibrationPropagation, MonteCarloRefineSigmaHonestUnsynchronizedPool) {
+  ExpectHonest(
+      MonteCarloRefine(DriftScenes()[0], false, false, HandHeldDelay()),
+      "refine, unsynchronized, pool");
+}
+TEST(CalibrationPropagation, MonteCarloEachFrameSigmaHonestUnsynchronized) {
+  for (const DriftScene& scene : DriftScenes()) {
+    ZStatistics frames;
+    const ZStatistics window =
+        MonteCarloFrameByFrame(scene, true, &frames, false, HandHeldDelay());
+    std::printf("(window, unsynchronized, %s: z mean %.2f sd %.2f)\n",
+                scene.name, window.mean, window.sd);
+    ExpectHonest(
+        frames,
+        (std::string("each frame, unsynchronized, ") + scene.name).c_str());
+  }
 }
 
 // A drifted rig whose n, estimated with the rotation held, is pinned at the

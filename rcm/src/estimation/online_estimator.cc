@@ -1,5 +1,7 @@
 #include "rcm/estimation/online_estimator.h"
 
+#include <glog/logging.h>
+
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
@@ -201,16 +203,17 @@ FrameFit FitFrame(const StereoRig& rig,
   return fit;
 }
 
-StatusOr<PooledLocusEstimate> FrameEstimateOf(
-    const StereoRig& rig, const FrameFit& fit,
-    const RefinementOptions& options) {
+StatusOr<PooledLocusEstimate> FrameEstimateOf(const StereoRig& rig,
+                                              const FrameFit& fit,
+                                              const RefinementOptions& options,
+                                              double scatter_inflation) {
   if (!fit.estimate.ok()) return fit.estimate.status();
   FrameEstimateSums own;
   if (fit.model) {
     own.Add(fit.model->n, fit.model->information, fit.model->coupling);
   }
   const StatusOr<CalibratedLocusEstimate> calibrated = EstimateWithCalibration(
-      rig, fit.cost, fit.normal_equations, own, options);
+      rig, fit.cost, fit.normal_equations, own, options, scatter_inflation);
   if (!calibrated.ok()) return calibrated.status();
   return PooledEstimateOf(*calibrated);
 }
@@ -231,8 +234,9 @@ CalibrationParameterLayout SelfCalibrationLayout(
 StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
     const StereoRig& rig, const LocusCostFunction& cost,
     const LocusNormalEquations& normal_equations,
-    const FrameEstimateSums& frame_estimates,
-    const RefinementOptions& options) {
+    const FrameEstimateSums& frame_estimates, const RefinementOptions& options,
+    double scatter_inflation) {
+  CHECK_GE(scatter_inflation, 1.0);
   // n alone first: it checks the inliers and the observability of n.
   const StatusOr<LocusEstimate> locus = EstimateFromLocusCost(cost, options);
   if (!locus.ok()) return locus.status();
@@ -242,7 +246,8 @@ StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
     estimate.consistency =
         FrameConsistencyOf(frame_estimates, locus->n, locus->sigma_px);
     const double inflation =
-        estimate.consistency ? estimate.consistency->inflation : 1.0;
+        std::max(scatter_inflation,
+                 estimate.consistency ? estimate.consistency->inflation : 1.0);
     estimate.sigma_n_noise = estimate.sigma_n = locus->sigma_n * inflation;
     RCM_RETURN_IF_ERROR(CheckNotPinnedAtUpperBound(locus->n, estimate.sigma_n));
     return estimate;
@@ -276,7 +281,8 @@ StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
   estimate.consistency = FrameConsistencyOf(
       frame_estimates, n, sigma_px, SelfCalibrationOf(rotation, focal_scale));
   const double inflation =
-      estimate.consistency ? estimate.consistency->inflation : 1.0;
+      std::max(scatter_inflation,
+               estimate.consistency ? estimate.consistency->inflation : 1.0);
   StatusOr<CalibrationPropagation> propagation = PropagateCalibration(
       at_solution, layout, uncertainty,
       self_calibrate ? RotationMode::kPrior : RotationMode::kHeld, sigma_px,
@@ -363,8 +369,10 @@ OnlineRefractiveIndexEstimator::AddFrame(
     }
     update.inliers = std::move(fit.inliers);
   }
-  update.frame_estimate = FrameEstimateOf(rig_, fit, options_);
   update.cumulative = Current();
+  update.frame_estimate = FrameEstimateOf(
+      rig_, fit, options_,
+      update.cumulative.ok() ? ScatterInflationOf(*update.cumulative) : 1.0);
   return update;
 }
 

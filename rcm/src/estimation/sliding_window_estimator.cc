@@ -105,11 +105,17 @@ SlidingWindowRefractiveIndexEstimator::AddFrame(
   FrameFit fit = FitFrame(rig_, frame_matches, options_);
   update.correspondences = fit.correspondences;
   update.usable = fit.usable;
-  update.frame_estimate = FrameEstimateOf(rig_, fit, options_);
+  // The window's frames scatter by its consistency inflation beyond their
+  // noise (cameras not triggered together on a moving rig, a scene that
+  // moves): so does this frame, in its reported sigma and in the change
+  // test.
+  const StatusOr<Estimate> window = Current();
+  const double inflation = window.ok() ? ScatterInflationOf(*window) : 1.0;
+  update.frame_estimate = FrameEstimateOf(rig_, fit, options_, inflation);
   if (!fit.estimate.ok()) {
     ++num_skipped_frames_;
     update.decision = Decision::kSkipped;
-    update.window = Current();
+    update.window = window;
     return update;
   }
   FrameCost frame_cost;
@@ -119,7 +125,6 @@ SlidingWindowRefractiveIndexEstimator::AddFrame(
   frame_cost.normal_equations = fit.normal_equations;
   frame_cost.model = *fit.model;
 
-  const StatusOr<Estimate> window = Current();
   if (window.ok()) {
     // With a self-calibrated window, the frame's own n at the window's
     // rotation (FrameFit::Model).
@@ -129,6 +134,7 @@ SlidingWindowRefractiveIndexEstimator::AddFrame(
           *window->rotation,
           window->focal_scale.value_or(Eigen::Vector2d::Zero())));
     }
+    own.sigma_n *= inflation;
     update.z = ChangeStatistic(own, window->n, window->sigma_n_noise);
   }
   if (!update.z || *update.z <= window_options_.change_threshold) {
@@ -142,9 +148,11 @@ SlidingWindowRefractiveIndexEstimator::AddFrame(
 
   // Inconsistent with the window: pending, with the frames before it when
   // it agrees with the last of them.
+  LocusEstimate scattered = frame_cost.estimate;
+  scattered.sigma_n *= inflation;
   if (!pending_.empty() &&
-      ChangeStatistic(frame_cost.estimate, pending_.back().estimate.n,
-                      pending_.back().estimate.sigma_n) >
+      ChangeStatistic(scattered, pending_.back().estimate.n,
+                      inflation * pending_.back().estimate.sigma_n) >
           window_options_.change_threshold) {
     num_dropped_frames_ += static_cast<int64_t>(pending_.size());
     pending_.clear();

@@ -3,13 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
-#include <utility>
 #include <numeric>
 #include <random>
 #include <sstream>
+#include <utility>
 
-#include "rcm/camera/refractive_camera.h"
 #include "rcm/camera/flat_port_camera.h"
+#include "rcm/camera/refractive_camera.h"
 
 namespace rcm {
 
@@ -29,7 +29,7 @@ Status StereoSamplerOptions::Check() const {
   } else if (!(frame_rate > 0.0) || !std::isfinite(frame_rate)) {
     message << "frame_rate = " << frame_rate << " must be > 0";
   } else {
-    return Status::Ok();
+    return exposure_delay.Check();
   }
   return Status::Error(message.str());
 }
@@ -39,9 +39,9 @@ namespace {
 // Traces one drawn sample of `frame`: the point at depth Z = `depth` (left
 // camera frame) on the ray of left pixel `drawn`, imaged in both cameras.
 // Returns false when the point is not visible in both.
-using SampleTracer = std::function<bool(int frame, const Eigen::Vector2d& drawn,
-                                        double depth, Eigen::Vector2d* left,
-                                        Eigen::Vector2d* right)>;
+using SampleTracer =
+    std::function<bool(int frame, const Eigen::Vector2d& drawn, double depth,
+                       Eigen::Vector2d* left, Eigen::Vector2d* right)>;
 
 // The sampling loop shared by the model's and the flat port's sampler.
 StatusOr<std::vector<StereoCorrespondence>> SampleWithTracer(
@@ -93,6 +93,20 @@ StatusOr<std::vector<StereoCorrespondence>> SampleWithTracer(
   return correspondences;
 }
 
+// cam1's view of each frame: right_from_left, after the scene's motion
+// during the exposure delay.
+std::vector<Rigid3d> RightFromLeftOfFrames(
+    const StereoRig& rig, const StereoSamplerOptions& options) {
+  std::vector<Rigid3d> right_from_left(options.num_frames,
+                                       rig.right_from_left());
+  for (int frame = 0; frame < options.num_frames; ++frame) {
+    right_from_left[frame] =
+        rig.right_from_left() *
+        options.exposure_delay.MotionOfFrame(options.seed, frame);
+  }
+  return right_from_left;
+}
+
 }  // namespace
 
 StatusOr<std::vector<StereoCorrespondence>> SampleStereoCorrespondences(
@@ -102,9 +116,11 @@ StatusOr<std::vector<StereoCorrespondence>> SampleStereoCorrespondences(
       RefractiveCamera::Create(rig.left(), options.n).value();
   const RefractiveCamera right =
       RefractiveCamera::Create(rig.right(), options.n).value();
+  const std::vector<Rigid3d> right_from_left =
+      RightFromLeftOfFrames(rig, options);
   return SampleWithTracer(
       rig, options,
-      [&](int, const Eigen::Vector2d& drawn, double depth,
+      [&](int frame, const Eigen::Vector2d& drawn, double depth,
           Eigen::Vector2d* left_pixel, Eigen::Vector2d* right_pixel) {
         const std::optional<Eigen::Vector3d> bearing =
             left.BearingInWaterFromImage(drawn);
@@ -113,7 +129,7 @@ StatusOr<std::vector<StereoCorrespondence>> SampleStereoCorrespondences(
         const std::optional<Eigen::Vector2d> l =
             left.ImageFromPointInWater(point_in_left);
         const std::optional<Eigen::Vector2d> r =
-            right.ImageFromPointInWater(rig.right_from_left() * point_in_left);
+            right.ImageFromPointInWater(right_from_left[frame] * point_in_left);
         if (!l || !r) return false;
         *left_pixel = *l;
         *right_pixel = *r;
@@ -122,8 +138,8 @@ StatusOr<std::vector<StereoCorrespondence>> SampleStereoCorrespondences(
 }
 
 StatusOr<std::vector<StereoCorrespondence>> SampleFlatPortCorrespondences(
-    const StereoRig& rig, const FlatPort& left_port,
-    const FlatPort& right_port, const StereoSamplerOptions& options,
+    const StereoRig& rig, const FlatPort& left_port, const FlatPort& right_port,
+    const StereoSamplerOptions& options,
     const std::vector<double>& n_of_frame) {
   RCM_RETURN_IF_ERROR(options.Check());
   if (!n_of_frame.empty() &&
@@ -154,6 +170,8 @@ StatusOr<std::vector<StereoCorrespondence>> SampleFlatPortCorrespondences(
     }
     camera_of_frame[f] = static_cast<size_t>(it - distinct.begin());
   }
+  const std::vector<Rigid3d> right_from_left =
+      RightFromLeftOfFrames(rig, options);
   return SampleWithTracer(
       rig, options,
       [&](int frame, const Eigen::Vector2d& drawn, double depth,
@@ -167,7 +185,7 @@ StatusOr<std::vector<StereoCorrespondence>> SampleFlatPortCorrespondences(
         const std::optional<Eigen::Vector2d> l =
             left.ImageFromPoint(point_in_left);
         const std::optional<Eigen::Vector2d> r =
-            right.ImageFromPoint(rig.right_from_left() * point_in_left);
+            right.ImageFromPoint(right_from_left[frame] * point_in_left);
         if (!l || !r) return false;
         *left_pixel = *l;
         *right_pixel = *r;

@@ -169,12 +169,23 @@ bool SelfCalibrates(const StereoRig& rig, const RefinementOptions& options);
 // batch refinement does.
 CalibrationParameterLayout SelfCalibrationLayout(
     const StereoRig& rig, const RefinementOptions& options);
+//
+// `scatter_inflation` (>= 1) is a floor on the consistency test's
+// inflation: the scatter of the frames around this one, when the estimate
+// is one frame's and the estimator's frames disagree beyond their noise
+// (FrameEstimateOf).
 StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
     const StereoRig& rig, const LocusCostFunction& cost,
     const LocusNormalEquations& normal_equations,
-    const FrameEstimateSums& frame_estimates, const RefinementOptions& options);
+    const FrameEstimateSums& frame_estimates, const RefinementOptions& options,
+    double scatter_inflation = 1.0);
 // Its fields as the estimators report them.
 PooledLocusEstimate PooledEstimateOf(const CalibratedLocusEstimate& estimate);
+// The consistency test's inflation of a pooled estimate: 1 when its frames
+// agree (or it has fewer than two).
+inline double ScatterInflationOf(const PooledLocusEstimate& estimate) {
+  return estimate.consistency ? estimate.consistency->inflation : 1.0;
+}
 
 // Steps 1-4 for one frame.
 struct FrameFit {
@@ -221,9 +232,17 @@ FrameFit FitFrame(const StereoRig& rig,
 // sigma_f: pixel noise at the frame's own rotation) stays the estimators'
 // internal measure of frame-to-frame agreement. The error says why there is
 // no estimate.
+//
+// `scatter_inflation` is the estimator's frames' consistency inflation
+// (FrameConsistency::inflation of its pooled estimate, 1 when they agree):
+// frames that disagree beyond their pixel noise (cameras not triggered
+// together on a moving rig, a scene that moves) scatter each frame's n by
+// that factor more than its noise share says, so the frame's noise share
+// is inflated by it as the pooled one is.
 StatusOr<PooledLocusEstimate> FrameEstimateOf(const StereoRig& rig,
                                               const FrameFit& fit,
-                                              const RefinementOptions& options);
+                                              const RefinementOptions& options,
+                                              double scatter_inflation = 1.0);
 
 class OnlineRefractiveIndexEstimator {
  public:

@@ -53,7 +53,12 @@
 // test of calibration_propagation.h) and the calibration's uncertainty with
 // cam1's rotation held. The change test uses the frames' own sigma and the
 // window's pixel-noise share (a calibration error is common to both and
-// cancels from their difference).
+// cancels from their difference); when the window's frames disagree beyond
+// their noise (its consistency inflation r > 1: cameras not triggered
+// together on a moving rig, a scene that moves), a frame's own sigma is
+// r sigma_f, in the change test and in the frame's reported estimate
+// (FrameEstimateOf), so that a frame that scatters as the window's own
+// frames do is not taken for a change of medium.
 //
 // Memory: window_frames + confirm_frames cost functions (each
 // LocusCostFunction::kNumNodes x 3 doubles), allocated at Create, plus one

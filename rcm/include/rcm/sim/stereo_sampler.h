@@ -9,16 +9,18 @@
 // pixel's ray in the medium at that depth, and both pixels are obtained by
 // projecting it (RefractiveCamera::ImageFromPointInWater, or
 // FlatPortCamera::ImageFromPoint). Points whose right pixel falls outside
-// the right image are redrawn.
+// the right image are redrawn. With an exposure delay (exposure_delay.h),
+// the right camera sees each frame's points moved by that frame's motion.
 #ifndef RCM_SIM_STEREO_SAMPLER_H_
 #define RCM_SIM_STEREO_SAMPLER_H_
 
 #include <cstdint>
 #include <vector>
 
+#include "rcm/camera/flat_port.h"
 #include "rcm/geometry/stereo_correspondence.h"
 #include "rcm/geometry/stereo_rig.h"
-#include "rcm/camera/flat_port.h"
+#include "rcm/sim/exposure_delay.h"
 #include "rcm/util/status.h"
 
 namespace rcm {
@@ -31,6 +33,10 @@ struct StereoSamplerOptions {
   int per_frame = 100;       // correspondences per frame, >= 1
   double frame_rate = 20.0;  // Hz; timestamps t = frame / frame_rate, > 0
   uint64_t seed = 1;         // the sample depends only on the seed
+  // Default none: the cameras are triggered together. Its motions are
+  // keyed by (seed, frame) apart from the points' draws, so that a delay
+  // moves the right pixels of the same points.
+  ExposureDelay exposure_delay;
 
   Status Check() const;
 };
@@ -41,15 +47,15 @@ struct StereoSamplerOptions {
 StatusOr<std::vector<StereoCorrespondence>> SampleStereoCorrespondences(
     const StereoRig& rig, const StereoSamplerOptions& options);
 
-// The same sampling through exact flat ports (rcm/camera/flat_port_camera.h): the
-// left pixel's ray in the medium starts on the outer glass face and the
+// The same sampling through exact flat ports (rcm/camera/flat_port_camera.h):
+// the left pixel's ray in the medium starts on the outer glass face and the
 // point is where it reaches depth Z. The medium of frame f is
 // n_of_frame[f] when given (num_frames entries, each in [1, 2]; media that
 // switch between frames), options.n otherwise. Fails as the model sampler
 // does, or when a port is invalid.
 StatusOr<std::vector<StereoCorrespondence>> SampleFlatPortCorrespondences(
-    const StereoRig& rig, const FlatPort& left_port,
-    const FlatPort& right_port, const StereoSamplerOptions& options,
+    const StereoRig& rig, const FlatPort& left_port, const FlatPort& right_port,
+    const StereoSamplerOptions& options,
     const std::vector<double>& n_of_frame = {});
 
 // Adds independent zero-mean Gaussian noise of standard deviation sigma_px
