@@ -134,8 +134,10 @@ TEST(EstimateCli, OnlineAgreesWithRefine) {
   // equals the batch to 1e-6 (online_estimator_test). With the default
   // drift prior both self-calibrate cam1's rotation, the batch on the
   // nonlinear problem and the online estimator on the frames' linearized
-  // models (online_estimator.h): they agree to a small fraction of sigma
-  // (measured 0.1 sigma in n, 0.1 % in sigma on these 10 frames). The
+  // models (online_estimator.h), each frame's taken at one rotation
+  // (LinearizationPoint, up to 0.15 deg from the solution): they agree to
+  // a small fraction of sigma (measured 0.1 sigma in n, 1.7 % in sigma on
+  // these 10 frames; 3 % allowed). The
   // online estimator holds the lenses (it propagates the focal drift
   // prior), so the batch is compared with its lenses held too.
   for (const bool exact : {true, false}) {
@@ -154,7 +156,7 @@ TEST(EstimateCli, OnlineAgreesWithRefine) {
     const double sigma = a["sigma_n"].get<double>();
     EXPECT_NEAR(a["n"].get<double>(), b["n"].get<double>(),
                 exact ? 1e-6 : 0.2 * sigma);
-    EXPECT_NEAR(sigma, b["sigma_n"].get<double>(), exact ? 1e-6 : 0.01 * sigma);
+    EXPECT_NEAR(sigma, b["sigma_n"].get<double>(), exact ? 1e-6 : 0.03 * sigma);
     EXPECT_EQ(a["inliers"], b["inliers"]);
   }
 }

@@ -95,6 +95,28 @@ OnlineRefractiveIndexEstimator RunOnline(
   return estimator;
 }
 
+// The frames' rows share one rotation: the first pooled one, kept while
+// the pooled rotation stays within kMaxDistance of it, moved to it beyond.
+TEST(LinearizationPoint, FollowsThePooledRotationOnlyBeyondItsDistance) {
+  LinearizationPoint point;
+  point.Follow(std::nullopt);
+  EXPECT_FALSE(point.rotation.has_value());
+  const Eigen::Vector3d first(1e-3, -2e-3, 5e-4);
+  point.Follow(first);
+  ASSERT_TRUE(point.rotation.has_value());
+  EXPECT_EQ(*point.rotation, first);
+  const Eigen::Vector3d near =
+      first + Eigen::Vector3d(0.9 * LinearizationPoint::kMaxDistance, 0, 0);
+  point.Follow(near);
+  EXPECT_EQ(*point.rotation, first);
+  point.Follow(std::nullopt);  // no pooled rotation: the point stays
+  EXPECT_EQ(*point.rotation, first);
+  const Eigen::Vector3d far =
+      first + Eigen::Vector3d(0, 1.1 * LinearizationPoint::kMaxDistance, 0);
+  point.Follow(far);
+  EXPECT_EQ(*point.rotation, far);
+}
+
 TEST(OnlineEstimator, MatchesBatchOnCleanData) {
   // No robust stage and no threshold: both estimators fit plain least
   // squares to every match, so they must agree whatever the noise.
@@ -191,11 +213,12 @@ TEST(OnlineEstimator, FrameEstimateWithCalibrationIsTheBatchOfThatFrame) {
   const StereoRig truth =
       nominal.WithCam1Moved(Eigen::Vector3d(0.0, 0.1, 0.05) * M_PI / 180.0)
           .value();
-  const StereoRig rig =
-      nominal
-          .WithCalibrationUncertainty(CalibrationUncertainty::DefaultDriftPrior())
-          .value();
-  std::vector<StereoCorrespondence> sequence = Sequence(truth, 1.333, 3, 200, 16);
+  const StereoRig rig = nominal
+                            .WithCalibrationUncertainty(
+                                CalibrationUncertainty::DefaultDriftPrior())
+                            .value();
+  std::vector<StereoCorrespondence> sequence =
+      Sequence(truth, 1.333, 3, 200, 16);
   AddPixelNoise(0.3, 17, &sequence);
   const Frames frames = SplitByFrame(sequence);
   RefinementOptions options;
@@ -210,10 +233,11 @@ TEST(OnlineEstimator, FrameEstimateWithCalibrationIsTheBatchOfThatFrame) {
     ASSERT_TRUE(update.frame_estimate.ok())
         << update.frame_estimate.status().message();
     const PooledLocusEstimate& own = *update.frame_estimate;
-    std::printf("frame: n %.6f +- %.6f (noise %.6f, calibration %.6f, "
-                "systematic %.6f); batch %.6f +- %.6f\n",
-                own.n, own.sigma_n, own.sigma_n_noise, own.sigma_n_calibration,
-                own.sigma_n_systematic, batch.n, batch.sigma_n);
+    std::printf(
+        "frame: n %.6f +- %.6f (noise %.6f, calibration %.6f, "
+        "systematic %.6f); batch %.6f +- %.6f\n",
+        own.n, own.sigma_n, own.sigma_n_noise, own.sigma_n_calibration,
+        own.sigma_n_systematic, batch.n, batch.sigma_n);
     EXPECT_NEAR(own.n, batch.n, kFractionOfSigma * batch.sigma_n);
     EXPECT_NEAR(own.sigma_n, batch.sigma_n, kFractionOfSigma * batch.sigma_n);
     EXPECT_GT(own.sigma_n_calibration, 0.0);

@@ -49,9 +49,11 @@ StatusOr<LocusEstimate> EstimateFromLocusCost(
   return estimate;
 }
 
-FrameFit FitFrame(const StereoRig& rig,
-                  const std::vector<StereoCorrespondence>& frame_matches,
-                  const RefinementOptions& options) {
+FrameFit FitFrame(
+    const StereoRig& rig,
+    const std::vector<StereoCorrespondence>& frame_matches,
+    const RefinementOptions& options,
+    const std::optional<Eigen::Vector3d>& linearization_rotation) {
   FrameFit fit;
   const Eigen::Matrix3d essential = EssentialMatrix(rig.right_from_left());
   fit.correspondences = static_cast<int64_t>(frame_matches.size());
@@ -160,11 +162,17 @@ FrameFit FitFrame(const StereoRig& rig,
   fit.estimate = EstimateFromLocusCost(fit.cost, options);
 
   // The calibration's share and the self-calibration need the inliers'
-  // normal equations, taken at the frame's own estimate.
-  // The refinement's, when the frame keeps all its inliers (the rows are
-  // the same; the refinement took them at its own n, which the intercepts
-  // carry to first order); else taken here.
-  if (own_equations && rejected.empty() &&
+  // normal equations, taken at the frame's n and at the estimator's
+  // linearization rotation when there is one (header), else at the
+  // frame's own. The refinement's,
+  // when they are at its rotation and the frame keeps all its inliers (the
+  // rows are the same; the refinement took them at its own n, which the
+  // intercepts carry to first order); else taken here.
+  const bool self_calibrated = own_equations.has_value();
+  const Eigen::Vector3d linearization =
+      self_calibrated && linearization_rotation ? *linearization_rotation
+                                                : rotation;
+  if (own_equations && rejected.empty() && linearization == rotation &&
       own_equations->information.rows() == layout.Size()) {
     fit.normal_equations = *std::move(own_equations);
   } else if (rig.calibration_uncertainty() || options.systematic_px > 0.0) {
@@ -176,7 +184,7 @@ FrameFit FitFrame(const StereoRig& rig,
     for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int64_t>(i);
     AccumulateLocusNormalEquations(
         frame_rig, layout, raw, kept, all,
-        fit.estimate.ok() ? fit.estimate->n : fit.n_robust, rotation,
+        fit.estimate.ok() ? fit.estimate->n : fit.n_robust, linearization,
         focal_scale, &fit.normal_equations);
   }
   if (fit.estimate.ok()) {
@@ -352,7 +360,8 @@ OnlineRefractiveIndexEstimator::AddFrame(
   FrameUpdate update;
   update.frame = num_frames_++;
   num_correspondences_ += static_cast<int64_t>(frame_matches.size());
-  FrameFit fit = FitFrame(rig_, frame_matches, options_);
+  FrameFit fit =
+      FitFrame(rig_, frame_matches, options_, linearization_.rotation);
   update.correspondences = fit.correspondences;
   update.usable = fit.usable;
   update.skipped = fit.skipped;
@@ -370,6 +379,8 @@ OnlineRefractiveIndexEstimator::AddFrame(
     update.inliers = std::move(fit.inliers);
   }
   update.cumulative = Current();
+  if (update.cumulative.ok())
+    linearization_.Follow(update.cumulative->rotation);
   update.frame_estimate = FrameEstimateOf(
       rig_, fit, options_,
       update.cumulative.ok() ? ScatterInflationOf(*update.cumulative) : 1.0);

@@ -102,15 +102,17 @@ SlidingWindowRefractiveIndexEstimator::AddFrame(
     int64_t frame, const std::vector<StereoCorrespondence>& frame_matches) {
   WindowUpdate update;
   update.frame = frame;
-  FrameFit fit = FitFrame(rig_, frame_matches, options_);
-  update.correspondences = fit.correspondences;
-  update.usable = fit.usable;
   // The window's frames scatter by its consistency inflation beyond their
   // noise (cameras not triggered together on a moving rig, a scene that
   // moves): so does this frame, in its reported sigma and in the change
-  // test.
+  // test. Its rows are taken at the window's LinearizationPoint (FitFrame).
   const StatusOr<Estimate> window = Current();
   const double inflation = window.ok() ? ScatterInflationOf(*window) : 1.0;
+  if (window.ok()) linearization_.Follow(window->rotation);
+  FrameFit fit =
+      FitFrame(rig_, frame_matches, options_, linearization_.rotation);
+  update.correspondences = fit.correspondences;
+  update.usable = fit.usable;
   update.frame_estimate = FrameEstimateOf(rig_, fit, options_, inflation);
   if (!fit.estimate.ok()) {
     ++num_skipped_frames_;

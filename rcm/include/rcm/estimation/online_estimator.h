@@ -199,9 +199,9 @@ struct FrameFit {
   StatusOr<LocusEstimate> estimate = Status::Error("frame not fitted");
   // With a rig that has a calibration uncertainty: the inliers' normal
   // equations (calibration_propagation.h, SelfCalibrationLayout) at n_f
-  // (n_robust without an own estimate) and the frame's own self-calibrated
-  // rotation and focal scales (the lenses scaled by them); empty (all
-  // zero) otherwise.
+  // (n_robust without an own estimate), the frame's own self-calibrated
+  // focal scales (the lenses scaled by them) and the linearization
+  // rotation (FitFrame); empty (all zero) otherwise.
   LocusNormalEquations normal_equations;
   // The frame's own n as the consistency test sees it, n_f(x) = n - b .
   // x / information to first order in x = (w, e) (FrameEstimateSums,
@@ -220,9 +220,40 @@ struct FrameFit {
   };
   std::optional<Model> model;
 };
+//
+// The rows of the normal equations are linearized at cam1's rotation
+// `linearization_rotation` when given (the estimator's
+// LinearizationPoint), else at the frame's own. The pooled quadratic model
+// sums the frames' affine models, which hold near where each was taken:
+// frames whose own rotations scatter (cameras not triggered together on a
+// moving rig: exposure_delay.h) would otherwise be summed from points
+// tenths of a degree apart along the ridge where n and the rotation trade,
+// and the pooled n is biased (z mean +1.5 to +2.9 in the pool, +7 on a
+// narrow board, measured). Taken at one point they agree; exact data stay
+// exact (the point is then the truth). The refinement's own normal
+// equations are then not reused.
 FrameFit FitFrame(const StereoRig& rig,
                   const std::vector<StereoCorrespondence>& frame_matches,
-                  const RefinementOptions& options);
+                  const RefinementOptions& options,
+                  const std::optional<Eigen::Vector3d>& linearization_rotation =
+                      std::nullopt);
+
+// Where an estimator takes its frames' rows (FitFrame): the pooled
+// self-calibrated rotation when it first has one, and again only when the
+// pooled rotation has moved more than kMaxDistance from it, so that the
+// frames it sums share one point. The affine model's neglected second
+// order is ~f |dw|^2 / 2 in pixels: 0.002 px at kMaxDistance and f = 500
+// px (a rig that turns slowly over a long run moves the point along).
+struct LinearizationPoint {
+  static constexpr double kMaxDistance = 0.15 * M_PI / 180.0;  // radians
+  std::optional<Eigen::Vector3d> rotation;
+
+  void Follow(const std::optional<Eigen::Vector3d>& pooled) {
+    if (pooled && (!rotation || (*pooled - *rotation).norm() > kMaxDistance)) {
+      rotation = pooled;
+    }
+  }
+};
 
 // The frame's own estimate as the estimators report it: EstimateWithCalibration
 // of the frame alone, so that its sigma_n counts what the pooled one counts
@@ -293,6 +324,7 @@ class OnlineRefractiveIndexEstimator {
   // The frames' normal equations and own estimates, summed.
   LocusNormalEquations normal_equations_;
   FrameEstimateSums frame_estimates_;
+  LinearizationPoint linearization_;
   int64_t num_frames_ = 0;
   int64_t num_skipped_frames_ = 0;
   int64_t num_correspondences_ = 0;

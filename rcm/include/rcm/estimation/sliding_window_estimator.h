@@ -186,6 +186,7 @@ class SlidingWindowRefractiveIndexEstimator {
   LocusCostFunction window_cost_;
   LocusNormalEquations window_normal_equations_;
   FrameEstimateSums window_estimates_;
+  LinearizationPoint linearization_;
   // Pending frames, oldest first; capacity confirm_frames.
   std::vector<FrameCost> pending_;
 

@@ -30,11 +30,11 @@
 // period at 20 Hz, hence the worker.
 //
 // Cost per 720x540 pair (live_benchmark, this project's 2-core machine):
-// the window's update of all ~1200 matches and both remaps take 65 ms of
+// the window's update of all ~1200 matches and both remaps take 72 ms of
 // CPU for a rig read as `rcm` reads a camchain without a sidecar (the
 // default drift and focal drift priors: each pair's refinement estimates
-// cam1's rotation and both focal scales with n, and its normal equations
-// carry the lenses' columns), 18-20 ms for a rig without them; the front
+// cam1's rotation and both focal scales with n, and its normal equations,
+// taken at the window's rotation, carry the lenses' columns), 18-20 ms for a rig without them; the front
 // end's matching adds ~31-38 ms (on both cores). With all matches a pair
 // therefore takes ~100 ms of wall time: about 10 pairs a second, the rest
 // dropped whole by the caller (latest_slot.h). max_matches 400 takes the
@@ -85,11 +85,11 @@ struct LivePipelineOptions {
   double map_update_threshold = 1e-3;
   // Matches of a pair the window takes at most, every k-th of the front
   // end's (which come in image order, so the subset keeps their spread);
-  // >= 0, 0 takes all. The window's update costs ~54 us of CPU per match
+  // >= 0, 0 takes all. The window's update costs ~60 us of CPU per match
   // with the default priors (the frame's refinement with cam1's rotation
   // and the focal scales, the lenses' columns of its normal equations, the
   // locus cost function's 577 nodes; ~12 us without priors): the ~1200
-  // matches a 720x540 pair gives take ~65 ms, and the cap bounds a richer
+  // matches a 720x540 pair gives take ~72 ms, and the cap bounds a richer
   // scene's up to the front end's 2000 features. 400 fits the 25 ms that
   // half a core at 20 Hz allows.
   int max_matches = 1500;
