@@ -35,6 +35,13 @@ DEFINE_string(depth_range, "",
               "MIN,MAX in meters: sample the matches at depths uniform in "
               "[MIN, MAX] on random left pixels' rays instead of on the "
               "tank's surfaces (needs --noimages)");
+DEFINE_string(exposure_delay, "",
+              "MS,DEG_S[,M_S]: the right camera exposes MS milliseconds "
+              "after the left (cameras not triggered together, e.g. a "
+              "StereoPi) while the rig turns at DEG_S deg/s and moves at "
+              "M_S m/s (standard deviation per axis, drawn per frame): the "
+              "matches' right pixels see the scene moved in between (needs "
+              "--noimages)");
 DEFINE_string(board_distance, "0.6,2.0",
               "with --board: MIN,MAX in meters, the range of the board's "
               "distance in front of cam0");
@@ -73,7 +80,9 @@ constexpr char kSimulateUsage[] =
     "  truth.csv             frame,t,n,tx,ty,tz,qx,qy,qz,qw (world_from_cam0)\n"
     "  matches.csv           with --matches-per-frame: frame,xl,yl,xr,yr,t\n"
     "                        (points of the tank's surfaces, or with\n"
-    "                        --depth-range points at sampled depths)\n"
+    "                        --depth-range points at sampled depths;\n"
+    "                        with --exposure-delay the right pixels see\n"
+    "                        the scene moved during the delay)\n"
     "  simulation.json       the settings, to reproduce the run\n"
     "With --board a diver holds a printed chessboard (the flags of rcm\n"
     "calibrate; chessboards only) in front of the rig, moving it slowly and\n"
@@ -106,7 +115,6 @@ bool FlagGiven(const char* name) {
   gflags::CommandLineFlagInfo info;
   return gflags::GetCommandLineFlagInfo(name, &info) && !info.is_default;
 }
-
 
 // --board and --board-distance into options->board, board_motion.
 Status BoardFromFlags(SequenceOptions* options) {
@@ -208,6 +216,23 @@ int RunSimulate() {
     PrintError(command, lens.message());
     return kExitUsage;
   }
+  if (!FLAGS_exposure_delay.empty()) {
+    const StatusOr<std::vector<double>> values =
+        ParseNumberList(FLAGS_exposure_delay);
+    if (!values.ok() || (values->size() != 2 && values->size() != 3)) {
+      PrintError(command, "--exposure-delay " + FLAGS_exposure_delay +
+                              ": expected MS,DEG_S[,M_S], e.g. 10,5,0.05");
+      return kExitUsage;
+    }
+    options.exposure_delay.delay = 1e-3 * (*values)[0];
+    options.exposure_delay.angular_speed_sd = (*values)[1] * kDegree;
+    options.exposure_delay.speed_sd = values->size() == 3 ? (*values)[2] : 0.0;
+    if (const Status valid = options.Check(); !valid.ok()) {
+      PrintError(command, "--exposure-delay " + FLAGS_exposure_delay + ": " +
+                              valid.message());
+      return kExitUsage;
+    }
+  }
   if (const Status board = BoardFromFlags(&options); !board.ok()) {
     PrintError(command, board.message());
     return kExitUsage;
@@ -249,8 +274,14 @@ int RunSimulate() {
                                   {options.cam1_drift.translation.x() * 1e3,
                                    options.cam1_drift.translation.y() * 1e3,
                                    options.cam1_drift.translation.z() * 1e3}}};
-  settings["lens_change_percent"] = {100.0 * options.lens_change.focal_scale[0],
-                                    100.0 * options.lens_change.focal_scale[1]};
+  settings["lens_change_percent"] = {
+      100.0 * options.lens_change.focal_scale[0],
+      100.0 * options.lens_change.focal_scale[1]};
+  settings["exposure_delay"] = {
+      {"delay_ms", 1e3 * options.exposure_delay.delay},
+      {"angular_speed_sd_deg_s",
+       options.exposure_delay.angular_speed_sd / kDegree},
+      {"speed_sd_m_s", options.exposure_delay.speed_sd}};
   // The extrinsics that made the data (camchain.yaml has the calibration).
   settings["true_cam1_from_cam0"] =
       MatrixRows(simulator.value()->true_rig().right_from_left().ToMatrix());
@@ -276,9 +307,9 @@ int RunSimulate() {
     PrintError(command, settings_written.message());
     return kExitFailure;
   }
-  const double seconds = std::chrono::duration<double>(
-                             std::chrono::steady_clock::now() - start)
-                             .count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count();
 
   const SequenceSimulator& sim = *simulator.value();
   if (FLAGS_json) {
@@ -312,6 +343,16 @@ int RunSimulate() {
               << " % (cam0), "
               << FormatFixed(100.0 * options.lens_change.focal_scale[1], 2)
               << " % (cam1) since the calibration in camchain.yaml\n";
+  }
+  if (!options.exposure_delay.IsZero()) {
+    std::cout << "  delay    cam1 exposes "
+              << FormatFixed(1e3 * options.exposure_delay.delay, 1)
+              << " ms after cam0, the rig turning at "
+              << FormatFixed(options.exposure_delay.angular_speed_sd / kDegree,
+                             1)
+              << " deg/s and moving at "
+              << FormatFixed(options.exposure_delay.speed_sd, 3)
+              << " m/s per axis (sd, per frame): matches only\n";
   }
   if (options.board) {
     const std::array<int, 3> visible = CountVisibleBoardFrames(sim);

@@ -4,6 +4,8 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -43,6 +45,28 @@ RunResult Simulate(const std::string& folder, const std::string& flags) {
   return Rcm(args);
 }
 
+std::string ReadFile(const std::string& path) {
+  std::ifstream file(path);
+  std::stringstream text;
+  text << file.rdbuf();
+  return text.str();
+}
+
+// The rows of a CSV file, each split at its commas.
+std::vector<std::vector<std::string>> ReadCsv(const std::string& path) {
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream lines(ReadFile(path));
+  for (std::string line; std::getline(lines, line);) {
+    std::vector<std::string> fields;
+    std::istringstream cells(line);
+    for (std::string cell; std::getline(cells, cell, ',');) {
+      fields.push_back(cell);
+    }
+    rows.push_back(fields);
+  }
+  return rows;
+}
+
 void ExpectFailsWithOneLine(const RunResult& result, int exit_code,
                             const std::string& needle) {
   EXPECT_EQ(result.exit_code, exit_code) << result.err;
@@ -56,8 +80,8 @@ TEST(SimulateCli, WritesASequenceThatEstimateReads) {
   // matches and returns the truth to 1e-9 (batch_refinement_test).
   const std::string folder = Folder("sequence");
   const RunResult simulated =
-      Rcm({"simulate", "--out", folder, "--frames", "2", "--supersampling",
-           "1", "--matches-per-frame", "200", "--n", "1.34"});
+      Rcm({"simulate", "--out", folder, "--frames", "2", "--supersampling", "1",
+           "--matches-per-frame", "200", "--n", "1.34"});
   ASSERT_EQ(simulated.exit_code, 0) << simulated.err;
   EXPECT_NE(simulated.out.find("wrote 2 frames"), std::string::npos)
       << simulated.out;
@@ -79,8 +103,9 @@ TEST(SimulateCli, WritesASequenceThatEstimateReads) {
 
 TEST(SimulateCli, SameSeedSameBytes) {
   const std::vector<std::string> flags = {
-      "--frames",         "2",   "--supersampling", "1", "--seed", "9",
-      "--matches-per-frame", "50", "--match-noise", "0.5"};
+      "--frames",      "2",  "--supersampling",     "1",
+      "--seed",        "9",  "--matches-per-frame", "50",
+      "--match-noise", "0.5"};
   std::vector<std::string> folders;
   for (const char* name : {"a", "b"}) {
     folders.push_back(Folder(name));
@@ -88,8 +113,8 @@ TEST(SimulateCli, SameSeedSameBytes) {
     args.insert(args.end(), flags.begin(), flags.end());
     ASSERT_EQ(Rcm(args).exit_code, 0);
   }
-  for (const char* file : {"left/000000.png", "right/000001.png",
-                           "matches.csv", "truth.csv", "camchain.yaml"}) {
+  for (const char* file : {"left/000000.png", "right/000001.png", "matches.csv",
+                           "truth.csv", "camchain.yaml"}) {
     EXPECT_EQ(test::ReadWholeFile(folders[0] + "/" + file),
               test::ReadWholeFile(folders[1] + "/" + file))
         << file;
@@ -114,10 +139,9 @@ TEST(SimulateCli, MediaSwitchesAreInTheTruth) {
 TEST(SimulateCli, DepthRangeMatchesWithoutImages) {
   // The correspondence generator alone: thin port, close range, exact.
   const std::string folder = Folder("depths");
-  const RunResult simulated =
-      Rcm({"simulate", "--out", folder, "--noimages", "--depth-range",
-           "0.3,1.5", "--matches-per-frame", "150", "--frames", "2", "--n",
-           "1.6"});
+  const RunResult simulated = Rcm(
+      {"simulate", "--out", folder, "--noimages", "--depth-range", "0.3,1.5",
+       "--matches-per-frame", "150", "--frames", "2", "--n", "1.6"});
   ASSERT_EQ(simulated.exit_code, 0) << simulated.err;
   const RunResult estimated =
       Rcm({"estimate", "--calib", folder + "/camchain.yaml", "--matches",
@@ -135,16 +159,88 @@ TEST(SimulateCli, DepthRangeMatchesWithoutImages) {
       2, "no images");
 }
 
+// Cameras not triggered together: the matches of the delayed run differ
+// from the synchronized run's in their right pixels only, and the frames
+// then disagree beyond their noise, which rcm estimate reports (chi-square
+// test) and counts in sigma_n. 10 ms at 20 deg/s and 0.2 m/s (sd) moves
+// cam1's view by ~0.2 deg and ~2 mm per frame, several times the exact
+// data's 1e-9.
+TEST(SimulateCli, ExposureDelayMovesTheRightPixels) {
+  const std::string synchronized = Folder("synchronized");
+  const std::string delayed = Folder("delayed");
+  const std::vector<std::string> base = {"simulate",
+                                         "--noimages",
+                                         "--depth-range",
+                                         "0.5,6",
+                                         "--matches-per-frame",
+                                         "150",
+                                         "--frames",
+                                         "6"};
+  std::vector<std::string> args = base;
+  args.insert(args.end(), {"--out", synchronized});
+  ASSERT_EQ(Rcm(args).exit_code, 0);
+  args = base;
+  args.insert(args.end(), {"--out", delayed, "--exposure-delay", "10,20,0.2"});
+  const RunResult run = Rcm(args);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("cam1 exposes 10.0 ms after cam0"), std::string::npos)
+      << run.out;
+  const std::vector<std::vector<std::string>> a =
+      ReadCsv(synchronized + "/matches.csv");
+  const std::vector<std::vector<std::string>> b =
+      ReadCsv(delayed + "/matches.csv");
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_GT(a.size(), 1u);
+  // The same left pixels (frame, xl, yl), but for the few points whose
+  // moved right pixel left the image and were drawn again; every right
+  // pixel of a shared left pixel moved.
+  std::map<std::vector<std::string>, std::vector<std::string>> right_of;
+  for (size_t i = 1; i < a.size(); ++i) {
+    ASSERT_GE(a[i].size(), 5u);
+    right_of[{a[i][0], a[i][1], a[i][2]}] = {a[i][3], a[i][4]};
+  }
+  int shared = 0;
+  for (size_t i = 1; i < b.size(); ++i) {
+    ASSERT_GE(b[i].size(), 5u);
+    const auto it = right_of.find({b[i][0], b[i][1], b[i][2]});
+    if (it == right_of.end()) continue;
+    ++shared;
+    EXPECT_NE(it->second, (std::vector<std::string>{b[i][3], b[i][4]}));
+  }
+  EXPECT_GE(shared, static_cast<int>(0.9 * (b.size() - 1)));
+  const nlohmann::json settings =
+      nlohmann::json::parse(ReadFile(delayed + "/simulation.json"));
+  EXPECT_DOUBLE_EQ(settings["exposure_delay"]["delay_ms"].get<double>(), 10.0);
+  const RunResult estimated =
+      Rcm({"estimate", "--calib", delayed + "/camchain.yaml", "--matches",
+           delayed + "/matches.csv", "--json"});
+  ASSERT_EQ(estimated.exit_code, 0) << estimated.err;
+  const nlohmann::json json = nlohmann::json::parse(estimated.out);
+  EXPECT_GT(json["consistency"]["inflation"].get<double>(), 1.0)
+      << estimated.out;
+  ExpectFailsWithOneLine(Rcm({"simulate", "--out", Folder("delay_images"),
+                              "--exposure-delay", "10,5"}),
+                         2, "render no images");
+  ExpectFailsWithOneLine(
+      Rcm({"simulate", "--out", Folder("delay_bad"), "--noimages",
+           "--matches-per-frame", "5", "--exposure-delay", "10"}),
+      2, "MS,DEG_S");
+  ExpectFailsWithOneLine(
+      Rcm({"simulate", "--out", Folder("delay_big"), "--noimages",
+           "--matches-per-frame", "5", "--exposure-delay", "500,5"}),
+      2, "exposure delay");
+}
+
 TEST(SimulateCli, UsesTheCamerasOfAGivenRigFile) {
-  // --left-camera cam1 --right-camera cam0 swaps the pair: the written camchain's cam0 is
-  // the file's cam1 (fx 344.39...).
+  // --left-camera cam1 --right-camera cam0 swaps the pair: the written
+  // camchain's cam0 is the file's cam1 (fx 344.39...).
   const std::string folder = Folder("swapped");
-  const RunResult result = Rcm(
-      {"simulate", "--out", folder, "--calib",
-       std::string(RCM_SOURCE_DIR) +
-           "/examples/data/alphasense_front_rectified.yaml",
-       "--left-camera", "cam1", "--right-camera", "cam0", "--noimages",
-       "--matches-per-frame", "20", "--frames", "1"});
+  const RunResult result =
+      Rcm({"simulate", "--out", folder, "--calib",
+           std::string(RCM_SOURCE_DIR) +
+               "/examples/data/alphasense_front_rectified.yaml",
+           "--left-camera", "cam1", "--right-camera", "cam0", "--noimages",
+           "--matches-per-frame", "20", "--frames", "1"});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const std::string camchain = test::ReadWholeFile(folder + "/camchain.yaml");
   const size_t cam0 = camchain.find("cam0:");
@@ -180,9 +276,9 @@ TEST(SimulateCli, BadFlagsGiveOneLine) {
 
 TEST(SimulateCli, RefusesToOverwriteASequence) {
   const std::string folder = Folder("twice");
-  const std::vector<std::string> args = {"simulate", "--out", folder,
-                                         "--noimages", "--matches-per-frame",
-                                         "10", "--frames", "1"};
+  const std::vector<std::string> args = {
+      "simulate", "--out",    folder, "--noimages", "--matches-per-frame",
+      "10",       "--frames", "1"};
   ASSERT_EQ(Rcm(args).exit_code, 0);
   ExpectFailsWithOneLine(Rcm(args), 1, "--overwrite");
   std::vector<std::string> overwrite = args;

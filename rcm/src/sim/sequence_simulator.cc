@@ -37,6 +37,7 @@ enum SeedStream : uint64_t {
   kNoiseSeed = 5,
   kOutlierSeed = 6,
   kBoardSeed = 7,
+  kExposureDelaySeed = 8,
 };
 
 }  // namespace
@@ -87,6 +88,7 @@ Status SequenceOptions::Check() const {
   RCM_RETURN_IF_ERROR(render.Check());
   RCM_RETURN_IF_ERROR(cam1_drift.Check());
   RCM_RETURN_IF_ERROR(lens_change.Check());
+  RCM_RETURN_IF_ERROR(exposure_delay.Check());
   if (board) {
     RCM_RETURN_IF_ERROR(board->Check());
     RCM_RETURN_IF_ERROR(board_motion.Check());
@@ -104,6 +106,9 @@ Status SequenceOptions::Check() const {
                std::isfinite(match_max_depth))) {
     message << "match depth range [" << match_min_depth << ", "
             << match_max_depth << "] must satisfy 0 < min <= max < inf";
+  } else if (!exposure_delay.IsZero() && render_images) {
+    message << "an exposure delay moves the matches only (the images are "
+               "rendered from one pose); render no images with it";
   } else if (UsesDepthRange() && render_images) {
     message << "matches over a depth range do not belong to the images; "
                "render no images with them";
@@ -180,8 +185,16 @@ std::vector<StereoCorrespondence> SequenceSimulator::SampleMatches(
   const FlatPortCamera right =
       FlatPortCamera::Create(true_rig_.right(), options_.right_port, n).value();
   const Rigid3d& world_from_left = poses_[index].world_from_cam0;
-  const Rigid3d world_from_right =
+  Rigid3d world_from_right =
       world_from_left * true_rig_.right_from_left().Inverse();
+  if (!options_.exposure_delay.IsZero()) {
+    // cam1 at the right exposure: it sees X (left frame) at M X, i.e. it
+    // has moved by M^-1 relative to the scene.
+    const Rigid3d motion = options_.exposure_delay.MotionOfFrame(
+        DeriveSeed(options_.seed, kExposureDelaySeed), index);
+    world_from_right =
+        world_from_left * (true_rig_.right_from_left() * motion).Inverse();
+  }
   const Rigid3d right_from_world = world_from_right.Inverse();
   const Camera& left_camera = true_rig_.left();
   const Camera& right_camera = true_rig_.right();
@@ -262,6 +275,7 @@ StatusOr<SequenceFrame> SequenceSimulator::Frame(int index) {
       sampler.max_depth = options_.match_max_depth;
       sampler.per_frame = options_.matches_per_frame;
       sampler.seed = DeriveSeed(DeriveSeed(options_.seed, kMatchSeed), index);
+      sampler.exposure_delay = options_.exposure_delay;
       StatusOr<std::vector<StereoCorrespondence>> sampled =
           SampleFlatPortCorrespondences(true_rig_, options_.left_port,
                                         options_.right_port, sampler);

@@ -15,6 +15,8 @@
 // - extrinsic drift: the rig that renders the images and samples the
 //   matches is rig.WithCam1Moved(drift) (stereo_rig.h), while rig() stays
 //   the in-air calibration a user would have (and a writer's camchain);
+// - cameras not triggered together (ExposureDelay): the right camera's
+//   matches see the scene moved by the frame's motion during the delay;
 // - lenses that changed (LensChange): each camera's focal lengths scaled
 //   by 1 + s_c in that rig (a focus ring or a lens that shifted in its
 //   mount, temperature), the calibration's unchanged;
@@ -43,6 +45,7 @@
 #include "rcm/geometry/stereo_correspondence.h"
 #include "rcm/geometry/stereo_rig.h"
 #include "rcm/sim/board_motion.h"
+#include "rcm/sim/exposure_delay.h"
 #include "rcm/sim/media_schedule.h"
 #include "rcm/sim/scene_board.h"
 #include "rcm/sim/stereo_renderer.h"
@@ -98,8 +101,8 @@ struct SequenceOptions {
   // Its frames is replaced by the media schedule's frame count.
   TrajectoryOptions trajectory;
   RenderOptions render;
-  bool render_images = true;  // false: poses and matches only (fast)
-  int matches_per_frame = 0;  // exact scene correspondences per frame, >= 0
+  bool render_images = true;      // false: poses and matches only (fast)
+  int matches_per_frame = 0;      // exact scene correspondences per frame, >= 0
   double match_noise_px = 0.0;    // Gaussian noise on all four coordinates
   double outlier_fraction = 0.0;  // of each frame's matches, in [0, 1]
   // Both zero (the default): matches are points of the tank's surfaces.
@@ -113,6 +116,10 @@ struct SequenceOptions {
   // Default none: the rig is as calibrated.
   ExtrinsicDrift cam1_drift;
   LensChange lens_change;
+  // Default none: the cameras are triggered together. With a delay the
+  // right camera sees each frame's scene moved by that frame's motion
+  // (exposure_delay.h), in the matches only: render no images with it.
+  ExposureDelay exposure_delay;
   // A chessboard held in front of the rig (default none), and how it
   // moves; the motion's seed is replaced by one derived from `seed`.
   std::optional<SceneBoard> board;
