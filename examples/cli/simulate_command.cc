@@ -116,6 +116,22 @@ bool FlagGiven(const char* name) {
   return gflags::GetCommandLineFlagInfo(name, &info) && !info.is_default;
 }
 
+// --exposure-delay into options->exposure_delay; one line on a bad value
+// (also images asked for with it: SequenceOptions::Check).
+Status ExposureDelayFromFlag(SequenceOptions* options) {
+  if (FLAGS_exposure_delay.empty()) return Status::Ok();
+  const std::string context = "--exposure-delay " + FLAGS_exposure_delay;
+  const StatusOr<std::vector<double>> values =
+      ParseNumberList(FLAGS_exposure_delay);
+  if (!values.ok() || (values->size() != 2 && values->size() != 3)) {
+    return Status::Error(context + ": expected MS,DEG_S[,M_S], e.g. 10,5,0.05");
+  }
+  options->exposure_delay.delay = 1e-3 * (*values)[0];
+  options->exposure_delay.angular_speed_sd = (*values)[1] * kDegree;
+  options->exposure_delay.speed_sd = values->size() == 3 ? (*values)[2] : 0.0;
+  return options->Check().WithContext(context);
+}
+
 // --board and --board-distance into options->board, board_motion.
 Status BoardFromFlags(SequenceOptions* options) {
   if (!TargetGiven()) {
@@ -216,22 +232,9 @@ int RunSimulate() {
     PrintError(command, lens.message());
     return kExitUsage;
   }
-  if (!FLAGS_exposure_delay.empty()) {
-    const StatusOr<std::vector<double>> values =
-        ParseNumberList(FLAGS_exposure_delay);
-    if (!values.ok() || (values->size() != 2 && values->size() != 3)) {
-      PrintError(command, "--exposure-delay " + FLAGS_exposure_delay +
-                              ": expected MS,DEG_S[,M_S], e.g. 10,5,0.05");
-      return kExitUsage;
-    }
-    options.exposure_delay.delay = 1e-3 * (*values)[0];
-    options.exposure_delay.angular_speed_sd = (*values)[1] * kDegree;
-    options.exposure_delay.speed_sd = values->size() == 3 ? (*values)[2] : 0.0;
-    if (const Status valid = options.Check(); !valid.ok()) {
-      PrintError(command, "--exposure-delay " + FLAGS_exposure_delay + ": " +
-                              valid.message());
-      return kExitUsage;
-    }
+  if (const Status delay = ExposureDelayFromFlag(&options); !delay.ok()) {
+    PrintError(command, delay.message());
+    return kExitUsage;
   }
   if (const Status board = BoardFromFlags(&options); !board.ok()) {
     PrintError(command, board.message());

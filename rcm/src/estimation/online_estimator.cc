@@ -245,6 +245,12 @@ StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
     const FrameEstimateSums& frame_estimates, const RefinementOptions& options,
     double scatter_inflation) {
   CHECK_GE(scatter_inflation, 1.0);
+  // The consistency test's inflation, at least scatter_inflation.
+  const auto inflation_of =
+      [scatter_inflation](const std::optional<FrameConsistency>& consistency) {
+        return std::max(scatter_inflation,
+                        consistency ? consistency->inflation : 1.0);
+      };
   // n alone first: it checks the inliers and the observability of n.
   const StatusOr<LocusEstimate> locus = EstimateFromLocusCost(cost, options);
   if (!locus.ok()) return locus.status();
@@ -253,9 +259,7 @@ StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
   if (!rig.calibration_uncertainty() && options.systematic_px == 0.0) {
     estimate.consistency =
         FrameConsistencyOf(frame_estimates, locus->n, locus->sigma_px);
-    const double inflation =
-        std::max(scatter_inflation,
-                 estimate.consistency ? estimate.consistency->inflation : 1.0);
+    const double inflation = inflation_of(estimate.consistency);
     estimate.sigma_n_noise = estimate.sigma_n = locus->sigma_n * inflation;
     RCM_RETURN_IF_ERROR(CheckNotPinnedAtUpperBound(locus->n, estimate.sigma_n));
     return estimate;
@@ -288,9 +292,7 @@ StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
   estimate.locus.crlb = sigma_px / std::sqrt(cost.Information(n));
   estimate.consistency = FrameConsistencyOf(
       frame_estimates, n, sigma_px, SelfCalibrationOf(rotation, focal_scale));
-  const double inflation =
-      std::max(scatter_inflation,
-               estimate.consistency ? estimate.consistency->inflation : 1.0);
+  const double inflation = inflation_of(estimate.consistency);
   StatusOr<CalibrationPropagation> propagation = PropagateCalibration(
       at_solution, layout, uncertainty,
       self_calibrate ? RotationMode::kPrior : RotationMode::kHeld, sigma_px,
@@ -379,11 +381,12 @@ OnlineRefractiveIndexEstimator::AddFrame(
     update.inliers = std::move(fit.inliers);
   }
   update.cumulative = Current();
-  if (update.cumulative.ok())
+  double inflation = 1.0;
+  if (update.cumulative.ok()) {
     linearization_.Follow(update.cumulative->rotation);
-  update.frame_estimate = FrameEstimateOf(
-      rig_, fit, options_,
-      update.cumulative.ok() ? ScatterInflationOf(*update.cumulative) : 1.0);
+    inflation = ScatterInflationOf(*update.cumulative);
+  }
+  update.frame_estimate = FrameEstimateOf(rig_, fit, options_, inflation);
   return update;
 }
 

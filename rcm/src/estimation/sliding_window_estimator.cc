@@ -11,9 +11,9 @@ namespace {
 
 // z between two independent estimates (header); a zero denominator (exact
 // data) gives 0 for equal values and +inf otherwise.
-double ChangeStatistic(const LocusEstimate& a, double n_b, double sigma_b) {
-  const double difference = std::abs(a.n - n_b);
-  const double sigma = std::hypot(a.sigma_n, sigma_b);
+double ChangeStatistic(double n_a, double sigma_a, double n_b, double sigma_b) {
+  const double difference = std::abs(n_a - n_b);
+  const double sigma = std::hypot(sigma_a, sigma_b);
   if (sigma > 0.0) return difference / sigma;
   return difference == 0.0 ? 0.0 : std::numeric_limits<double>::infinity();
 }
@@ -130,14 +130,14 @@ SlidingWindowRefractiveIndexEstimator::AddFrame(
   if (window.ok()) {
     // With a self-calibrated window, the frame's own n at the window's
     // rotation (FrameFit::Model).
-    LocusEstimate own = frame_cost.estimate;
-    if (window->rotation) {
-      own.n = frame_cost.model.At(SelfCalibrationOf(
-          *window->rotation,
-          window->focal_scale.value_or(Eigen::Vector2d::Zero())));
-    }
-    own.sigma_n *= inflation;
-    update.z = ChangeStatistic(own, window->n, window->sigma_n_noise);
+    const double own_n =
+        window->rotation
+            ? frame_cost.model.At(SelfCalibrationOf(
+                  *window->rotation,
+                  window->focal_scale.value_or(Eigen::Vector2d::Zero())))
+            : frame_cost.estimate.n;
+    update.z = ChangeStatistic(own_n, inflation * frame_cost.estimate.sigma_n,
+                               window->n, window->sigma_n_noise);
   }
   if (!update.z || *update.z <= window_options_.change_threshold) {
     num_dropped_frames_ += static_cast<int64_t>(pending_.size());
@@ -150,10 +150,10 @@ SlidingWindowRefractiveIndexEstimator::AddFrame(
 
   // Inconsistent with the window: pending, with the frames before it when
   // it agrees with the last of them.
-  LocusEstimate scattered = frame_cost.estimate;
-  scattered.sigma_n *= inflation;
   if (!pending_.empty() &&
-      ChangeStatistic(scattered, pending_.back().estimate.n,
+      ChangeStatistic(frame_cost.estimate.n,
+                      inflation * frame_cost.estimate.sigma_n,
+                      pending_.back().estimate.n,
                       inflation * pending_.back().estimate.sigma_n) >
           window_options_.change_threshold) {
     num_dropped_frames_ += static_cast<int64_t>(pending_.size());

@@ -185,16 +185,14 @@ std::vector<StereoCorrespondence> SequenceSimulator::SampleMatches(
   const FlatPortCamera right =
       FlatPortCamera::Create(true_rig_.right(), options_.right_port, n).value();
   const Rigid3d& world_from_left = poses_[index].world_from_cam0;
-  Rigid3d world_from_right =
-      world_from_left * true_rig_.right_from_left().Inverse();
-  if (!options_.exposure_delay.IsZero()) {
-    // cam1 at the right exposure: it sees X (left frame) at M X, i.e. it
-    // has moved by M^-1 relative to the scene.
-    const Rigid3d motion = options_.exposure_delay.MotionOfFrame(
-        DeriveSeed(options_.seed, kExposureDelaySeed), index);
-    world_from_right =
-        world_from_left * (true_rig_.right_from_left() * motion).Inverse();
-  }
+  // cam1 at the right exposure (exposure_delay.h).
+  const Rigid3d world_from_right =
+      world_from_left *
+      options_.exposure_delay
+          .RightFromLeftOfFrame(true_rig_.right_from_left(),
+                                DeriveSeed(options_.seed, kExposureDelaySeed),
+                                index)
+          .Inverse();
   const Rigid3d right_from_world = world_from_right.Inverse();
   const Camera& left_camera = true_rig_.left();
   const Camera& right_camera = true_rig_.right();

@@ -93,16 +93,14 @@ StatusOr<std::vector<StereoCorrespondence>> SampleWithTracer(
   return correspondences;
 }
 
-// cam1's view of each frame: right_from_left, after the scene's motion
-// during the exposure delay.
+// cam1's view of each frame (ExposureDelay::RightFromLeftOfFrame).
 std::vector<Rigid3d> RightFromLeftOfFrames(
     const StereoRig& rig, const StereoSamplerOptions& options) {
-  std::vector<Rigid3d> right_from_left(options.num_frames,
-                                       rig.right_from_left());
+  std::vector<Rigid3d> right_from_left;
+  right_from_left.reserve(options.num_frames);
   for (int frame = 0; frame < options.num_frames; ++frame) {
-    right_from_left[frame] =
-        rig.right_from_left() *
-        options.exposure_delay.MotionOfFrame(options.seed, frame);
+    right_from_left.push_back(options.exposure_delay.RightFromLeftOfFrame(
+        rig.right_from_left(), options.seed, frame));
   }
   return right_from_left;
 }

@@ -64,6 +64,14 @@ struct ExposureDelay {
   // The motion of frame `frame` during the delay, X -> X' above (identity
   // when IsZero()). Depends only on (seed, frame).
   Rigid3d MotionOfFrame(uint64_t seed, int frame) const;
+  // cam1's view of frame `frame` at its exposure: right_from_left *
+  // MotionOfFrame(seed, frame); `right_from_left` itself, bit for bit,
+  // when IsZero().
+  Rigid3d RightFromLeftOfFrame(const Rigid3d& right_from_left, uint64_t seed,
+                               int frame) const {
+    if (IsZero()) return right_from_left;
+    return right_from_left * MotionOfFrame(seed, frame);
+  }
 };
 
 }  // namespace rcm
