@@ -726,7 +726,7 @@ nlohmann::json CalibrationJson(const Report& report, const StereoRig& rig) {
   const Eigen::Vector3d per_degree = p.dn_drotation / kDegreesPerRadian;
   const Eigen::Vector3d per_mm = 1e-3 * p.dn_dtranslation;
   const Eigen::Matrix3d rotation =
-      rig.calibration_uncertainty()->RotationCovariance();
+      rig.calibration_uncertainty()->RotationPriorCovariance();
   return {
       {"source", p.source},
       {"rotation", RotationModeName(p.mode)},
@@ -770,7 +770,7 @@ std::vector<std::string> UncertaintyWarnings(const Report& report,
   if (report.rotation && report.calibration && rig.calibration_uncertainty()) {
     const RotationCorrection& rotation = *report.rotation;
     const Eigen::Matrix3d prior =
-        rig.calibration_uncertainty()->RotationCovariance();
+        rig.calibration_uncertainty()->RotationPriorCovariance();
     const Eigen::LDLT<Eigen::Matrix3d> ldlt(prior);
     if (rotation.with_prior && ldlt.info() == Eigen::Success) {
       const double sigmas =

@@ -98,5 +98,74 @@ TEST(CalibrationUncertainty, ExtrinsicsLensCorrelation) {
   EXPECT_THAT(bad.Check(1, 1).message(), HasSubstr("needs both lens"));
 }
 
+// A fixed positive definite n x n matrix (entries of a sine table).
+Eigen::MatrixXd FixedCovariance(int n, double shift) {
+  Eigen::MatrixXd root(n, n);
+  for (int r = 0; r < n; ++r) {
+    for (int c = 0; c < n; ++c)
+      root(r, c) = std::sin(shift + 1.3 * r + 0.7 * c * c);
+  }
+  return root * root.transpose() + 0.1 * Eigen::MatrixXd::Identity(n, n);
+}
+
+// The conditional covariance is the Schur complement Sigma_xx - Sigma_xq
+// Sigma_qq^-1 Sigma_qx for an invertible Sigma_qq (to 1e-12 relative: the
+// two differ only by rounding), ignores variables of zero variance, and is
+// the marginal when x is uncorrelated with the rest.
+TEST(CalibrationUncertainty, ConditionalCovarianceIsTheSchurComplement) {
+  constexpr double kRounding = 1e-12;
+  const Eigen::MatrixXd joint = FixedCovariance(7, 0.2);
+  const Eigen::MatrixXd expected =
+      joint.topLeftCorner(3, 3) - joint.topRightCorner(3, 4) *
+                                      joint.bottomRightCorner(4, 4).inverse() *
+                                      joint.bottomLeftCorner(4, 3);
+  const Eigen::MatrixXd conditional = ConditionalCovariance(joint, 3);
+  EXPECT_LT((conditional - expected).norm(), kRounding * joint.norm());
+  EXPECT_EQ(conditional, conditional.transpose());
+
+  // A variable of zero variance (an exact parameter) changes nothing.
+  Eigen::MatrixXd padded = Eigen::MatrixXd::Zero(8, 8);
+  padded.topLeftCorner(7, 7) = joint;
+  EXPECT_LT((ConditionalCovariance(padded, 3) - expected).norm(),
+            kRounding * joint.norm());
+
+  Eigen::MatrixXd independent = joint;
+  independent.topRightCorner(3, 4).setZero();
+  independent.bottomLeftCorner(4, 3).setZero();
+  EXPECT_EQ(ConditionalCovariance(independent, 3), joint.topLeftCorner(3, 3));
+  EXPECT_EQ(ConditionalCovariance(joint, 7), joint);
+}
+
+// The rotation's prior: the marginal for a drift prior alone; for a rotation
+// fitted through the lenses, w = K lenses + e, what e alone spreads (the
+// lenses' share conditioned out, to rounding), however large K makes the
+// marginal.
+TEST(CalibrationUncertainty, RotationPriorIsTheRotationGivenTheRest) {
+  const CalibrationUncertainty drift =
+      CalibrationUncertainty::DriftPrior(1e-3, 1e-4);
+  EXPECT_EQ(drift.RotationPriorCovariance(), drift.RotationCovariance());
+
+  // Lenses of 2 parameters each, independent of the own error e of
+  // [w; dt] (covariance E0); the rotation moves 0.01 rad per unit of lens.
+  const Eigen::MatrixXd lens = FixedCovariance(4, 1.1);
+  Eigen::Matrix<double, 6, 4> k = Eigen::Matrix<double, 6, 4>::Zero();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) k(r, c) = 0.01 * std::cos(r + 2.0 * c);
+  }
+  const Eigen::Matrix<double, 6, 6> own = 1e-8 * FixedCovariance(6, 0.4);
+  CalibrationUncertainty fitted;
+  fitted.extrinsics_covariance = own + k * lens * k.transpose();
+  fitted.left_lens_covariance = lens.topLeftCorner(2, 2);
+  fitted.right_lens_covariance = lens.bottomRightCorner(2, 2);
+  fitted.lens_cross_covariance = lens.topRightCorner(2, 2);
+  fitted.extrinsics_lens_covariance = k * lens;
+  ASSERT_TRUE(fitted.Check(2, 2).ok()) << fitted.Check(2, 2).message();
+  // Given the lenses and dt, w spreads as e does given e's dt.
+  const Eigen::Matrix3d expected = ConditionalCovariance(own, 3);
+  EXPECT_LT((fitted.RotationPriorCovariance() - expected).norm(),
+            1e-9 * expected.norm());
+  EXPECT_GT(fitted.RotationCovariance().trace(), 100.0 * expected.trace());
+}
+
 }  // namespace
 }  // namespace rcm

@@ -336,7 +336,8 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
     const double prior_sigma_px = 0.5 * options.loss_scale_px;
     ceres::CostFunction* prior =
         mode == RotationMode::kPrior
-            ? NewRotationPrior(uncertainty.RotationCovariance(), prior_sigma_px)
+            ? NewRotationPrior(uncertainty.RotationPriorCovariance(),
+                               prior_sigma_px)
             : nullptr;
     const ceres::Solver::Summary stage1 = Solve(
         essential, matches, all, options.loss, options, with_rotation, prior,
@@ -435,7 +436,7 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
           const double weight_px = std::max(prior_sigma_px, 1e-6);
           ceres::CostFunction* prior =
               mode == RotationMode::kPrior
-                  ? NewRotationPrior(uncertainty.RotationCovariance(),
+                  ? NewRotationPrior(uncertainty.RotationPriorCovariance(),
                                      weight_px)
                   : nullptr;
           const ceres::Solver::Summary stage2 =

@@ -539,21 +539,30 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
       for (int k = 0; k < 3; ++k) sigma_pw(r, k) = calibration(held[r], 1 + k);
     }
   }
+  // The rotation's prior P_w is its covariance given the held columns
+  // (CalibrationUncertainty::RotationPriorCovariance); the rotation's
+  // deviation from it has the marginal covariance Sigma_ww, so its share is
+  // sigma^4 H'^-1 P_w Sigma_ww P_w H'^-1 (H'^-1 P_w H'^-1 when w is
+  // uncorrelated with the held columns and the two are equal).
   Eigen::MatrixXd prior = Eigen::MatrixXd::Zero(nx, nx);
+  Eigen::MatrixXd prior_spread = Eigen::MatrixXd::Zero(nx, nx);
   if (mode == RotationMode::kPrior) {
-    const Eigen::Matrix3d rotation_covariance =
-        uncertainty.RotationCovariance();
-    const Eigen::LDLT<Eigen::Matrix3d> ldlt(rotation_covariance);
+    const Eigen::LDLT<Eigen::Matrix3d> ldlt(
+        uncertainty.RotationPriorCovariance());
     if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) {
       return Status::Error(
           "the rotation prior is singular: give every axis a drift sigma > 0");
     }
-    prior.block<3, 3>(1, 1) = ldlt.solve(Eigen::Matrix3d::Identity());
+    const Eigen::Matrix3d precision = ldlt.solve(Eigen::Matrix3d::Identity());
+    prior.block<3, 3>(1, 1) = precision;
+    prior_spread.block<3, 3>(1, 1) =
+        precision * uncertainty.RotationCovariance() * precision;
   }
   Eigen::MatrixXd n_prior = Eigen::MatrixXd::Zero(nx, nx);
   if (n_prior_sigma > 0.0)
     n_prior(0, 0) = 1.0 / (n_prior_sigma * n_prior_sigma);
   prior += n_prior;
+  prior_spread += n_prior;
   Eigen::MatrixXd focal_prior = Eigen::MatrixXd::Zero(nx, nx);
   if (layout.focal) {
     if (!(focal_variance > 0.0)) {
@@ -563,6 +572,7 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
         Eigen::Matrix2d::Identity() / focal_variance;
   }
   prior += focal_prior;
+  prior_spread += focal_prior;
   // In the sigma^2-scaled form, stable down to exact data (sigma = 0):
   // H' = sigma^2 H = A + sigma^2 P, S = H'^-1 B.
   const Eigen::MatrixXd h = a + variance * prior;
@@ -575,7 +585,7 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
   const Eigen::MatrixXd h_inverse = lu.inverse();
   const Eigen::MatrixXd noise = variance * h_inverse * a * h_inverse;
   const Eigen::MatrixXd from_prior =
-      variance * variance * h_inverse * prior * h_inverse;
+      variance * variance * h_inverse * prior_spread * h_inverse;
   const Eigen::MatrixXd from_n_prior =
       variance * variance * h_inverse * n_prior * h_inverse;
   const Eigen::MatrixXd from_focal_prior =
@@ -584,7 +594,8 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
   // The estimate's error is H'^-1 (B dp - sigma^2 P_w dw) for held
   // parameters off by dp and a rotation off its prior by dw (P_w the
   // rotation prior's rows of x), so beside the two independent shares
-  //   from_held  = S Sigma_p S^T,   from_prior = sigma^4 H'^-1 P H'^-1,
+  //   from_held  = S Sigma_p S^T,
+  //   from_prior = sigma^4 H'^-1 P_w Sigma_ww P_w^T H'^-1,
   // their correlation adds
   //   cross = -sigma^2 (S Sigma_pw P_w^T H'^-1 + its transpose).
   Eigen::MatrixXd cross = Eigen::MatrixXd::Zero(nx, nx);

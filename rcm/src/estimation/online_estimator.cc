@@ -273,7 +273,7 @@ StatusOr<CalibratedLocusEstimate> EstimateWithCalibration(
   Eigen::Vector2d focal_scale = Eigen::Vector2d::Zero();
   if (self_calibrate) {
     const QuadraticSelfCalibration pooled = SelfCalibrateQuadratic(
-        normal_equations, layout, uncertainty.RotationCovariance(),
+        normal_equations, layout, uncertainty.RotationPriorCovariance(),
         uncertainty.focal_drift_sigma, locus->sigma_px);
     estimate.locus.n = pooled.n;
     estimate.locus.sigma_px = pooled.sigma_px;

@@ -139,9 +139,10 @@ StatusOr<ThickPortRefinementSummary> RefineRefractiveIndexThickPort(
   const bool with_rotation = mode == RotationMode::kPrior;
   // The prior in pixels of residual for the pixel noise sigma_px.
   const auto rotation_prior = [&](double sigma_px) -> ceres::CostFunction* {
-    return with_rotation ? NewRotationPrior(uncertainty.RotationCovariance(),
-                                            std::max(sigma_px, 1e-6))
-                         : nullptr;
+    return with_rotation
+               ? NewRotationPrior(uncertainty.RotationPriorCovariance(),
+                                  std::max(sigma_px, 1e-6))
+               : nullptr;
   };
   const auto residual = [&](const Parameters& at, size_t i, double* r) {
     return GeneralizedEpipolarResidual(stereo, matches[i], at.n, at.gap_delta,

@@ -1,5 +1,7 @@
 #include "rcm/geometry/calibration_uncertainty.h"
 
+#include <glog/logging.h>
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -150,6 +152,49 @@ Eigen::MatrixXd CalibrationUncertainty::JointCovariance() const {
     joint.block(6 + left, 6, right, left) = lens_cross_covariance.transpose();
   }
   return joint;
+}
+
+Eigen::MatrixXd ConditionalCovariance(const Eigen::MatrixXd& joint, int k) {
+  CHECK_EQ(joint.rows(), joint.cols());
+  CHECK(k >= 0 && k <= joint.rows());
+  const int q = static_cast<int>(joint.rows()) - k;
+  const Eigen::MatrixXd marginal = joint.topLeftCorner(k, k);
+  const Eigen::MatrixXd sigma_xq = joint.topRightCorner(k, q);
+  if (q == 0 || sigma_xq.isZero(0.0)) return marginal;
+  // Sigma_qq in correlation form (its exact entries, zero variance, carry
+  // no covariance with x in a positive semi-definite joint: left out).
+  const Eigen::MatrixXd sigma_qq = joint.bottomRightCorner(q, q);
+  Eigen::VectorXd scale(q);
+  for (int i = 0; i < q; ++i) {
+    const double variance = sigma_qq(i, i);
+    scale[i] = variance > 0.0 ? 1.0 / std::sqrt(variance) : 0.0;
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(
+      scale.asDiagonal() * sigma_qq * scale.asDiagonal());
+  const Eigen::VectorXd& values = eigen.eigenvalues();
+  const double largest = values.maxCoeff();
+  Eigen::VectorXd inverse = Eigen::VectorXd::Zero(q);
+  for (int i = 0; i < q; ++i) {
+    if (values[i] > 1e-12 * largest) inverse[i] = 1.0 / values[i];
+  }
+  const Eigen::MatrixXd projected =
+      sigma_xq * scale.asDiagonal() * eigen.eigenvectors();
+  const Eigen::MatrixXd conditional =
+      marginal - projected * inverse.asDiagonal() * projected.transpose();
+  return 0.5 * (conditional + conditional.transpose());
+}
+
+Eigen::Matrix3d CalibrationUncertainty::RotationPriorCovariance() const {
+  const Eigen::Matrix3d marginal = RotationCovariance();
+  const Eigen::Matrix3d conditional =
+      ConditionalCovariance(JointCovariance(), 3);
+  // Floor the eigenvalues (rounding, or a rotation the lenses determine).
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> own(conditional);
+  const double floor = 1e-12 * std::max(marginal.diagonal().maxCoeff(), 0.0);
+  if (own.eigenvalues().minCoeff() >= floor) return conditional;
+  const Eigen::Vector3d floored = own.eigenvalues().cwiseMax(floor);
+  return own.eigenvectors() * floored.asDiagonal() *
+         own.eigenvectors().transpose();
 }
 
 Status CalibrationUncertainty::Check(int left_num_params,

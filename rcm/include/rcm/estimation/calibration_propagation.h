@@ -31,23 +31,30 @@
 //
 // Estimated x = [n] or [n, w], the rest p held at the calibration and
 // perturbed by its covariance Sigma_p; with A = M_xx, B = M_xp, pixel noise
-// sigma and, when w is estimated with the drift prior, P = Sigma_ww^-1
-// (P = 0 when w is free, --refine-rotation):
+// sigma and, when w is estimated under its prior, P = Sigma_w|p^-1, the
+// inverse of w's covariance given the held parameters
+// (CalibrationUncertainty::RotationPriorCovariance; P = 0 when w is free,
+// --refine-rotation):
 //
 //   H        = A / sigma^2 + diag(0, P)          posterior information
 //   S        = H^-1 B / sigma^2                  d x_hat / d p
 //   cov(x)   = H^-1 A / sigma^2 H^-1             pixel noise
-//            + H^-1 diag(0, P) H^-1              the prior's share of w
+//            + H^-1 diag(0, P Sigma_ww P) H^-1   the prior's share of w
 //            + S Sigma_p S^T                     the calibration held fixed
 //
-// (for a w drawn from the prior the first two sum to H^-1, the Bayesian
-// posterior covariance: MAP estimation, Kay, Fundamentals of Statistical
-// Signal Processing I, ch. 10-11). When the calibration's extrinsics are
-// correlated with its lenses (CalibrationUncertainty::extrinsics_lens_
-// covariance, an underwater calibration's), Sigma_p is the joint
-// covariance of the held columns, and with w under its prior the error
-// H^-1 (B dp / sigma^2 - diag(0, P) dw) of a rotation off its prior by dw
-// adds the cross term
+// (Sigma_ww the marginal covariance of w. When w is uncorrelated with the
+// held parameters Sigma_w|p = Sigma_ww, and for a w drawn from the prior
+// the first two sum to H^-1, the Bayesian posterior covariance: MAP
+// estimation, Kay, Fundamentals of Statistical Signal Processing I, ch.
+// 10-11. An underwater calibration's rotation is fitted through the air
+// lenses, so its marginal is degrees while given the lenses it is what the
+// water views measured: the conditional prior keeps n separable from w,
+// and the terms here and below count the lenses' error in full.) When the
+// calibration's extrinsics are correlated with its lenses
+// (CalibrationUncertainty::extrinsics_lens_covariance, an underwater
+// calibration's), Sigma_p is the joint covariance of the held columns, and
+// with w under its prior the error H^-1 (B dp / sigma^2 - diag(0, P) dw) of
+// a rotation off its prior by dw adds the cross term
 //
 //            - H^-1 (B Sigma_pw diag(0, P) / sigma^2 + transpose) H^-1,
 //

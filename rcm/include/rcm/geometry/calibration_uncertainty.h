@@ -125,9 +125,29 @@ struct CalibrationUncertainty {
       const Eigen::VectorXd& left_params,
       const Eigen::VectorXd& right_params) const;
 
+  // The covariance of w alone (its marginal): how far cam1 may have turned
+  // from the camchain's rotation whatever the lenses are.
   Eigen::Matrix3d RotationCovariance() const {
     return extrinsics_covariance.topLeftCorner<3, 3>();
   }
+  // The covariance of w given the rest held at the camchain's values, the
+  // prior of an estimator that self-calibrates w with dt and the lenses
+  // held (batch_refinement.h, online_estimator.h): with q = [dt; left
+  // params; right params] and the joint covariance above,
+  //
+  //   Sigma_w|q = Sigma_ww - Sigma_wq Sigma_qq^+ Sigma_qw
+  //
+  // (the conditional of a Gaussian, ConditionalCovariance). It equals
+  // RotationCovariance() when w is uncorrelated with q (a drift prior alone, an
+  // air calibration without a rotation-translation correlation). An underwater
+  // calibration fits cam1_from_cam0 through the air lenses, so a lens error
+  // turns the fitted rotation with it by degrees while the two cancel in the
+  // epipolar geometry: the marginal then says degrees, and the conditional what
+  // the water views measured. The held q's own error is propagated with its
+  // correlation with w (calibration_propagation.h). Eigenvalues are floored at
+  // 1e-12 of the marginal's largest (a rotation the lenses determine is then
+  // held).
+  Eigen::Matrix3d RotationPriorCovariance() const;
   // True when nothing is uncertain (every entry zero, no lens covariance).
   bool IsZero() const;
   // The joint covariance of [w; dt; left params; right params] above (the
@@ -144,6 +164,13 @@ struct CalibrationUncertainty {
   // semi-definite".
   Status Check(int left_num_params, int right_num_params) const;
 };
+
+// The covariance of the first k variables of a Gaussian given the others,
+// Sigma_xx - Sigma_xq Sigma_qq^+ Sigma_qx (Sigma_qq^+ the pseudo-inverse of
+// its correlation form, directions below 1e-12 of its largest eigenvalue
+// dropped; variables of zero variance left out), symmetric. `joint` is
+// positive semi-definite, 0 <= k <= its size.
+Eigen::MatrixXd ConditionalCovariance(const Eigen::MatrixXd& joint, int k);
 
 // A covariance matrix as Check requires it: finite, symmetric to a
 // relative 1e-9, smallest eigenvalue above -1e-9 times the largest entry.
