@@ -23,6 +23,7 @@
 #include "image_input_flags.h"
 #include "medium_flag.h"
 #include "progress.h"
+#include "rcm/calib/calibration_covariance.h"
 #include "rcm/calib/calibration_report.h"
 #include "rcm/calib/underwater_calibration.h"
 #include "rcm/calib/underwater_model_selection.h"
@@ -80,87 +81,6 @@ Status CheckPortsForAirGap(const std::string& air) {
         "port block with air_gap 0 for an unknown gap) or neither");
   }
   return Status::Ok();
-}
-
-// Per component of [w; dt], the leave-out spread over the covariance's
-// sigma, at least 1: the scales S of the extrinsics' rows in the sidecar.
-// (One scale for all six, the largest ratio, as an air calibration's
-// sidecar has it, rcm/calib/calibration_covariance.h, carries the ratio of
-// the best-known component, often the rotation about the optical axis,
-// whose covariance sigma is tiny, to the others, whose leave-out spread
-// may be below their covariance's: a target-free estimate, which is
-// sensitive to the rotation about x above all, then inherits a sigma
-// several times too large.)
-Eigen::Matrix<double, 6, 1> ExtrinsicsLeaveOutScales(
-    const calib::ExtrinsicChange& change) {
-  Eigen::Matrix<double, 6, 1> scales = Eigen::Matrix<double, 6, 1>::Ones();
-  const auto ratio = [](double leave_out, double covariance) {
-    return covariance > 0.0 ? std::max(1.0, leave_out / covariance) : 1.0;
-  };
-  for (int k = 0; k < 3; ++k) {
-    if (change.rotation_leave_out_sigma_deg) {
-      scales[k] = ratio((*change.rotation_leave_out_sigma_deg)[k],
-                        change.rotation_sigma_deg[k]);
-    }
-    if (change.translation_leave_out_sigma_mm) {
-      scales[3 + k] = ratio((*change.translation_leave_out_sigma_mm)[k],
-                            change.translation_sigma_mm[k]);
-    }
-  }
-  return scales;
-}
-
-// The sidecar of an underwater calibration: medium water, no drift prior
-// (the extrinsics and the lenses were measured in this dive: no focal
-// drift prior either), and the joint covariance
-// of the extrinsics [w; dt] and the lenses: the lenses' from the joint fit
-// (air views given) or from the air calibration's sidecar when it had
-// one; the extrinsics' from the bundle adjustment, with their correlation
-// with the lenses and the lenses' share of their own
-// (UnderwaterCalibration::extrinsics_lens_covariance); the extrinsics'
-// rows and columns then scaled by the leave-out spread per component
-// (ExtrinsicsLeaveOutScales), E -> S E S and X -> S X, which keeps the
-// joint matrix positive semi-definite. One camera: the air calibration's
-// extrinsics and their uncertainty are kept.
-CalibrationCovarianceFile UnderwaterCovarianceFile(
-    const UnderwaterCalibration& result, const StereoRig& air_rig) {
-  CalibrationCovarianceFile file;
-  file.medium = "water";
-  file.cameras.resize(2);
-  if (result.lenses_estimated) {
-    // The joint fit's lenses and their covariance (it counts the air views
-    // and the water's).
-    file.cameras[0].intrinsics_covariance = result.lens_covariance[0];
-    file.cameras[1].intrinsics_covariance = result.lens_covariance[1];
-    file.cameras[1].previous_intrinsics_covariance =
-        result.lens_cross_covariance;
-  } else if (const std::optional<CalibrationUncertainty>& air =
-                 air_rig.calibration_uncertainty()) {
-    file.cameras[0].intrinsics_covariance = air->left_lens_covariance;
-    file.cameras[1].intrinsics_covariance = air->right_lens_covariance;
-    if (!result.extrinsics_estimated) {
-      file.cameras[1].from_previous_covariance = air->extrinsics_covariance;
-    }
-  }
-  if (result.extrinsics_estimated) {
-    const Eigen::DiagonalMatrix<double, 6> scales(
-        ExtrinsicsLeaveOutScales(result.extrinsic_change));
-    Eigen::Matrix<double, 6, 6> extrinsics = result.extrinsic_change.covariance;
-    // The extrinsics were fitted through the lenses: their covariance with
-    // the lenses, and the lenses' share of their own.
-    const int lens_size =
-        static_cast<int>(file.cameras[0].intrinsics_covariance.rows() +
-                         file.cameras[1].intrinsics_covariance.rows());
-    if (file.cameras[0].intrinsics_covariance.size() > 0 &&
-        file.cameras[1].intrinsics_covariance.size() > 0 &&
-        result.extrinsics_lens_covariance.cols() == lens_size) {
-      extrinsics += result.extrinsics_covariance_from_lenses;
-      file.cameras[1].from_previous_intrinsics_covariance =
-          scales * result.extrinsics_lens_covariance;
-    }
-    file.cameras[1].from_previous_covariance = scales * extrinsics * scales;
-  }
-  return file;
 }
 
 std::string Vector3Text(const Eigen::Vector3d& v, int digits) {
@@ -579,7 +499,7 @@ int RunCalibrateUnderwater(const Subcommand& command,
   }
   if (Status status = WriteCamchainWithCovariance(
           paths.camchain, camchain,
-          UnderwaterCovarianceFile(*result, *air_rig));
+          calib::UnderwaterCalibrationCovariance(*result, *air_rig));
       !status.ok()) {
     PrintError(command, status.message());
     return kExitFailure;

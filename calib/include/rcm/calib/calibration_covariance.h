@@ -21,6 +21,8 @@
 
 #include "rcm/calib/cross_validation.h"
 #include "rcm/calib/stereo_calibration.h"
+#include "rcm/calib/underwater_calibration.h"
+#include "rcm/geometry/stereo_rig.h"
 #include "rcm/io/calibration_covariance_file.h"
 
 namespace rcm::calib {
@@ -36,6 +38,36 @@ CalibrationCovarianceFile AirCalibrationCovariance(
 // 1 without a cross-validation.
 double LeaveOutScale(const std::optional<CrossValidation>& cross_validation,
                      int camera);
+
+// Per component of [w; dt], the leave-out spread over the covariance's
+// sigma, at least 1: the scales S of the extrinsics' rows in an underwater
+// calibration's sidecar (one scale for all six, as the air sidecar has it,
+// would carry the ratio of the best-known component, often the rotation
+// about the optical axis, to the others).
+Eigen::Matrix<double, 6, 1> ExtrinsicsLeaveOutScales(
+    const ExtrinsicChange& change);
+
+// The sidecar of an underwater calibration: medium water, no drift prior
+// (the extrinsics and the lenses were measured in this dive), and the
+// joint covariance of the extrinsics [w; dt] and the lenses: the lenses'
+// from the joint fit (air views given) or from the air rig's
+// calibration_uncertainty() when it has one; the extrinsics' E from the
+// bundle adjustment with their covariance with the lenses X
+// (UnderwaterCalibration::extrinsics_lens_covariance) and the lenses'
+// share of their own. The extrinsics' covariance given the lenses, E_e|L
+// (ConditionalCovariance), is scaled by the leave-out spread per component
+// (ExtrinsicsLeaveOutScales, S), the lenses' share and X kept as the fit
+// has them:
+//
+//   E' = S E_e|L S + (E - E_e|L),   X' = X,
+//
+// positive semi-definite with the lenses' block (its Schur complement is
+// S E_e|L S). Scaling X too would claim a response of the extrinsics to a
+// lens error that the rig does not have, which a target-free estimate then
+// counts as an error of n. Without X, E' = S E S. One camera: the air
+// calibration's extrinsics and their uncertainty are kept.
+CalibrationCovarianceFile UnderwaterCalibrationCovariance(
+    const UnderwaterCalibration& result, const StereoRig& air_rig);
 
 }  // namespace rcm::calib
 
