@@ -164,14 +164,14 @@ FrameFit FitFrame(
   // The calibration's share and the self-calibration need the inliers'
   // normal equations, taken at the frame's n and at the estimator's
   // linearization rotation when there is one (header), else at the
-  // frame's own. The refinement's,
-  // when they are at its rotation and the frame keeps all its inliers (the
-  // rows are the same; the refinement took them at its own n, which the
-  // intercepts carry to first order); else taken here.
-  const bool self_calibrated = own_equations.has_value();
+  // frame's own (whether the frame's refinement self-calibrated or fell
+  // back to the calibration's rotation: the intercepts carry where the
+  // rows were taken). The refinement's, when they are at that rotation
+  // and the frame keeps all its inliers (the rows are the same; the
+  // refinement took them at its own n, which the intercepts carry to
+  // first order); else taken here.
   const Eigen::Vector3d linearization =
-      self_calibrated && linearization_rotation ? *linearization_rotation
-                                                : rotation;
+      linearization_rotation.value_or(rotation);
   if (own_equations && rejected.empty() && linearization == rotation &&
       own_equations->information.rows() == layout.Size()) {
     fit.normal_equations = *std::move(own_equations);
