@@ -28,8 +28,10 @@ Status StereoSamplerOptions::Check() const {
             << " must be >= 1";
   } else if (!(frame_rate > 0.0) || !std::isfinite(frame_rate)) {
     message << "frame_rate = " << frame_rate << " must be > 0";
+  } else if (const Status delay = exposure_delay.Check(); !delay.ok()) {
+    return delay;
   } else {
-    return exposure_delay.Check();
+    return non_rigid_layer.Check();
   }
   return Status::Error(message.str());
 }
@@ -60,6 +62,11 @@ StatusOr<std::vector<StereoCorrespondence>> SampleWithTracer(
   std::vector<StereoCorrespondence> correspondences;
   correspondences.reserve(total);
   int64_t draws = 0;
+  std::vector<double> layer_offsets(options.num_frames);
+  for (int frame = 0; frame < options.num_frames; ++frame) {
+    layer_offsets[frame] =
+        options.non_rigid_layer.OffsetOfFrame(options.seed, frame);
+  }
   for (int frame = 0; frame < options.num_frames; ++frame) {
     for (int i = 0; i < options.per_frame;) {
       if (++draws > max_draws) {
@@ -79,8 +86,14 @@ StatusOr<std::vector<StereoCorrespondence>> SampleWithTracer(
       const double depth = depth_dist(rng);
       StereoCorrespondence correspondence;
       if (!trace(frame, drawn, depth, &correspondence.left_pixel,
-                 &correspondence.right_pixel) ||
-          !rig.left().InImage(correspondence.left_pixel) ||
+                 &correspondence.right_pixel)) {
+        continue;
+      }
+      if (options.non_rigid_layer.Covers(correspondence.left_pixel,
+                                         rig.left().height())) {
+        correspondence.right_pixel.y() += layer_offsets[frame];
+      }
+      if (!rig.left().InImage(correspondence.left_pixel) ||
           !rig.right().InImage(correspondence.right_pixel)) {
         continue;
       }

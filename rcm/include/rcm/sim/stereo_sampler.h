@@ -10,7 +10,10 @@
 // projecting it (RefractiveCamera::ImageFromPointInWater, or
 // FlatPortCamera::ImageFromPoint). Points whose right pixel falls outside
 // the right image are redrawn. With an exposure delay (exposure_delay.h),
-// the right camera sees each frame's points moved by that frame's motion.
+// the right camera sees each frame's points moved by that frame's motion;
+// with a non-rigid layer (non_rigid_layer.h), the right pixels of the
+// matches in its band of the image are moved by its offset (before the
+// right image's bounds are checked).
 #ifndef RCM_SIM_STEREO_SAMPLER_H_
 #define RCM_SIM_STEREO_SAMPLER_H_
 
@@ -21,6 +24,7 @@
 #include "rcm/geometry/stereo_correspondence.h"
 #include "rcm/geometry/stereo_rig.h"
 #include "rcm/sim/exposure_delay.h"
+#include "rcm/sim/non_rigid_layer.h"
 #include "rcm/util/status.h"
 
 namespace rcm {
@@ -37,6 +41,9 @@ struct StereoSamplerOptions {
   // keyed by (seed, frame) apart from the points' draws, so that a delay
   // moves the right pixels of the same points.
   ExposureDelay exposure_delay;
+  // Default none: every match is on the rigid scene. Its offsets are keyed
+  // by (seed, frame) as the delay's are.
+  NonRigidLayer non_rigid_layer;
 
   Status Check() const;
 };
