@@ -1,6 +1,7 @@
 // rcm simulate: a synthetic underwater stereo sequence with ground truth.
 #include <gflags/gflags.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -45,6 +46,11 @@ DEFINE_string(exposure_delay, "",
 DEFINE_string(board_distance, "0.6,2.0",
               "with --board: MIN,MAX in meters, the range of the board's "
               "distance in front of cam0");
+DEFINE_string(board_warp, "",
+              "with --board: X_MM,Y_MM, the board's bow (mrcal's "
+              "calobject_warp, rcm calibrate's board_warp_mm: X_MM + Y_MM "
+              "is the bowl at the centre; positive bows it away from the "
+              "cameras); default flat");
 DEFINE_bool(images, true, "render the images (--noimages: matches only)");
 DEFINE_bool(overwrite, false,
             "replace a sequence already in --out (its frames, matches, "
@@ -63,7 +69,8 @@ constexpr char kSimulateUsage[] =
     "narrow]\n"
     "                    [--extrinsic-drift 0.5,0,0] [--lens-change 0.5,-0.3]\n"
     "                    [--board chessboard --cols 9 --rows 6\n"
-    "                    --square 0.03 [--board-distance 0.6,2]] [--seed "
+    "                    --square 0.03 [--board-distance 0.6,2]\n"
+    "                    [--board-warp 1,0.5]] [--seed "
     "1]\n\n"
     "A robot moves through a textured pool with the stereo rig looking 16\n"
     "degrees down; each camera sees through an exact flat port (air gap,\n"
@@ -86,7 +93,9 @@ constexpr char kSimulateUsage[] =
     "  simulation.json       the settings, to reproduce the run\n"
     "With --board a diver holds a printed chessboard (the flags of rcm\n"
     "calibrate; chessboards only) in front of the rig, moving it slowly and\n"
-    "keeping it in view of both cameras when possible.\n"
+    "keeping it in view of both cameras when possible; --board-warp\n"
+    "X_MM,Y_MM bows it as a hand-held board bows (rcm calibrate estimates\n"
+    "the same warp).\n"
     "truth.csv is written last; the same flags give the same bytes.";
 
 int RunSimulate();
@@ -135,8 +144,12 @@ Status ExposureDelayFromFlag(SequenceOptions* options) {
 // --board and --board-distance into options->board, board_motion.
 Status BoardFromFlags(SequenceOptions* options) {
   if (!TargetGiven()) {
-    if (FlagGiven("board_distance")) {
-      return Status::Error("--board-distance needs --board chessboard");
+    for (const char* flag : {"board_distance", "board_warp"}) {
+      if (FlagGiven(flag)) {
+        std::string name = flag;
+        std::replace(name.begin(), name.end(), '_', '-');
+        return Status::Error("--" + name + " needs --board chessboard");
+      }
     }
     return Status::Ok();
   }
@@ -156,6 +169,18 @@ Status BoardFromFlags(SequenceOptions* options) {
   board.cols = target->cols;
   board.rows = target->rows;
   board.square = target->col_spacing;
+  if (!FLAGS_board_warp.empty()) {
+    const std::string warp_context =
+        FlagContext("board-warp", FLAGS_board_warp);
+    const StatusOr<std::vector<double>> warp =
+        ParseNumberList(FLAGS_board_warp);
+    if (!warp.ok() || warp->size() != 2) {
+      return Status::Error(warp_context +
+                           ": expected X_MM,Y_MM in millimetres, e.g. 1,0.5");
+    }
+    board.warp = 1e-3 * Eigen::Vector2d((*warp)[0], (*warp)[1]);
+    RCM_RETURN_IF_ERROR(board.Check().WithContext(warp_context));
+  }
   RCM_RETURN_IF_ERROR(
       board.Check().WithContext(FlagContext("board", FLAGS_board)));
   options->board = board;
@@ -296,6 +321,8 @@ int RunSimulate() {
         {"cols", options.board->cols},
         {"rows", options.board->rows},
         {"square", options.board->square},
+        {"warp_mm",
+         {1e3 * options.board->warp.x(), 1e3 * options.board->warp.y()}},
         {"distance",
          {options.board_motion.min_distance,
           options.board_motion.max_distance}},

@@ -425,6 +425,12 @@ TEST(SimulateCli, BadDriftAndBoardFlagsGiveOneLine) {
        "--board-distance 2: expected MIN,MAX"},
       {board + "--square 0.03 --board-distance 2,1", 2, "0 < min <= max"},
       {"--board-distance 1,2", 2, "--board-distance needs --board"},
+      {"--board-warp 1,1", 2, "--board-warp needs --board"},
+      {board + "--square 0.03 --board-warp 1", 2,
+       "--board-warp 1: expected X_MM,Y_MM"},
+      {board + "--square 0.03 --board-warp 0,80", 2,
+       "--board-warp 0,80: board warp (0, 0.08) m: each must be within 0.05 "
+       "m"},
       {"--rig gopro", 1, "alphasense, alphasense-unrectified or narrow"},
   };
   for (const auto& bad : cases) {
@@ -439,8 +445,9 @@ TEST(SimulateCli, HelpListsTheFlags) {
   EXPECT_EQ(result.exit_code, 0);
   for (const char* flag :
        {"--out", "--media", "--air-gap", "--calib", "--matches-per-frame",
-        "--seed", "--overwrite", "--extrinsic-drift", "--board=", "--cols=",
-        "--rows=", "--square=", "--board-distance", "board.csv", "narrow"}) {
+        "--seed", "--overwrite", "--extrinsic-drift",
+        "--board=", "--cols=", "--rows=", "--square=", "--board-distance",
+        "--board-warp", "board.csv", "narrow"}) {
     EXPECT_NE(result.out.find(flag), std::string::npos) << flag;
   }
 }

@@ -7,6 +7,7 @@
 #include <random>
 #include <vector>
 
+#include "rcm/calib/board_warp.h"
 #include "rcm/calib/calibration_target.h"
 #include "rcm/calib/target_image.h"
 #include "rcm/sim/scene_intersection.h"
@@ -48,6 +49,31 @@ TEST(SceneBoard, CornersMatchCalibTargetPoints) {
     for (size_t i = 0; i < corners.size(); ++i) {
       EXPECT_EQ(corners[i], expected[i]) << "point " << i;
     }
+  }
+}
+
+// A bowed board's corners are calib's warped target points (the warp that
+// rcm calibrate estimates), to rounding: the two evaluate the same
+// polynomial in another order (1e-15 m on a board of decimetres).
+TEST(SceneBoard, BowedCornersMatchCalibWarpedTargetPoints) {
+  constexpr double kRounding = 1e-15;
+  for (const Eigen::Vector2d warp :
+       {Eigen::Vector2d(1e-3, 0.5e-3), Eigen::Vector2d(-3e-3, 2e-3)}) {
+    SceneBoard board = Board(9, 6, 0.0254);
+    board.warp = warp;
+    ASSERT_TRUE(board.Check().ok());
+    const std::vector<Eigen::Vector3d> expected = calib::WarpedTargetPoints(
+        calib::MakeCheckerboardTarget(board.cols, board.rows, board.square)
+            .value(),
+        warp);
+    const std::vector<Eigen::Vector3d> corners = board.Corners();
+    ASSERT_EQ(corners.size(), expected.size());
+    for (size_t i = 0; i < corners.size(); ++i) {
+      EXPECT_LT((corners[i] - expected[i]).norm(), kRounding) << i;
+    }
+    // The bowl at the centre is warp_x + warp_y.
+    const Eigen::Vector3d center = board.Center();
+    EXPECT_NEAR(board.Height(center.x(), center.y()), warp.sum(), kRounding);
   }
 }
 
@@ -138,6 +164,59 @@ TEST(SceneBoard, CheckRejectsBadBoards) {
   SceneBoard board;
   board.black_albedo = 0.9;
   EXPECT_NE(board.Check().message().find("albedo"), std::string::npos);
+  board = SceneBoard();
+  board.warp = Eigen::Vector2d(0.0, 0.2);
+  EXPECT_NE(board.Check().message().find("board warp (0, 0.2) m"),
+            std::string::npos);
+  board.warp = Eigen::Vector2d(NAN, 0.0);
+  EXPECT_NE(board.Check().message().find("board warp"), std::string::npos);
+}
+
+// Rays meet a bowed board on its surface: the hit lies on z = h(x, y) to
+// the Newton iteration's tolerance (1e-12 m), on the ray, its normal the
+// surface's (-h_x, -h_y, 1) turned towards the ray; a ray towards a corner
+// of the bowed board meets it at the corner. Off-centre rays at 30-40
+// degrees to the board, 2-3 mm of bow.
+TEST(PlacedBoard, RaysMeetABowedBoardOnItsSurface) {
+  constexpr double kTolerance = 1e-12;
+  SceneBoard board;
+  board.warp = Eigen::Vector2d(2e-3, 1e-3);
+  Rigid3d world_from_target = WorldFromTarget(board);
+  // Tilt the board by 35 degrees about its y axis.
+  world_from_target.rotation =
+      world_from_target.rotation *
+      Eigen::AngleAxisd(35.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()).matrix();
+  const PlacedBoard placed(board, world_from_target);
+  const Eigen::Vector3d camera(6.0, 4.0, 1.5);
+  const Rigid3d target_from_world = world_from_target.Inverse();
+  for (const Eigen::Vector3d& corner : board.Corners()) {
+    const Eigen::Vector3d point = world_from_target * corner;
+    const Eigen::Vector3d direction = (point - camera).normalized();
+    const std::optional<BoardHit> hit = placed.Intersect(camera, direction);
+    ASSERT_TRUE(hit.has_value());
+    EXPECT_LT((hit->point - point).norm(), kTolerance);
+    EXPECT_TRUE(hit->printed_side);
+    const Eigen::Vector3d in_target = target_from_world * hit->point;
+    EXPECT_NEAR(in_target.z(), board.Height(in_target.x(), in_target.y()),
+                kTolerance);
+    const Eigen::Vector2d slope = board.Slope(in_target.x(), in_target.y());
+    const Eigen::Vector3d normal =
+        -(world_from_target.rotation *
+          Eigen::Vector3d(-slope.x(), -slope.y(), 1.0).normalized());
+    EXPECT_LT((hit->normal - normal).norm(), kTolerance);
+    EXPECT_LT(hit->normal.dot(direction), 0.0);
+  }
+  // The same rays miss the flat board's plane points by the bow.
+  SceneBoard flat = board;
+  flat.warp.setZero();
+  const PlacedBoard placed_flat(flat, world_from_target);
+  const Eigen::Vector3d through = world_from_target * flat.Center();
+  const BoardHit bowed =
+      placed.Intersect(camera, (through - camera).normalized()).value();
+  const BoardHit plane =
+      placed_flat.Intersect(camera, (through - camera).normalized()).value();
+  EXPECT_GT((bowed.point - plane.point).norm(), 2e-3);
+  EXPECT_LT((plane.point - through).norm(), kTolerance);
 }
 
 TEST(PlacedBoard, RaysMeetThePrintedSideWherePlaneAndAreaSay) {

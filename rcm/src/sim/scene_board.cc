@@ -71,10 +71,29 @@ Status SceneBoard::Check() const {
                white_albedo <= 1.0)) {
     message << "board albedos (black " << black_albedo << ", white "
             << white_albedo << ") must satisfy 0 <= black < white <= 1";
+  } else if (!(std::abs(warp.x()) <= kMaxWarp &&
+               std::abs(warp.y()) <= kMaxWarp)) {
+    message << "board warp (" << warp.x() << ", " << warp.y()
+            << ") m: each must be within " << kMaxWarp << " m";
   } else {
     return Status::Ok();
   }
   return Status::Error(message.str());
+}
+
+double SceneBoard::Height(double x, double y) const {
+  if (warp.isZero(0.0)) return 0.0;
+  const double xr = x / ((cols - 1) * square);
+  const double yr = y / ((rows - 1) * square);
+  return warp.x() * 4.0 * xr * (1.0 - xr) + warp.y() * 4.0 * yr * (1.0 - yr);
+}
+
+Eigen::Vector2d SceneBoard::Slope(double x, double y) const {
+  if (warp.isZero(0.0)) return Eigen::Vector2d::Zero();
+  const double width = (cols - 1) * square;
+  const double height = (rows - 1) * square;
+  return Eigen::Vector2d(warp.x() * 4.0 * (1.0 - 2.0 * x / width) / width,
+                         warp.y() * 4.0 * (1.0 - 2.0 * y / height) / height);
 }
 
 std::vector<Eigen::Vector3d> SceneBoard::Corners() const {
@@ -82,7 +101,8 @@ std::vector<Eigen::Vector3d> SceneBoard::Corners() const {
   corners.reserve(static_cast<size_t>(cols) * rows);
   for (int r = 0; r < rows; ++r) {
     for (int c = 0; c < cols; ++c) {
-      corners.emplace_back(c * square, r * square, 0.0);
+      corners.emplace_back(c * square, r * square,
+                           Height(c * square, r * square));
     }
   }
   return corners;
@@ -94,7 +114,8 @@ std::vector<Eigen::Vector3d> SceneBoard::PatternOutline() const {
   std::vector<Eigen::Vector3d> outline;
   outline.reserve(2 * (cols + rows) + 4);
   const auto add = [&](int i, int j) {
-    outline.emplace_back(i * square, j * square, 0.0);
+    outline.emplace_back(i * square, j * square,
+                         Height(i * square, j * square));
   };
   for (int i = -1; i < cols; ++i) add(i, -1);
   for (int j = -1; j < rows; ++j) add(cols, j);
@@ -141,7 +162,32 @@ std::optional<BoardHit> PlacedBoard::Intersect(
   const Eigen::Vector3d v =
       target_from_world_.rotation * unit_direction_in_world;
   if (!(v.z() != 0.0)) return std::nullopt;  // parallel, or NaN
-  const double t = -o.z() / v.z();
+  double t = -o.z() / v.z();
+  Eigen::Vector3d surface_normal = Eigen::Vector3d::UnitZ();  // target, +z
+  if (!board_.warp.isZero(0.0)) {
+    // Newton's method on f(t) (file comment), from the plane's hit.
+    constexpr int kMaxIterations = 20;
+    constexpr double kStepTolerance = 1e-12;  // meters
+    bool settled = false;
+    for (int k = 0; k < kMaxIterations && std::isfinite(t); ++k) {
+      const double x = o.x() + t * v.x();
+      const double y = o.y() + t * v.y();
+      const double f = o.z() + t * v.z() - board_.Height(x, y);
+      const double slope = v.z() - board_.Slope(x, y).dot(v.head<2>());
+      if (!(slope != 0.0)) break;
+      const double step = f / slope;
+      t -= step;
+      if (std::abs(step) < kStepTolerance) {
+        settled = true;
+        break;
+      }
+    }
+    if (!settled) return std::nullopt;
+    const Eigen::Vector2d gradient =
+        board_.Slope(o.x() + t * v.x(), o.y() + t * v.y());
+    surface_normal =
+        Eigen::Vector3d(-gradient.x(), -gradient.y(), 1.0).normalized();
+  }
   if (!(t > 0.0)) return std::nullopt;
   const double x = o.x() + t * v.x();
   const double y = o.y() + t * v.y();
@@ -149,9 +195,9 @@ std::optional<BoardHit> PlacedBoard::Intersect(
   BoardHit hit;
   hit.distance = t * unit_direction_in_world.norm();
   hit.point = origin_in_world + t * unit_direction_in_world;
-  hit.printed_side = v.z() > 0.0;
-  hit.normal =
-      world_from_target_.rotation.col(2) * (hit.printed_side ? -1.0 : 1.0);
+  hit.printed_side = v.dot(surface_normal) > 0.0;
+  hit.normal = world_from_target_.rotation * surface_normal *
+               (hit.printed_side ? -1.0 : 1.0);
   hit.point_in_target = Eigen::Vector2d(x, y);
   hit.direction_in_target = v;
   return hit;

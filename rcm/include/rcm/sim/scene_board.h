@@ -38,6 +38,26 @@
 // albedo = black B + white (1 - B). Exact for the box, with h -> 0 the
 // point value; a point-symmetric filter keeps each corner where it is.
 //
+// A bowed board (`warp`): a hand-held board is not a plane. Its printed
+// side is the surface z = h(x, y) of the target frame, mrcal's
+// calobject_warp as rcm::calib's board_warp.h has it (the numbers compare):
+//
+//   h(x, y) = warp_x 4 xr (1 - xr) + warp_y 4 yr (1 - yr),
+//   (xr, yr) = (x / ((cols - 1) square), y / ((rows - 1) square)),
+//
+// the corners' extent normalized (beyond it, in the margin, the same
+// polynomial). warp_x + warp_y is the bowl at the centre; z > 0 bows the
+// centre away from a camera that sees the printed side. The corners and
+// the outline then lie on the surface; a ray meets it (Intersect) by
+// Newton's method on the distance t along the ray from the plane's hit,
+//
+//   f(t) = o_z + t v_z - h(o_x + t v_x, o_y + t v_y),
+//   f'(t) = v_z - grad h . (v_x, v_y),
+//
+// to a step below 1e-12 m (a few iterations: the slope of millimetres of
+// bow over decimetres is ~0.01); a ray whose iteration does not settle (a
+// ray grazing the board) misses it. The hit's normal is the surface's.
+//
 // A sample's box (Shade): a ray of unit direction v (target frame) whose
 // sample is f meters wide across the ray (its angular footprint times the
 // distance) covers on the board an ellipse-like patch of width f across
@@ -68,16 +88,24 @@ struct SceneBoard {
   // print on a white board).
   double black_albedo = 0.05;
   double white_albedo = 0.85;
+  // The bow (warp_x, warp_y), meters, each |.| <= kMaxWarp (file comment);
+  // zero: a flat board.
+  static constexpr double kMaxWarp = 0.05;
+  Eigen::Vector2d warp = Eigen::Vector2d::Zero();
 
   Status Check() const;
+  // The printed surface's height h(x, y) and its gradient (file comment).
+  double Height(double x, double y) const;
+  Eigen::Vector2d Slope(double x, double y) const;
 
   // The inner corners in the target frame, point r * cols + c at
-  // (c square, r square, 0): calib::TargetPoints' order and values.
+  // (c square, r square, h): calib::TargetPoints' order and values (with
+  // the warp, calib::WarpedTargetPoints').
   std::vector<Eigen::Vector3d> Corners() const;
   // The corners of the pattern's squares along its outline: the
   // (cols + 2) x (rows + 2) lattice of square corners that bound the
   // pattern, the points of its border only, clockwise from the top-left
-  // (-square, -square).
+  // (-square, -square), on the surface.
   std::vector<Eigen::Vector3d> PatternOutline() const;
 
   // The printed area (pattern and margin) in the target plane.
@@ -129,7 +157,8 @@ class PlacedBoard {
   // `unit_direction_in_world` crosses the board's printed area, at a
   // distance > 0; nullopt when it misses it or runs parallel to it.
   // Plane z = 0 of the target frame: with o, v the origin and direction
-  // in that frame, t = -o_z / v_z.
+  // in that frame, t = -o_z / v_z; a bowed board's surface from there
+  // (file comment).
   std::optional<BoardHit> Intersect(
       const Eigen::Vector3d& origin_in_world,
       const Eigen::Vector3d& unit_direction_in_world) const;
