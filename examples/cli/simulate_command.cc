@@ -41,8 +41,8 @@ DEFINE_string(exposure_delay, "",
               "after the left (cameras not triggered together, e.g. a "
               "StereoPi) while the rig turns at DEG_S deg/s and moves at "
               "M_S m/s (standard deviation per axis, drawn per frame): the "
-              "matches' right pixels see the scene moved in between (needs "
-              "--noimages)");
+              "right image and the matches' right pixels see the scene "
+              "moved in between");
 DEFINE_string(board_distance, "0.6,2.0",
               "with --board: MIN,MAX in meters, the range of the board's "
               "distance in front of cam0");

@@ -218,9 +218,21 @@ TEST(SimulateCli, ExposureDelayMovesTheRightPixels) {
   const nlohmann::json json = nlohmann::json::parse(estimated.out);
   EXPECT_GT(json["consistency"]["inflation"].get<double>(), 1.0)
       << estimated.out;
-  ExpectFailsWithOneLine(Rcm({"simulate", "--out", Folder("delay_images"),
-                              "--exposure-delay", "10,5"}),
-                         2, "render no images");
+  // With images: the right ones see the scene moved, the left ones not.
+  const std::string images = Folder("delay_images");
+  const std::string still = Folder("still_images");
+  for (const std::string& folder : {images, still}) {
+    std::vector<std::string> run = {
+        "simulate", "--out",           folder, "--frames",
+        "1",        "--supersampling", "1",    "--matches-per-frame",
+        "20"};
+    if (folder == images) run.insert(run.end(), {"--exposure-delay", "10,20"});
+    ASSERT_EQ(Rcm(run).exit_code, 0) << folder;
+  }
+  EXPECT_EQ(test::ReadWholeFile(images + "/left/000000.png"),
+            test::ReadWholeFile(still + "/left/000000.png"));
+  EXPECT_NE(test::ReadWholeFile(images + "/right/000000.png"),
+            test::ReadWholeFile(still + "/right/000000.png"));
   ExpectFailsWithOneLine(
       Rcm({"simulate", "--out", Folder("delay_bad"), "--noimages",
            "--matches-per-frame", "5", "--exposure-delay", "10"}),

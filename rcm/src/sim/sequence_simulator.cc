@@ -106,9 +106,6 @@ Status SequenceOptions::Check() const {
                std::isfinite(match_max_depth))) {
     message << "match depth range [" << match_min_depth << ", "
             << match_max_depth << "] must satisfy 0 < min <= max < inf";
-  } else if (!exposure_delay.IsZero() && render_images) {
-    message << "an exposure delay moves the matches only (the images are "
-               "rendered from one pose); render no images with it";
   } else if (UsesDepthRange() && render_images) {
     message << "matches over a depth range do not belong to the images; "
                "render no images with them";
@@ -177,6 +174,12 @@ StatusOr<std::unique_ptr<SequenceSimulator>> SequenceSimulator::Create(
   return simulator;
 }
 
+Rigid3d SequenceSimulator::RightFromLeftOfFrame(int index) const {
+  return options_.exposure_delay.RightFromLeftOfFrame(
+      true_rig_.right_from_left(),
+      DeriveSeed(options_.seed, kExposureDelaySeed), index);
+}
+
 std::vector<StereoCorrespondence> SequenceSimulator::SampleMatches(
     int index, double n, const PlacedBoard* board) {
   // Ports and media passed SequenceOptions::Check in Create.
@@ -187,12 +190,7 @@ std::vector<StereoCorrespondence> SequenceSimulator::SampleMatches(
   const Rigid3d& world_from_left = poses_[index].world_from_cam0;
   // cam1 at the right exposure (exposure_delay.h).
   const Rigid3d world_from_right =
-      world_from_left *
-      options_.exposure_delay
-          .RightFromLeftOfFrame(true_rig_.right_from_left(),
-                                DeriveSeed(options_.seed, kExposureDelaySeed),
-                                index)
-          .Inverse();
+      world_from_left * RightFromLeftOfFrame(index).Inverse();
   const Rigid3d right_from_world = world_from_right.Inverse();
   const Camera& left_camera = true_rig_.left();
   const Camera& right_camera = true_rig_.right();
@@ -260,7 +258,8 @@ StatusOr<SequenceFrame> SequenceSimulator::Frame(int index) {
   const PlacedBoard* placed = board ? &*board : nullptr;
   if (renderer_ != nullptr) {
     StatusOr<StereoImages> images =
-        renderer_->Render(frame.world_from_cam0, frame.n, index, placed);
+        renderer_->Render(frame.world_from_cam0, frame.n, index, placed,
+                          RightFromLeftOfFrame(index));
     if (!images.ok()) return images.status();
     frame.left = images.value().left;
     frame.right = images.value().right;

@@ -178,11 +178,13 @@ StatusOr<const StereoRenderer::CacheEntry*> StereoRenderer::Rays(double n) {
 
 Status StereoRenderer::PrepareRays(double n) { return Rays(n).status(); }
 
-StatusOr<StereoImages> StereoRenderer::Render(const Rigid3d& world_from_cam0,
-                                              double n, int64_t frame_index,
-                                              const PlacedBoard* board) {
+StatusOr<StereoImages> StereoRenderer::Render(
+    const Rigid3d& world_from_cam0, double n, int64_t frame_index,
+    const PlacedBoard* board, const std::optional<Rigid3d>& right_from_left) {
   const Rigid3d world_from_cam[2] = {
-      world_from_cam0, world_from_cam0 * rig_.right_from_left().Inverse()};
+      world_from_cam0,
+      world_from_cam0 *
+          right_from_left.value_or(rig_.right_from_left()).Inverse()};
   for (int c = 0; c < 2; ++c) {
     if (!scene_->Contains(world_from_cam[c].translation)) {
       const Eigen::Vector3d& p = world_from_cam[c].translation;

@@ -16,7 +16,8 @@
 //   matches is rig.WithCam1Moved(drift) (stereo_rig.h), while rig() stays
 //   the in-air calibration a user would have (and a writer's camchain);
 // - cameras not triggered together (ExposureDelay): the right camera's
-//   matches see the scene moved by the frame's motion during the delay;
+//   image and matches see the scene moved by the frame's motion during the
+//   delay (RightFromLeftOfFrame);
 // - lenses that changed (LensChange): each camera's focal lengths scaled
 //   by 1 + s_c in that rig (a focus ring or a lens that shifted in its
 //   mount, temperature), the calibration's unchanged;
@@ -118,7 +119,8 @@ struct SequenceOptions {
   LensChange lens_change;
   // Default none: the cameras are triggered together. With a delay the
   // right camera sees each frame's scene moved by that frame's motion
-  // (exposure_delay.h), in the matches only: render no images with it.
+  // (exposure_delay.h), in its image and in the matches (the lamp where it
+  // was at the left exposure).
   ExposureDelay exposure_delay;
   // A chessboard held in front of the rig (default none), and how it
   // moves; the motion's seed is replaced by one derived from `seed`.
@@ -175,6 +177,10 @@ class SequenceSimulator {
   const std::vector<double>& n_of_frame() const { return n_of_frame_; }
   // With a board: its pose and visibility in every frame; empty without.
   const std::vector<BoardFrame>& board_frames() const { return board_frames_; }
+  // cam1's view of frame `index` at its exposure: true_rig()'s
+  // right_from_left, moved by the frame's exposure delay motion when there
+  // is one (ExposureDelay::RightFromLeftOfFrame).
+  Rigid3d RightFromLeftOfFrame(int index) const;
 
   // Renders frame `index` (in [0, num_frames())) and samples up to
   // matches_per_frame matches (fewer only when the two cameras barely

@@ -49,6 +49,7 @@
 #include <cstdint>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <vector>
 
 #include "rcm/camera/flat_port.h"
@@ -122,10 +123,15 @@ class StereoRenderer {
   // The stereo pair seen with cam0 at `world_from_cam0` in a medium of
   // index n (1 = air); `frame_index` selects the noise. With a `board`
   // (may be null), the board is in the tank at its pose and occludes it.
-  // Fails when n is not in [1, 2] or a camera is outside the tank.
-  StatusOr<StereoImages> Render(const Rigid3d& world_from_cam0, double n,
-                                int64_t frame_index,
-                                const PlacedBoard* board = nullptr);
+  // `right_from_left`, when given, is cam1's view for this frame in place
+  // of the rig's (cameras not triggered together: the right image exposed
+  // where the rig had moved to, ExposureDelay::RightFromLeftOfFrame); the
+  // lamp is where it was at the left exposure. Fails when n is not in
+  // [1, 2] or a camera is outside the tank.
+  StatusOr<StereoImages> Render(
+      const Rigid3d& world_from_cam0, double n, int64_t frame_index,
+      const PlacedBoard* board = nullptr,
+      const std::optional<Rigid3d>& right_from_left = std::nullopt);
 
  private:
   struct RayTable;  // per camera and n, defined in the .cc
