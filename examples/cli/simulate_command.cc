@@ -125,8 +125,7 @@ bool FlagGiven(const char* name) {
   return gflags::GetCommandLineFlagInfo(name, &info) && !info.is_default;
 }
 
-// --exposure-delay into options->exposure_delay; one line on a bad value
-// (also images asked for with it: SequenceOptions::Check).
+// --exposure-delay into options->exposure_delay; one line on a bad value.
 Status ExposureDelayFromFlag(SequenceOptions* options) {
   if (FLAGS_exposure_delay.empty()) return Status::Ok();
   const std::string context = "--exposure-delay " + FLAGS_exposure_delay;
@@ -169,7 +168,10 @@ Status BoardFromFlags(SequenceOptions* options) {
   board.cols = target->cols;
   board.rows = target->rows;
   board.square = target->col_spacing;
+  RCM_RETURN_IF_ERROR(
+      board.Check().WithContext(FlagContext("board", FLAGS_board)));
   if (!FLAGS_board_warp.empty()) {
+    // (The board's own flags checked first: an error here is the warp's.)
     const std::string warp_context =
         FlagContext("board-warp", FLAGS_board_warp);
     const StatusOr<std::vector<double>> warp =
@@ -181,8 +183,6 @@ Status BoardFromFlags(SequenceOptions* options) {
     board.warp = 1e-3 * Eigen::Vector2d((*warp)[0], (*warp)[1]);
     RCM_RETURN_IF_ERROR(board.Check().WithContext(warp_context));
   }
-  RCM_RETURN_IF_ERROR(
-      board.Check().WithContext(FlagContext("board", FLAGS_board)));
   options->board = board;
   const std::string context =
       FlagContext("board-distance", FLAGS_board_distance);
@@ -382,7 +382,7 @@ int RunSimulate() {
                              1)
               << " deg/s and moving at "
               << FormatFixed(options.exposure_delay.speed_sd, 3)
-              << " m/s per axis (sd, per frame): matches only\n";
+              << " m/s per axis (sd, per frame)\n";
   }
   if (options.board) {
     const std::array<int, 3> visible = CountVisibleBoardFrames(sim);

@@ -30,8 +30,8 @@ Rigid3d ExposureDelay::MotionOfFrame(uint64_t seed, int frame) const {
   if (IsZero()) return Rigid3d();
   // Six draws keyed by (seed, frame, component): a frame's motion does not
   // depend on how many frames were drawn before it.
-  const uint64_t key = SplitMix64(seed ^ 0x5DE1A7E5C0FFEE11ull) +
-                       0x9E3779B97F4A7C15ull * static_cast<uint64_t>(frame);
+  const uint64_t key =
+      IndexKey(seed, 0x5DE1A7E5C0FFEE11ull, static_cast<uint64_t>(frame));
   Eigen::Matrix<double, 6, 1> draw;
   for (int k = 0; k < 6; ++k) {
     draw[k] = GaussianFromHash(SplitMix64(key + static_cast<uint64_t>(k)));

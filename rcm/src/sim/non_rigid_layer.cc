@@ -27,8 +27,8 @@ Status NonRigidLayer::Check() const {
 double NonRigidLayer::OffsetOfFrame(uint64_t seed, int frame) const {
   if (IsZero()) return 0.0;
   // Keyed by (seed, frame), apart from ExposureDelay's keys.
-  const uint64_t key = SplitMix64(seed ^ 0x3C6EF372FE94F82Bull) +
-                       0x9E3779B97F4A7C15ull * static_cast<uint64_t>(frame);
+  const uint64_t key =
+      IndexKey(seed, 0x3C6EF372FE94F82Bull, static_cast<uint64_t>(frame));
   return offset_px + offset_sd_px * GaussianFromHash(SplitMix64(key));
 }
 

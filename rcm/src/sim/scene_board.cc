@@ -81,19 +81,20 @@ Status SceneBoard::Check() const {
   return Status::Error(message.str());
 }
 
+BoardWarpSurface SceneBoard::WarpSurface() const {
+  BoardWarpSurface surface;
+  surface.extent = Eigen::Vector2d((cols - 1) * square, (rows - 1) * square);
+  surface.warp = warp;
+  return surface;
+}
+
 double SceneBoard::Height(double x, double y) const {
-  if (warp.isZero(0.0)) return 0.0;
-  const double xr = x / ((cols - 1) * square);
-  const double yr = y / ((rows - 1) * square);
-  return warp.x() * 4.0 * xr * (1.0 - xr) + warp.y() * 4.0 * yr * (1.0 - yr);
+  // A flat board's corners keep z = 0 bit for bit (not -0).
+  return warp.isZero(0.0) ? 0.0 : WarpSurface().Height(x, y);
 }
 
 Eigen::Vector2d SceneBoard::Slope(double x, double y) const {
-  if (warp.isZero(0.0)) return Eigen::Vector2d::Zero();
-  const double width = (cols - 1) * square;
-  const double height = (rows - 1) * square;
-  return Eigen::Vector2d(warp.x() * 4.0 * (1.0 - 2.0 * x / width) / width,
-                         warp.y() * 4.0 * (1.0 - 2.0 * y / height) / height);
+  return WarpSurface().Slope(x, y);
 }
 
 std::vector<Eigen::Vector3d> SceneBoard::Corners() const {

@@ -72,6 +72,7 @@
 #include <optional>
 #include <vector>
 
+#include "rcm/geometry/board_warp_surface.h"
 #include "rcm/geometry/rigid3d.h"
 #include "rcm/util/status.h"
 
@@ -94,7 +95,9 @@ struct SceneBoard {
   Eigen::Vector2d warp = Eigen::Vector2d::Zero();
 
   Status Check() const;
-  // The printed surface's height h(x, y) and its gradient (file comment).
+  // The bow as a surface over the corners' extent (board_warp_surface.h),
+  // and its height h(x, y) and gradient (file comment).
+  BoardWarpSurface WarpSurface() const;
   double Height(double x, double y) const;
   Eigen::Vector2d Slope(double x, double y) const;
 

@@ -19,6 +19,13 @@ constexpr uint64_t SplitMix64(uint64_t x) {
   return x ^ (x >> 31);
 }
 
+// The key of item `index` (a frame) of the stream `salt` under `seed`:
+// hashes of key + k then give the item's draws, which do not depend on how
+// many items were drawn before it.
+constexpr uint64_t IndexKey(uint64_t seed, uint64_t salt, uint64_t index) {
+  return SplitMix64(seed ^ salt) + 0x9E3779B97F4A7C15ull * index;
+}
+
 // A standard normal draw from one 64-bit hash (e.g. SplitMix64 of a seed
 // and a pixel index): Box-Muller on its two 32-bit halves, so that a noise
 // image depends on the seed and the pixel only, not on thread scheduling.
