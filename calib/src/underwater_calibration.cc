@@ -505,6 +505,21 @@ Eigen::VectorXd JackknifeSigma(const std::vector<Eigen::VectorXd>& samples) {
   return ((g - 1.0) / g * sum).cwiseSqrt();
 }
 
+// (g - 1) / g sum_k (x_k - mean)(x_k - mean)^T: the jackknife covariance,
+// whose diagonal is JackknifeSigma's square.
+Eigen::MatrixXd JackknifeCovariance(
+    const std::vector<Eigen::VectorXd>& samples) {
+  const int g = static_cast<int>(samples.size());
+  Eigen::VectorXd mean = Eigen::VectorXd::Zero(samples[0].size());
+  for (const Eigen::VectorXd& x : samples) mean += x;
+  mean /= g;
+  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(mean.size(), mean.size());
+  for (const Eigen::VectorXd& x : samples) {
+    sum += (x - mean) * (x - mean).transpose();
+  }
+  return (g - 1.0) / g * sum;
+}
+
 // One refit of sigma_n_lenses (header): camera `camera`'s lens moved by
 // `delta` = sqrt(l_i) e_i.
 struct LensPerturbation {
@@ -1127,6 +1142,53 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     }
   }
 
+  // The ports' covariance in q's order (header), with the extrinsics' and,
+  // in the joint fit, the lenses'.
+  {
+    // Rows of q against the block `column` (zero rows for what was not
+    // estimated).
+    const auto port_rows = [&](std::string_view column, int size) {
+      Eigen::MatrixXd rows = Eigen::MatrixXd::Zero(6, size);
+      for (int c = 0; c < 2; ++c) {
+        if (free.air_gap[c]) {
+          rows.row(3 * c) =
+              result.covariance.Block(CameraName(c) + " air_gap", column);
+        }
+        if (free.tilt[c]) {
+          rows.middleRows(3 * c + 1, 2) =
+              result.covariance.Block(CameraName(c) + " port_tilt", column);
+        }
+      }
+      return rows;
+    };
+    for (int c = 0; c < 2; ++c) {
+      result.ports_estimated |= free.air_gap[c] || free.tilt[c];
+    }
+    for (int c = 0; c < 2 && result.ports_estimated; ++c) {
+      if (free.air_gap[c]) {
+        result.port_covariance.col(3 * c) =
+            port_rows(CameraName(c) + " air_gap", 1);
+      }
+      if (free.tilt[c]) {
+        result.port_covariance.middleCols(3 * c + 1, 2) =
+            port_rows(CameraName(c) + " port_tilt", 2);
+      }
+    }
+    if (result.ports_estimated && free.extrinsics) {
+      Eigen::Matrix<double, 6, 6> jacobian;
+      ChangeFromAir(air_extrinsics, water_extrinsics, &jacobian);
+      result.extrinsics_port_covariance =
+          jacobian * port_rows("cam1_from_cam0", 6).transpose();
+    }
+    if (result.ports_estimated && free.lens[0] && free.lens[1]) {
+      result.port_lens_covariance =
+          (Eigen::MatrixXd(6, lens_sizes[0] + lens_sizes[1])
+               << port_rows("cam0 lens", lens_sizes[0]),
+           port_rows("cam1 lens", lens_sizes[1]))
+              .finished();
+    }
+  }
+
   // The refits below (leave-out replicates, lens perturbations) start at
   // the solution; an air gap that ended on its lower bound 0 stays there
   // (the active set of the solution: Ceres' projected steps would take
@@ -1217,6 +1279,7 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     }
     if (samples.size() >= 2) {
       leave_out.sigma = JackknifeSigma(samples);
+      leave_out.covariance = JackknifeCovariance(samples);
       result.sigma_n_leave_out = leave_out.sigma[0];
       if (free.extrinsics) {
         const Eigen::VectorXd sigma = JackknifeSigma(changes);
@@ -1243,6 +1306,9 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
     Eigen::MatrixXd extrinsics_lens = Eigen::MatrixXd::Zero(6, lens_size);
     Eigen::Matrix<double, 6, 6> extrinsics_from_lenses =
         Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::MatrixXd port_lens = Eigen::MatrixXd::Zero(6, lens_size);
+    Eigen::Matrix<double, 6, 12> port_from_lenses =
+        Eigen::Matrix<double, 6, 12>::Zero();
     for (size_t i = 0; i < lens_steps.size(); ++i) {
       const LensPerturbation& step = lens_steps[i];
       Model perturbed = model;
@@ -1266,6 +1332,26 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
               moved * step.delta.transpose();
           extrinsics_from_lenses += moved * moved.transpose();
         }
+        if (result.ports_estimated) {
+          // The ports' move, q's order (what was not estimated stays).
+          Eigen::Matrix<double, 6, 1> port_move;
+          for (int c = 0; c < 2; ++c) {
+            port_move[3 * c] = refit.air_gap[c] - parameters.air_gap[c];
+            port_move[3 * c + 1] = refit.tilt[c][0] - parameters.tilt[c][0];
+            port_move[3 * c + 2] = refit.tilt[c][1] - parameters.tilt[c][1];
+          }
+          port_lens.middleCols(step.camera == 0 ? 0 : left_size,
+                               step.delta.size()) +=
+              port_move * step.delta.transpose();
+          Eigen::Matrix<double, 12, 1> held;
+          held << (free.extrinsics
+                       ? ChangeFromAir(
+                             water_extrinsics,
+                             RigidFromPose(refit.cam1_from_cam0.data()))
+                       : Eigen::Matrix<double, 6, 1>::Zero()),
+              port_move;
+          port_from_lenses += port_move * held.transpose();
+        }
       } else {
         ++failed;
       }
@@ -1278,6 +1364,10 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
       if (free.extrinsics) {
         result.extrinsics_lens_covariance = extrinsics_lens;
         result.extrinsics_covariance_from_lenses = extrinsics_from_lenses;
+      }
+      if (result.ports_estimated) {
+        result.port_lens_covariance = port_lens;
+        result.port_covariance_from_lenses = port_from_lenses;
       }
     } else {
       result.notes.push_back("lens uncertainty: " + std::to_string(failed) +

@@ -338,6 +338,9 @@ StatusOr<UnderwaterModelSelection> SelectUnderwaterModel(
           lenses->extrinsics_lens_covariance;
       chosen.fit->extrinsics_covariance_from_lenses =
           lenses->extrinsics_covariance_from_lenses;
+      chosen.fit->port_lens_covariance = lenses->port_lens_covariance;
+      chosen.fit->port_covariance_from_lenses =
+          lenses->port_covariance_from_lenses;
       for (const std::string& note : lenses->notes) {
         if (note.rfind("lens uncertainty", 0) == 0) {
           chosen.fit->notes.push_back(note);

@@ -407,6 +407,8 @@ int RunCalibrateUnderwater(const Subcommand& command,
   json["sigma_n_model"] = selection->sigma_n_model;
   json["sigma_n_covariance"] = result->sigma_n;
   json["sigma_n_leave_out"] = JsonNumber(result->sigma_n_leave_out);
+  // The sidecar's widening of the held geometry to the leave-out spread.
+  json["geometry_leave_out_scale"] = calib::GeometryLeaveOutScale(*result);
   json["model"] = model.Name();
   json["pinned"] = selection->pinned;
   json["advice"] = selection->advice;

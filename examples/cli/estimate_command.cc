@@ -739,6 +739,7 @@ nlohmann::json CalibrationJson(const Report& report, const StereoRig& rig) {
       {"sigma_n_rotation", std::sqrt(std::max(0.0, p.variance_rotation))},
       {"sigma_n_translation", std::sqrt(std::max(0.0, p.variance_translation))},
       {"sigma_n_lenses", std::sqrt(std::max(0.0, p.variance_lenses))},
+      {"sigma_n_ports", std::sqrt(std::max(0.0, p.variance_ports))},
       {"rotation_multiple_correlation", p.rotation_multiple_correlation},
       {"sigma_inflation_if_free", JsonNumber(p.rotation_sigma_inflation)}};
 }

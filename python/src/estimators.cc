@@ -128,6 +128,7 @@ py::object CalibrationDict(const std::optional<CalibrationPropagation>& c) {
   d["variance_rotation"] = c->variance_rotation;
   d["variance_translation"] = c->variance_translation;
   d["variance_lenses"] = c->variance_lenses;
+  d["variance_ports"] = c->variance_ports;
   d["variance_medium"] = c->variance_medium;
   d["variance_systematic"] = c->variance_systematic;
   d["dn_drotation"] = ToNumpy(c->dn_drotation);

@@ -98,6 +98,8 @@ py::object UncertaintyDict(const StereoRig& rig) {
   result["right_lens_covariance"] = ToNumpy(u.right_lens_covariance);
   result["extrinsics_lens_covariance"] = ToNumpy(u.extrinsics_lens_covariance);
   result["lens_cross_covariance"] = ToNumpy(u.lens_cross_covariance);
+  result["port_covariance"] = ToNumpy(u.port_covariance);
+  result["port_cross_covariance"] = ToNumpy(u.port_cross_covariance);
   return std::move(result);
 }
 
@@ -222,7 +224,12 @@ exact); one read from a file carries the default drift prior (0.1 degree,
                              "extrinsics_lens_covariance (6 x (p_l + p_r), "
                              "empty when uncorrelated), lens_cross_covariance "
                              "(p_l x p_r, of a joint calibration; empty when "
-                             "uncorrelated)) or None (exact).")
+                             "uncorrelated), port_covariance (6 x 6, of [d, "
+                             "a, b] of each port: air gap in m, tilt (N_x, "
+                             "N_y) / N_z; empty when the ports are exact), "
+                             "port_cross_covariance ((6 + lens rows) x 6, "
+                             "of [w; dt; lenses] with them)) or None "
+                             "(exact).")
       .def(
           "with_ports",
           [](const StereoRig& r, const FlatPort& left, const FlatPort& right) {

@@ -47,6 +47,7 @@ def test_reads_the_demo_camchain(demo_rig_path):
                                rtol=1e-12)
     assert not lens[2:, :].any() and not lens[:, 2:].any()
     assert uncertainty["extrinsics_lens_covariance"].size == 0
+    assert uncertainty["port_covariance"].size == 0
     assert uncertainty["lens_cross_covariance"].size == 0
     # focal_drift=0: the lenses as calibrated.
     exact = rcm.read_stereo_rig(demo_rig_path, focal_drift=0.0)

@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
+#include <vector>
 
 #include "rcm/geometry/calibration_uncertainty.h"
 #include "support/test_rigs.h"
@@ -20,14 +22,53 @@ Eigen::MatrixXd FixedCovariance(int n, double shift, double scale) {
          (root * root.transpose() + 0.1 * Eigen::MatrixXd::Identity(n, n));
 }
 
-// An underwater calibration whose extrinsics were fitted through air lenses
-// of covariance L (the air rig's sidecar): a lens error moves them by K
-// (X = K L, their lens share K L K^T), the water views measured them with
-// covariance E0 given the lenses, and the leave-out spread is twice that
-// about y and 1.5 times along z. The sidecar keeps X and the lens share as
-// the fit has them and widens only E0, per component:
-// Cov([w; dt] | lenses) = S E0 S (to rounding), the response to the lenses
-// K unchanged, the joint positive semi-definite.
+// The fit's covariance of [n, w, t, cam0 air_gap, cam0 port_tilt, cam1
+// port_tilt] (no cam1 air gap: not estimated), its blocks named as
+// CalibrateUnderwater names them, and the held geometry's part `geometry`
+// (11 x 11, the blocks after n).
+UnderwaterCovariance FitCovariance(const Eigen::MatrixXd& geometry) {
+  UnderwaterCovariance covariance;
+  covariance.blocks = {{"n", 0, 1},
+                       {"cam1_from_cam0", 1, 6},
+                       {"cam0 air_gap", 7, 1},
+                       {"cam0 port_tilt", 8, 2},
+                       {"cam1 port_tilt", 10, 2}};
+  covariance.matrix = Eigen::MatrixXd::Zero(12, 12);
+  covariance.matrix(0, 0) = 1e-6;
+  covariance.matrix.bottomRightCorner(11, 11) = geometry;
+  return covariance;
+}
+
+// The whitened mean of the leave-out spread: J = C^1/2 diag(d) C^1/2 gives
+// mean(d) (trace(C^-1 J) = sum d); a spread below the covariance widens
+// nothing; no leave-out, nothing.
+TEST(UnderwaterCalibrationCovariance, LeaveOutScaleIsTheWhitenedMeanSpread) {
+  UnderwaterCalibration result(test::AlphasenseRealisticRig());
+  const Eigen::MatrixXd geometry = FixedCovariance(11, 0.4, 1e-6);
+  result.covariance = FitCovariance(geometry);
+  EXPECT_EQ(GeometryLeaveOutScale(result), 1.0);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(geometry);
+  const Eigen::MatrixXd root = eigen.operatorSqrt();
+  Eigen::VectorXd d(11);
+  for (int i = 0; i < 11; ++i) d[i] = 1.0 + 0.5 * i;  // mean 3.5
+  UnderwaterLeaveOut leave_out;
+  leave_out.covariance = Eigen::MatrixXd::Zero(12, 12);
+  leave_out.covariance(0, 0) = 100.0;  // n's spread is not the geometry's
+  leave_out.covariance.bottomRightCorner(11, 11) = root * d.asDiagonal() * root;
+  result.leave_out = leave_out;
+  EXPECT_NEAR(GeometryLeaveOutScale(result), 3.5, 1e-9);
+  result.leave_out->covariance.bottomRightCorner(11, 11) = 0.25 * geometry;
+  EXPECT_EQ(GeometryLeaveOutScale(result), 1.0);
+}
+
+// An underwater calibration whose extrinsics and ports were fitted through
+// air lenses of covariance L (the air rig's sidecar): a lens error moves
+// the held geometry h = [w; dt; q] by K (X = K L, their lens share
+// K L K^T), the water views measured h with covariance G0 given the lenses,
+// and the leave-out spread is 2.25 G0 (s^2 = 2.25). The sidecar keeps X and
+// the lens share as the fit has them and widens only G0, as one:
+// Cov(h | lenses) = 2.25 G0 (to rounding), the response to the lenses K
+// unchanged, the joint positive semi-definite, the ports in their block.
 TEST(UnderwaterCalibrationCovariance, WidensOnlyWhatTheWaterViewsMeasured) {
   const StereoRig rig = test::AlphasenseRealisticRig();
   const int p = rig.left().num_params();
@@ -39,34 +80,39 @@ TEST(UnderwaterCalibrationCovariance, WidensOnlyWhatTheWaterViewsMeasured) {
   Eigen::MatrixXd lenses = Eigen::MatrixXd::Zero(2 * p, 2 * p);
   lenses.topLeftCorner(p, p) = air.left_lens_covariance;
   lenses.bottomRightCorner(p, p) = air.right_lens_covariance;
-  Eigen::MatrixXd k(6, 2 * p);
-  for (int r = 0; r < 6; ++r) {
-    for (int c = 0; c < 2 * p; ++c) k(r, c) = 1e-3 * std::cos(r + 0.5 * c);
+  // h's 12 rows; cam1's air gap (row 9) was not estimated.
+  Eigen::MatrixXd k(12, 2 * p);
+  for (int r = 0; r < 12; ++r) {
+    for (int c = 0; c < 2 * p; ++c) {
+      k(r, c) = r == 9 ? 0.0 : 1e-3 * std::cos(r + 0.5 * c);
+    }
   }
-  const Eigen::Matrix<double, 6, 6> own = FixedCovariance(6, 0.1, 1e-9);
+  // G0 over the 11 estimated components, in h's 12 rows.
+  const Eigen::MatrixXd estimated = FixedCovariance(11, 0.1, 1e-9);
+  const std::vector<int> rows = {0, 1, 2, 3, 4, 5, 6, 7, 8, 10, 11};
+  Eigen::MatrixXd own = Eigen::MatrixXd::Zero(12, 12);
+  for (int r = 0; r < 11; ++r) {
+    for (int c = 0; c < 11; ++c) own(rows[r], rows[c]) = estimated(r, c);
+  }
+  const Eigen::MatrixXd lens_share = k * lenses * k.transpose();
 
   UnderwaterCalibration result(rig);
   result.extrinsics_estimated = true;
-  result.extrinsic_change.covariance = own;
-  result.extrinsics_lens_covariance = k * lenses;
-  result.extrinsics_covariance_from_lenses = k * lenses * k.transpose();
-  Eigen::Matrix<double, 6, 1> sigma = own.diagonal().cwiseSqrt();
-  result.extrinsic_change.rotation_sigma_deg = sigma.head<3>() * 180.0 / M_PI;
-  result.extrinsic_change.translation_sigma_mm = sigma.tail<3>() * 1e3;
-  Eigen::Matrix<double, 6, 1> scales;
-  scales << 1.0, 2.0, 1.0, 1.0, 1.0, 1.5;
-  result.extrinsic_change.rotation_leave_out_sigma_deg =
-      Eigen::Vector3d(scales.head<3>().cwiseProduct(
-          result.extrinsic_change.rotation_sigma_deg));
-  result.extrinsic_change.translation_leave_out_sigma_mm =
-      Eigen::Vector3d(scales.tail<3>().cwiseProduct(
-          result.extrinsic_change.translation_sigma_mm));
-  // A leave-out spread below the covariance's widens nothing.
-  (*result.extrinsic_change.translation_leave_out_sigma_mm)[0] *= 0.5;
-  EXPECT_LT((ExtrinsicsLeaveOutScales(result.extrinsic_change) - scales)
-                .cwiseAbs()
-                .maxCoeff(),
-            1e-12);
+  result.ports_estimated = true;
+  result.extrinsic_change.covariance = own.topLeftCorner(6, 6);
+  result.extrinsics_port_covariance = own.topRightCorner(6, 6);
+  result.port_covariance = own.bottomRightCorner(6, 6);
+  result.extrinsics_lens_covariance = (k * lenses).topRows(6);
+  result.port_lens_covariance = (k * lenses).bottomRows(6);
+  result.extrinsics_covariance_from_lenses = lens_share.topLeftCorner(6, 6);
+  result.port_covariance_from_lenses = lens_share.bottomRows(6);
+  // The fit's covariance in its own layout (the change's Jacobian taken as
+  // the identity), and the replicates' spread 1.5 times its sigmas.
+  result.covariance = FitCovariance(estimated);
+  UnderwaterLeaveOut leave_out;
+  leave_out.covariance = 2.25 * result.covariance.matrix;
+  result.leave_out = leave_out;
+  ASSERT_NEAR(GeometryLeaveOutScale(result), 2.25, 1e-9);
 
   const CalibrationCovarianceFile file =
       UnderwaterCalibrationCovariance(result, air_rig);
@@ -81,19 +127,29 @@ TEST(UnderwaterCalibrationCovariance, WidensOnlyWhatTheWaterViewsMeasured) {
   written.right_lens_covariance = file.cameras[1].intrinsics_covariance;
   written.extrinsics_lens_covariance =
       file.cameras[1].from_previous_intrinsics_covariance;
+  written.port_covariance = file.port_covariance;
+  written.port_cross_covariance = file.port_cross_covariance;
   ASSERT_TRUE(written.Check(p, p).ok()) << written.Check(p, p).message();
-  const Eigen::MatrixXd given_lenses =
-      ConditionalCovariance(written.JointCovariance(), 6);
-  const Eigen::DiagonalMatrix<double, 6> s(scales);
-  const Eigen::Matrix<double, 6, 6> expected = s * own * s;
-  // Rounding: the lens share is ~1e3 times E0 in places, and the
+  // The joint in h's order: [w; dt; q; lenses].
+  const Eigen::MatrixXd joint = written.JointCovariance();
+  const int n = static_cast<int>(joint.rows());
+  ASSERT_EQ(n, 12 + 2 * p);
+  std::vector<int> order = {0, 1, 2, 3, 4, 5};
+  for (int i = 0; i < 6; ++i) order.push_back(6 + 2 * p + i);
+  for (int i = 0; i < 2 * p; ++i) order.push_back(6 + i);
+  Eigen::MatrixXd reordered(n, n);
+  for (int r = 0; r < n; ++r) {
+    for (int c = 0; c < n; ++c) reordered(r, c) = joint(order[r], order[c]);
+  }
+  const Eigen::MatrixXd given_lenses = ConditionalCovariance(reordered, 12);
+  const Eigen::MatrixXd expected = 2.25 * own;
+  // Rounding: the lens share is ~1e3 times G0 in places, and the
   // conditional subtracts it back out.
   EXPECT_LT((given_lenses - expected).norm(), 1e-6 * expected.norm());
-  // The extrinsics' response to a lens error, X' L^-1, is the fit's K
-  // (scaling X with the extrinsics, the sidecar before, made it S K: the
-  // same conditional, another response).
+  // h's response to a lens error, X' L^-1, is the fit's K (scaling X with
+  // h would make it another response with the same conditional).
   const Eigen::MatrixXd response =
-      file.cameras[1].from_previous_intrinsics_covariance * lenses.inverse();
+      reordered.block(0, 12, 12, 2 * p) * lenses.inverse();
   EXPECT_LT((response - k).norm(), 1e-9 * k.norm());
 }
 

@@ -507,26 +507,20 @@ TEST(UnderwaterCli, JointAirAndWater) {
   EXPECT_EQ(written.cameras[1].from_previous_intrinsics_covariance.rows(), 6);
   EXPECT_EQ(written.cameras[1].from_previous_intrinsics_covariance.cols(), 16);
   EXPECT_EQ(written.cameras[1].previous_intrinsics_covariance.rows(), 8);
-  // The extrinsics' sigmas in the sidecar: per component the larger of the
-  // covariance's and the leave-out's (the joint fit's covariance already
-  // counts the lenses).
+  // The extrinsics' variances in the sidecar: the water views' share
+  // widened as one to the leave-out spread, s^2 = geometry_leave_out_scale
+  // (the joint fit's covariance already counts the lenses, whose share is
+  // kept): between the covariance's and s^2 times it.
   const nlohmann::json& change = json["extrinsic_change"];
-  for (int k = 0; k < 3; ++k) {
-    const double rotation =
-        std::max(change["rotation_sigma_deg"][k].get<double>(),
-                 change["rotation_leave_out_sigma_deg"][k].get<double>()) *
-        M_PI / 180.0;
-    EXPECT_NEAR(std::sqrt((*written.cameras[1].from_previous_covariance)(k, k)),
-                rotation, 1e-9 * rotation)
-        << k;
-    const double translation =
-        1e-3 *
-        std::max(change["translation_sigma_mm"][k].get<double>(),
-                 change["translation_leave_out_sigma_mm"][k].get<double>());
-    EXPECT_NEAR(
-        std::sqrt((*written.cameras[1].from_previous_covariance)(3 + k, 3 + k)),
-        translation, 1e-9 * translation)
-        << k;
+  const double widening = json["geometry_leave_out_scale"].get<double>();
+  EXPECT_GE(widening, 1.0);
+  for (int k = 0; k < 6; ++k) {
+    const double sigma =
+        k < 3 ? change["rotation_sigma_deg"][k].get<double>() * M_PI / 180.0
+              : 1e-3 * change["translation_sigma_mm"][k - 3].get<double>();
+    const double variance = (*written.cameras[1].from_previous_covariance)(k, k);
+    EXPECT_GE(variance, (1.0 - 1e-9) * sigma * sigma) << k;
+    EXPECT_LE(variance, (1.0 + 1e-9) * widening * sigma * sigma) << k;
   }
   const Camchain air_chain = ReadCamchain(dive + "/camchain.yaml").value();
   const Camchain water_chain = ReadCamchain(water + "/camchain.yaml").value();

@@ -312,6 +312,93 @@ TEST(CalibrationPropagation, LensExtrinsicsCorrelationIsTheJointResponse) {
   EXPECT_GT(std::abs(without - with_correlation), 0.1 * with_correlation);
 }
 
+// The ports' columns, with their correlation with the extrinsics (an
+// underwater calibration that estimated the air gaps and tilts): for a
+// joint covariance v v^T of one direction v = [dw; dt; dq], sigma_n's
+// calibration share with the rotation held is (dn/de)^2, the thick-port
+// estimator's response to the rig moved by e v, its extrinsics and its
+// ports (central differences, e = +-0.1 of a v of 1e-4 rad, 0.2 mm of
+// translation, 1 mm of gap and 1e-3 of tilt: smooth, truncation below 1e-6
+// relative). The ports' share alone is what they add with that
+// correlation, and leaving the correlation out gets another variance.
+TEST(CalibrationPropagation, PortExtrinsicsCorrelationIsTheJointResponse) {
+  const auto port = [](double air_gap, double a, double b) {
+    FlatPort port;
+    port.air_gap = air_gap;
+    port.normal = Eigen::Vector3d(a, b, 1.0).normalized();
+    return port;
+  };
+  const Eigen::Vector3d left_q(0.012, 0.02, -0.01);  // d (m), a, b
+  const Eigen::Vector3d right_q(0.004, 0.01, 0.015);
+  const StereoRig truth =
+      test::AlphasenseRealisticRig()
+          .WithPorts(port(left_q[0], left_q[1], left_q[2]),
+                     port(right_q[0], right_q[1], right_q[2]))
+          .value();
+  const std::vector<StereoCorrespondence> data =
+      Frames(truth, kTrueN, 0.6, 6.0, 2, 300, 5);
+  Eigen::Matrix<double, 6, 1> extrinsics;
+  extrinsics << 1e-4, -1e-4, 5e-5, 0.0, 5e-5, -2e-4;
+  Eigen::Matrix<double, 6, 1> ports;
+  ports << 1e-3, 1e-3, -1e-3, -5e-4, 5e-4, 1e-3;
+  CalibrationUncertainty joint;
+  joint.extrinsics_covariance = extrinsics * extrinsics.transpose();
+  joint.port_covariance = ports * ports.transpose();
+  joint.port_cross_covariance = extrinsics * ports.transpose();
+  ASSERT_TRUE(
+      joint.Check(truth.left().num_params(), truth.right().num_params()).ok());
+  CalibrationUncertainty independent = joint;
+  independent.port_cross_covariance.resize(0, 0);
+
+  RefinementOptions options;
+  options.self_calibrate_rotation = false;
+  const auto propagated = [&](const CalibrationUncertainty& uncertainty) {
+    const RefinementSummary summary =
+        RefineRefractiveIndex(
+            truth.WithCalibrationUncertainty(uncertainty).value(), data,
+            options)
+            .value();
+    EXPECT_NEAR(summary.n, kTrueN, kExactTolerance);
+    return *summary.calibration;
+  };
+  const auto moved = [&](double e) {
+    return truth
+        .WithPorts(port(left_q[0] + e * ports[0], left_q[1] + e * ports[1],
+                        left_q[2] + e * ports[2]),
+                   port(right_q[0] + e * ports[3], right_q[1] + e * ports[4],
+                        right_q[2] + e * ports[5]))
+        .value()
+        .WithCam1Moved(e * extrinsics.head<3>(), e * extrinsics.tail<3>())
+        .value();
+  };
+  const auto n_alone = [&](const StereoRig& rig) {
+    return RefineRefractiveIndex(rig, data, options).value().n;
+  };
+  constexpr double kStep = 0.1;
+  const double response =
+      (n_alone(moved(kStep)) - n_alone(moved(-kStep))) / (2.0 * kStep);
+  const CalibrationPropagation with = propagated(joint);
+  const CalibrationPropagation without = propagated(independent);
+  const double with_correlation = std::pow(with.sigma_n_calibration, 2);
+  std::printf(
+      "[ MEASURED ] dn/de %.6g: variance %.6g with the correlation "
+      "(response^2 %.6g; ports' share %.6g, translation's %.6g), %.6g "
+      "without\n",
+      response, with_correlation, response * response, with.variance_ports,
+      with.variance_translation, std::pow(without.sigma_n_calibration, 2));
+  EXPECT_NEAR(with_correlation, response * response,
+              1e-3 * response * response);
+  // The rotation and translation's share is the extrinsics' alone; the
+  // ports' the rest.
+  EXPECT_NEAR(
+      with.variance_ports,
+      with_correlation - with.variance_translation - with.variance_rotation,
+      1e-12);
+  EXPECT_GT(
+      std::abs(std::pow(without.sigma_n_calibration, 2) - with_correlation),
+      0.1 * with_correlation);
+}
+
 // Noise-free, a rig with the drift prior gives n exactly: on the true rig,
 // and on a rig that drifted 0.5 degrees, whose rotation the
 // self-calibration then recovers exactly (with no noise the prior weighs

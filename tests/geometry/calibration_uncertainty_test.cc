@@ -167,5 +167,45 @@ TEST(CalibrationUncertainty, RotationPriorIsTheRotationGivenTheRest) {
   EXPECT_GT(fitted.RotationCovariance().trace(), 100.0 * expected.trace());
 }
 
+// The ports' parameters q join the joint covariance after the lenses, with
+// their cross-covariance; a rotation fitted with the port tilts (w = K q +
+// e) has the prior of e given the rest; sizes that do not fit are errors.
+TEST(CalibrationUncertainty, PortsJoinTheJointCovariance) {
+  const Eigen::MatrixXd q = 1e-4 * FixedCovariance(6, 0.7);
+  Eigen::Matrix<double, 6, 6> k = Eigen::Matrix<double, 6, 6>::Zero();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 6; ++c) k(r, c) = 0.5 * std::sin(r + 1.5 * c);
+  }
+  const Eigen::Matrix<double, 6, 6> own = 1e-8 * FixedCovariance(6, 0.2);
+  CalibrationUncertainty fitted;
+  fitted.extrinsics_covariance = own + k * q * k.transpose();
+  fitted.port_covariance = q;
+  fitted.port_cross_covariance = k * q;
+  ASSERT_TRUE(fitted.Check(4, 4).ok()) << fitted.Check(4, 4).message();
+  const Eigen::MatrixXd joint = fitted.JointCovariance();
+  ASSERT_EQ(joint.rows(), 12);
+  EXPECT_EQ(joint.bottomRightCorner(6, 6), q);
+  EXPECT_EQ(joint.topRightCorner(6, 6), k * q);
+  const Eigen::Matrix3d expected = ConditionalCovariance(own, 3);
+  EXPECT_LT((fitted.RotationPriorCovariance() - expected).norm(),
+            1e-9 * expected.norm());
+  EXPECT_FALSE(fitted.IsZero());
+
+  CalibrationUncertainty bad = fitted;
+  bad.port_covariance = q.topLeftCorner(5, 5);
+  EXPECT_THAT(bad.Check(4, 4).message(), HasSubstr("port covariance is 5x5"));
+  bad = fitted;
+  bad.port_covariance.resize(0, 0);
+  EXPECT_THAT(bad.Check(4, 4).message(),
+              HasSubstr("needs the port covariance"));
+  bad = fitted;
+  bad.left_lens_covariance = Eigen::MatrixXd::Identity(4, 4);
+  EXPECT_THAT(bad.Check(4, 4).message(),
+              HasSubstr("port cross-covariance is 6x6, not 10x6"));
+  bad = fitted;
+  bad.port_cross_covariance *= 1e3;
+  EXPECT_THAT(bad.Check(4, 4).message(), HasSubstr("not positive"));
+}
+
 }  // namespace
 }  // namespace rcm

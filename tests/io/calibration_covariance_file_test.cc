@@ -307,6 +307,68 @@ TEST(CalibrationCovarianceFile, LensCrossCovariance) {
   EXPECT_THAT(ParseError(bad), HasSubstr("needs both cameras' intrinsics"));
 }
 
+// The ports' block of an underwater calibration that estimated them:
+// written, read back bit for bit, handed to the (cam0, cam1) pair's
+// uncertainty (not to another pair), checked with the rest of the joint
+// matrix; a focal drift prior on a camera without a lens covariance gives
+// the cross-covariance that camera's zero rows.
+TEST(CalibrationCovarianceFile, PortsCovariance) {
+  const Eigen::MatrixXd full = Covariance(28, 1e-3, 6);  // [w; dt; 8; 8; q]
+  CalibrationCovarianceFile file = SampleFile();
+  file.cameras[1].from_previous_covariance = full.topLeftCorner<6, 6>();
+  file.cameras[0].intrinsics_covariance = full.block(6, 6, 8, 8);
+  file.cameras[1].intrinsics_covariance = full.block(14, 14, 8, 8);
+  file.cameras[1].from_previous_intrinsics_covariance = full.block(0, 6, 6, 16);
+  file.cameras[1].previous_intrinsics_covariance = full.block(6, 14, 8, 8);
+  file.port_covariance = full.bottomRightCorner<6, 6>();
+  file.port_cross_covariance = full.topRightCorner(22, 6);
+  const std::string text = FormatCalibrationCovariance(file);
+  EXPECT_THAT(text, HasSubstr("ports:\n  covariance:"));
+  const CalibrationCovarianceFile read =
+      ParseCalibrationCovariance(text, "c.yaml").value();
+  EXPECT_EQ(read.port_cross_covariance, file.port_cross_covariance);
+  EXPECT_EQ(FormatCalibrationCovariance(read), text);
+  const CalibrationUncertainty pair = Pair(read, 0, 1).value();
+  EXPECT_TRUE(pair.Check(8, 8).ok()) << pair.Check(8, 8).message();
+  // The joint's port rows are the full one's (to the rounding of a * a^T's
+  // symmetry).
+  EXPECT_LT((pair.JointCovariance() - full).bottomRows(6).norm(),
+            1e-14 * full.norm());
+  EXPECT_EQ(Pair(read, 1, 0).value().port_covariance.size(), 0);
+
+  CalibrationCovarianceFile bad = file;
+  bad.port_cross_covariance *= 1e3;
+  EXPECT_THAT(ParseError(bad), HasSubstr("not positive semi-definite"));
+  bad = file;
+  bad.port_cross_covariance.conservativeResize(21, 6);
+  EXPECT_THAT(ParseError(bad), HasSubstr("is 21x6, not 22x6"));
+  const std::string unknown =
+      "medium: water\ncam0: {}\ncam1: {}\nports:\n  tilt: 1\n";
+  EXPECT_THAT(
+      ParseCalibrationCovariance(unknown, "side.yaml").status().message(),
+      HasSubstr("ports.tilt: unknown key"));
+  const std::string no_covariance =
+      "medium: water\ncam0: {}\ncam1: {}\nports: {}\n";
+  EXPECT_THAT(
+      ParseCalibrationCovariance(no_covariance, "side.yaml").status().message(),
+      HasSubstr("needs covariance"));
+
+  // Ports without lens covariances: 6 cross rows; the focal drift prior
+  // then adds each lens's zero rows.
+  CalibrationCovarianceFile bare;
+  bare.medium = "water";
+  bare.cameras.resize(2);
+  bare.cameras[1].from_previous_covariance = full.topLeftCorner<6, 6>();
+  bare.port_covariance = full.bottomRightCorner<6, 6>();
+  bare.port_cross_covariance = full.block(0, 22, 6, 6);
+  const CalibrationUncertainty focal =
+      Pair(bare, 0, 1, std::nullopt, 0.003).value();
+  ASSERT_EQ(focal.port_cross_covariance.rows(), 22);
+  EXPECT_EQ(focal.port_cross_covariance.topRows(6), bare.port_cross_covariance);
+  EXPECT_TRUE(focal.port_cross_covariance.bottomRows(16).isZero(0.0));
+  EXPECT_TRUE(focal.Check(8, 8).ok()) << focal.Check(8, 8).message();
+}
+
 // ReadStereoRig attaches the sidecar when there is one, and the default
 // drift prior otherwise; a camera count that differs from the camchain's,
 // or a lens covariance of the wrong size, is an error naming the sidecar.

@@ -34,6 +34,7 @@ namespace {
 constexpr double kRotationStep = 1e-6;     // radians
 constexpr double kTranslationStep = 1e-6;  // meters
 constexpr double kLensStepScale = 1e-6;    // times (1 + |p|)
+constexpr double kPortStep = 1e-6;         // meters (air gap), tilt
 
 // The camera with parameter `index` of params() moved by `step`; nullopt
 // when the moved camera is invalid (a parameter at the edge of its range).
@@ -74,6 +75,22 @@ std::vector<Difference> LensDifferences(
   return differences;
 }
 
+// The port of a rig side with parameter k of q = [d, a, b] moved by
+// `step`; nullopt when the moved port is invalid (a gap below its least).
+std::optional<FlatPort> MovedPort(const FlatPort& port, int k, double step) {
+  FlatPort moved = port;
+  if (k == 0) {
+    moved.air_gap += step;
+  } else {
+    Eigen::Vector2d tilt(port.normal.x() / port.normal.z(),
+                         port.normal.y() / port.normal.z());
+    tilt[k - 1] += step;
+    moved.normal = Eigen::Vector3d(tilt.x(), tilt.y(), 1.0).normalized();
+  }
+  if (!moved.Check().ok()) return std::nullopt;
+  return moved;
+}
+
 }  // namespace
 
 CalibrationParameterLayout CalibrationParameterLayout::Of(const StereoRig& rig,
@@ -88,6 +105,12 @@ CalibrationParameterLayout CalibrationParameterLayout::Of(const StereoRig& rig,
     }
     if (uncertainty->right_lens_covariance.size() > 0) {
       layout.num_right_lens = rig.right().num_params();
+    }
+    if (uncertainty->port_covariance.size() > 0 && rig.HasThickPort()) {
+      layout.num_ports = kNumPorts;
+      for (int k = 0; k < kNumPorts; ++k) {
+        layout.port_varies[k] = uncertainty->port_covariance(k, k) > 0.0;
+      }
     }
     layout.focal = estimate_focal && uncertainty->focal_drift_sigma > 0.0 &&
                    layout.num_left_lens > 0 && layout.num_right_lens > 0;
@@ -181,6 +204,43 @@ void AccumulateLocusNormalEquations(
     }
   }
   const std::vector<Difference> lens = LensDifferences(*at, layout);
+  // The ports' columns: each parameter that varies moved both ways (an air
+  // gap within a step of 0 forward only: minus is the rig itself).
+  struct PortDifference {
+    int column = 0;
+    std::optional<LocusResidualModel> plus;
+    std::optional<LocusResidualModel> minus;  // nullopt: the rig at hand
+    double span = 0.0;                        // between plus and minus
+  };
+  std::vector<PortDifference> ports;
+  for (int k = 0; k < layout.num_ports; ++k) {
+    if (!layout.port_varies[k]) continue;
+    const int side = k / 3;
+    const int parameter = k % 3;
+    const FlatPort& port = side == 0 ? at->ports()->left : at->ports()->right;
+    const bool forward =
+        parameter == 0 &&
+        port.air_gap < 2.0 * kPortStep + FlatPort::kMinLayerThickness;
+    PortDifference difference;
+    difference.column = layout.Ports() + k;
+    difference.span = forward ? kPortStep : 2.0 * kPortStep;
+    for (int s = 0; s < (forward ? 1 : 2); ++s) {
+      const std::optional<FlatPort> moved =
+          MovedPort(port, parameter, s == 0 ? kPortStep : -kPortStep);
+      if (!moved) continue;
+      const StatusOr<StereoRig> shifted =
+          side == 0 ? at->WithPorts(*moved, at->ports()->right)
+                    : at->WithPorts(at->ports()->left, *moved);
+      if (!shifted.ok()) continue;
+      (s == 0 ? difference.plus : difference.minus)
+          .emplace(*shifted, shifted->right_from_left());
+    }
+    // A side that could not be moved leaves the column undefined.
+    if (!difference.plus || (!forward && !difference.minus)) {
+      difference.plus.reset();
+    }
+    ports.push_back(std::move(difference));
+  }
 
   std::map<int64_t, size_t> frame_slot;
   LocusNormalEquations::Vector row(size);
@@ -220,6 +280,16 @@ void AccumulateLocusNormalEquations(
         row[layout.LeftLens() + static_cast<int>(j)] =
             (values[0] - values[1]) / (2.0 * lens[j].step);
       }
+    }
+    for (size_t j = 0; j < ports.size() && defined; ++j) {
+      const PortDifference& port = ports[j];
+      double plus = 0.0;
+      double minus = r;
+      defined =
+          port.plus.has_value() &&
+          port.plus->Residual(match, n, &plus, nullptr) &&
+          (!port.minus || port.minus->Residual(match, n, &minus, nullptr));
+      if (defined) row[port.column] = (plus - minus) / port.span;
     }
     if (layout.focal && defined) {
       // d r / d e = g^T d r / d lens (d params / d e = g of the
@@ -464,6 +534,20 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
                       layout.num_right_lens, layout.num_left_lens) =
         uncertainty.lens_cross_covariance.transpose();
   }
+  // The ports' covariance, and theirs with the extrinsics and the lenses
+  // (the cross rows are [w; dt], then the lenses the uncertainty has, which
+  // are the layout's lens columns).
+  if (layout.num_ports > 0) {
+    const int ports = layout.Ports();
+    calibration.block(ports, ports, layout.num_ports, layout.num_ports) =
+        uncertainty.port_covariance;
+    const Eigen::MatrixXd& cross = uncertainty.port_cross_covariance;
+    if (cross.rows() == 6 + num_lens && cross.cols() == layout.num_ports) {
+      calibration.block(1, ports, 6 + num_lens, layout.num_ports) = cross;
+      calibration.block(ports, 1, layout.num_ports, 6 + num_lens) =
+          cross.transpose();
+    }
+  }
   for (int k = 0; k < layout.NumSystematic(); ++k) {
     calibration(layout.Systematic() + k, layout.Systematic() + k) =
         layout.systematic_px * layout.systematic_px;
@@ -608,37 +692,67 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
   const Eigen::MatrixXd from_held = s * sigma_p * s.transpose() + cross;
 
   // The held parameters' share, split by kind for the report: rotation
-  // (when held), translation, lenses; cross-covariances between kinds (a
-  // measured covariance of rotation with translation) go with the
+  // (when held), translation, lenses, ports; cross-covariances between
+  // kinds (a measured covariance of rotation with translation) go with the
   // translation, except the lenses' with the extrinsics, which go with the
-  // lenses (so that the lenses' share is what they add with their
-  // correlation, negative when the extrinsics fitted through them cancel
-  // more than they add).
+  // lenses, and the ports' with the extrinsics and the lenses, which go with
+  // the ports (so that a share is what its kind adds with its correlation,
+  // negative when what was fitted with it cancels more than it adds).
+  const int ports_column = layout.Ports();
   const int systematic = layout.Systematic();
-  const auto group_of = [systematic](int column) {
-    return column <= 3 ? 0 : column <= 6 ? 1 : column < systematic ? 2 : 3;
+  enum Group {
+    kRotationGroup,
+    kTranslationGroup,
+    kLensGroup,
+    kPortGroup,
+    kSystematicGroup,
+    kNumGroups
   };
-  double shares[4] = {0.0, 0.0, 0.0, 0.0};
-  for (int g = 0; g < 4; ++g) {
+  const auto group_of = [ports_column, systematic](int column) {
+    return column <= 3             ? kRotationGroup
+           : column <= 6           ? kTranslationGroup
+           : column < ports_column ? kLensGroup
+           : column < systematic   ? kPortGroup
+                                   : kSystematicGroup;
+  };
+  double shares[kNumGroups] = {};
+  for (int g = 0; g < kNumGroups; ++g) {
     Eigen::MatrixXd part = Eigen::MatrixXd::Zero(np, np);
     for (int r = 0; r < np; ++r) {
       for (int c = 0; c < np; ++c) {
         const int gr = group_of(held[r]);
         const int gc = group_of(held[c]);
-        if ((gr == g && gc == g) ||
-            (g == 2 && (gr == 2) != (gc == 2) && gr < 3 && gc < 3)) {
-          part(r, c) = sigma_p(r, c);
-        }
+        // The kind a cross term goes with: the later of lens and port.
+        const int owner = std::max(gr, gc);
+        const bool mine =
+            (gr == g && gc == g) ||
+            (gr != gc && owner == g && (g == kLensGroup || g == kPortGroup) &&
+             owner < kSystematicGroup);
+        if (mine) part(r, c) = sigma_p(r, c);
       }
     }
     shares[g] = (s.row(0) * part * s.row(0).transpose())(0, 0);
   }
-  shares[2] += cross(0, 0);
-  result.variance_rotation = shares[0];
-  result.variance_lenses = shares[2];
-  result.variance_systematic = shares[3];
-  result.variance_translation =
-      from_held(0, 0) - shares[0] - shares[2] - shares[3];
+  // The rotation prior's correlation with the held columns, by the kind of
+  // the held column (the translation's by difference below).
+  if (mode == RotationMode::kPrior && !sigma_pw.isZero(0.0)) {
+    const Eigen::MatrixXd p_w = prior.middleCols(1, 3);
+    for (const int g : {kLensGroup, kPortGroup}) {
+      Eigen::MatrixXd part = Eigen::MatrixXd::Zero(np, 3);
+      for (int r = 0; r < np; ++r) {
+        if (group_of(held[r]) == g) part.row(r) = sigma_pw.row(r);
+      }
+      shares[g] += -2.0 * variance *
+                   (s.row(0) * part * p_w.transpose() * h_inverse.col(0))(0, 0);
+    }
+  }
+  result.variance_rotation = shares[kRotationGroup];
+  result.variance_lenses = shares[kLensGroup];
+  result.variance_ports = shares[kPortGroup];
+  result.variance_systematic = shares[kSystematicGroup];
+  result.variance_translation = from_held(0, 0) - shares[kRotationGroup] -
+                                shares[kLensGroup] - shares[kPortGroup] -
+                                shares[kSystematicGroup];
   result.variance_medium = from_n_prior(0, 0);
   result.variance_lenses += from_focal_prior(0, 0);
   result.variance_rotation +=

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 namespace rcm {
 namespace {
@@ -82,16 +83,29 @@ void CalibrationUncertainty::AddFocalDrift(
     double focal_sigma, const Eigen::VectorXd& left_params,
     const Eigen::VectorXd& right_params) {
   if (focal_sigma == 0.0) return;
-  const auto add = [focal_sigma](const Eigen::VectorXd& params,
-                                 Eigen::MatrixXd* covariance) {
+  // A lens block that appears gets zero rows in the ports' cross-covariance
+  // (its rows follow the extrinsics', cam0's lens first).
+  const auto add = [this, focal_sigma](const Eigen::VectorXd& params,
+                                       Eigen::MatrixXd* covariance,
+                                       Eigen::Index cross_row) {
     const Eigen::Index size = params.size();
-    if (covariance->size() == 0)
+    if (covariance->size() == 0) {
       *covariance = Eigen::MatrixXd::Zero(size, size);
+      if (port_cross_covariance.size() > 0) {
+        Eigen::MatrixXd widened = Eigen::MatrixXd::Zero(
+            port_cross_covariance.rows() + size, port_cross_covariance.cols());
+        widened.topRows(cross_row) = port_cross_covariance.topRows(cross_row);
+        widened.bottomRows(port_cross_covariance.rows() - cross_row) =
+            port_cross_covariance.bottomRows(port_cross_covariance.rows() -
+                                             cross_row);
+        port_cross_covariance = std::move(widened);
+      }
+    }
     const Eigen::VectorXd g = FocalDirection(params);
     *covariance += focal_sigma * focal_sigma * g * g.transpose();
   };
-  add(left_params, &left_lens_covariance);
-  add(right_params, &right_lens_covariance);
+  add(left_params, &left_lens_covariance, 6);
+  add(right_params, &right_lens_covariance, 6 + left_lens_covariance.rows());
   focal_drift_sigma = std::hypot(focal_drift_sigma, focal_sigma);
   source += (source.empty() ? "" : ", ") + DescribeFocalDrift(focal_sigma);
 }
@@ -128,14 +142,16 @@ bool CalibrationUncertainty::IsZero() const {
          (left_lens_covariance.size() == 0 ||
           left_lens_covariance.isZero(0.0)) &&
          (right_lens_covariance.size() == 0 ||
-          right_lens_covariance.isZero(0.0));
+          right_lens_covariance.isZero(0.0)) &&
+         (port_covariance.size() == 0 || port_covariance.isZero(0.0));
 }
 
 Eigen::MatrixXd CalibrationUncertainty::JointCovariance() const {
   const int left = static_cast<int>(left_lens_covariance.rows());
   const int right = static_cast<int>(right_lens_covariance.rows());
-  Eigen::MatrixXd joint =
-      Eigen::MatrixXd::Zero(6 + left + right, 6 + left + right);
+  const int ports = port_covariance.size() > 0 ? kNumPortParams : 0;
+  const int held = 6 + left + right;
+  Eigen::MatrixXd joint = Eigen::MatrixXd::Zero(held + ports, held + ports);
   joint.topLeftCorner<6, 6>() = extrinsics_covariance;
   if (left > 0) joint.block(6, 6, left, left) = left_lens_covariance;
   if (right > 0) {
@@ -150,6 +166,14 @@ Eigen::MatrixXd CalibrationUncertainty::JointCovariance() const {
       lens_cross_covariance.cols() == right) {
     joint.block(6, 6 + left, left, right) = lens_cross_covariance;
     joint.block(6 + left, 6, right, left) = lens_cross_covariance.transpose();
+  }
+  if (ports > 0) {
+    joint.bottomRightCorner(ports, ports) = port_covariance;
+    if (port_cross_covariance.rows() == held &&
+        port_cross_covariance.cols() == ports) {
+      joint.topRightCorner(held, ports) = port_cross_covariance;
+      joint.bottomLeftCorner(ports, held) = port_cross_covariance.transpose();
+    }
   }
   return joint;
 }
@@ -219,9 +243,39 @@ Status CalibrationUncertainty::Check(int left_num_params,
     }
     RCM_RETURN_IF_ERROR(CheckCovarianceMatrix(*lenses[c], name));
   }
+  if (port_covariance.size() > 0) {
+    if (port_covariance.rows() != kNumPortParams ||
+        port_covariance.cols() != kNumPortParams) {
+      std::ostringstream message;
+      message << "port covariance is " << port_covariance.rows() << "x"
+              << port_covariance.cols() << ", not " << kNumPortParams << "x"
+              << kNumPortParams;
+      return Status::Error(message.str());
+    }
+    RCM_RETURN_IF_ERROR(
+        CheckCovarianceMatrix(port_covariance, "port covariance"));
+  }
+  if (port_cross_covariance.size() > 0) {
+    const int held = 6 + static_cast<int>(left_lens_covariance.rows() +
+                                          right_lens_covariance.rows());
+    if (port_covariance.size() == 0) {
+      return Status::Error("port cross-covariance needs the port covariance");
+    }
+    if (port_cross_covariance.rows() != held ||
+        port_cross_covariance.cols() != kNumPortParams) {
+      std::ostringstream message;
+      message << "port cross-covariance is " << port_cross_covariance.rows()
+              << "x" << port_cross_covariance.cols() << ", not " << held << "x"
+              << kNumPortParams;
+      return Status::Error(message.str());
+    }
+  }
   if (extrinsics_lens_covariance.size() == 0 &&
       lens_cross_covariance.size() == 0) {
-    return Status::Ok();
+    return port_cross_covariance.size() == 0
+               ? Status::Ok()
+               : CheckCovarianceMatrix(JointCovariance(),
+                                       "joint calibration covariance");
   }
   if (left_lens_covariance.size() == 0 || right_lens_covariance.size() == 0) {
     return Status::Error(

@@ -81,6 +81,61 @@ StatusOr<Eigen::MatrixXd> ReadCrossCovariance(const YamlReader& reader,
   return matrix;
 }
 
+// The `ports` block of a file whose cameras are read: its matrices, checked
+// with cam0's and cam1's blocks as one joint covariance.
+Status ReadPorts(const YamlReader& reader, const YamlEntry& ports,
+                 CalibrationCovarianceFile* file) {
+  const StatusOr<YamlEntries> fields = reader.Entries(ports.value, "ports");
+  if (!fields.ok()) return fields.status();
+  const YAML::Node* cross_node = nullptr;
+  for (const auto& [key, entry] : *fields) {
+    const std::string field = "ports." + key;
+    if (key == "covariance") {
+      StatusOr<Eigen::MatrixXd> matrix = ReadCovariance(
+          reader, entry.value, field, CalibrationUncertainty::kNumPortParams);
+      if (!matrix.ok()) return matrix.status();
+      file->port_covariance = std::move(matrix).value();
+    } else if (key == "cross_covariance") {
+      StatusOr<Eigen::MatrixXd> matrix =
+          ReadCrossCovariance(reader, entry.value, field, 0,
+                              "[w; dt] and the intrinsics, against q");
+      if (!matrix.ok()) return matrix.status();
+      file->port_cross_covariance = std::move(matrix).value();
+      cross_node = &entry.value;
+    } else {
+      return reader.Error(entry.key, field,
+                          "unknown key (expected covariance, "
+                          "cross_covariance)");
+    }
+  }
+  if (file->port_covariance.size() == 0) {
+    return reader.Error(ports.key, "ports", "needs covariance");
+  }
+  if (file->cameras.size() < 2) {
+    return reader.Error(ports.key, "ports", "needs cam0 and cam1");
+  }
+  CalibrationUncertainty joint;
+  const CalibrationCovarianceFile::Camera& cam1 = file->cameras[1];
+  joint.extrinsics_covariance = cam1.from_previous_covariance.value_or(
+      Eigen::Matrix<double, 6, 6>::Zero());
+  joint.left_lens_covariance = file->cameras[0].intrinsics_covariance;
+  joint.right_lens_covariance = cam1.intrinsics_covariance;
+  joint.extrinsics_lens_covariance = cam1.from_previous_intrinsics_covariance;
+  joint.lens_cross_covariance = cam1.previous_intrinsics_covariance;
+  joint.port_covariance = file->port_covariance;
+  joint.port_cross_covariance = file->port_cross_covariance;
+  const Status valid =
+      joint.Check(static_cast<int>(joint.left_lens_covariance.rows()),
+                  static_cast<int>(joint.right_lens_covariance.rows()));
+  if (!valid.ok()) {
+    return cross_node != nullptr
+               ? reader.Error(*cross_node, "ports.cross_covariance",
+                              valid.message())
+               : reader.Error(ports.value, "ports", valid.message());
+  }
+  return Status::Ok();
+}
+
 StatusOr<CalibrationCovarianceFile> ReadDocument(const YamlReader& reader,
                                                  const YAML::Node& root) {
   const StatusOr<YamlEntries> entries =
@@ -100,12 +155,12 @@ StatusOr<CalibrationCovarianceFile> ReadDocument(const YamlReader& reader,
 
   int num_cameras = 0;
   for (const auto& [key, entry] : *entries) {
-    if (key == "medium" || key == "drift_prior") continue;
+    if (key == "medium" || key == "drift_prior" || key == "ports") continue;
     const std::optional<int> index = CamchainCameraIndex(key);
     if (!index) {
       return reader.Error(entry.key, key,
                           "unknown key (expected medium, drift_prior, cam0, "
-                          "cam1, ...)");
+                          "cam1, ..., ports)");
     }
     num_cameras = std::max(num_cameras, *index + 1);
   }
@@ -228,6 +283,9 @@ StatusOr<CalibrationCovarianceFile> ReadDocument(const YamlReader& reader,
                     static_cast<int>(camera.intrinsics_covariance.rows()));
     if (!valid.ok()) return reader.Error(node, field, valid.message());
   }
+  if (const YamlEntry* ports = FindYamlEntry(*entries, "ports")) {
+    RCM_RETURN_IF_ERROR(ReadPorts(reader, *ports, &file));
+  }
   return file;
 }
 
@@ -294,6 +352,11 @@ std::string FormatCalibrationCovariance(const CalibrationCovarianceFile& file) {
     out << "# intrinsics_cross_covariance: of the intrinsics of cam(n-1) "
            "(rows) with camn's (columns)\n";
   }
+  if (file.port_covariance.size() > 0) {
+    out << "# ports: of q = [d0, a0, b0, d1, a1, b1], air gap d (m) and tilt "
+           "(a, b) = (N_x, N_y) / N_z\n# of cam0's and cam1's ports; "
+           "cross_covariance: of [w; dt; cam0's intrinsics; cam1's] with q\n";
+  }
   out << "medium: " << file.medium << "\n";
   out << "drift_prior:\n"
       << "  rotation_deg: " << FormatDouble(file.drift_rotation_sigma / kDegree)
@@ -326,6 +389,14 @@ std::string FormatCalibrationCovariance(const CalibrationCovarianceFile& file) {
     if (camera.previous_intrinsics_covariance.size() > 0 && k > 0) {
       out << "  intrinsics_cross_covariance:\n";
       AppendRows(camera.previous_intrinsics_covariance, &out);
+    }
+  }
+  if (file.port_covariance.size() > 0) {
+    out << "ports:\n  covariance:\n";
+    AppendMatrix(file.port_covariance, &out);
+    if (file.port_cross_covariance.size() > 0) {
+      out << "  cross_covariance:\n";
+      AppendRows(file.port_cross_covariance, &out);
     }
   }
   return out.str();
@@ -363,6 +434,10 @@ StatusOr<CalibrationUncertainty> PairCalibrationUncertainty(
   if (right_index == left_index + 1) {
     uncertainty.lens_cross_covariance =
         file.cameras[right_index].previous_intrinsics_covariance;
+  }
+  if (left_index == 0 && right_index == 1) {
+    uncertainty.port_covariance = file.port_covariance;
+    uncertainty.port_cross_covariance = file.port_cross_covariance;
   }
   const auto [rotation, translation] =
       drift_override.value_or(std::pair<double, double>{

@@ -18,6 +18,8 @@
 #define RCM_CALIB_CALIBRATION_COVARIANCE_H_
 
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "rcm/calib/cross_validation.h"
 #include "rcm/calib/stereo_calibration.h"
@@ -39,33 +41,54 @@ CalibrationCovarianceFile AirCalibrationCovariance(
 double LeaveOutScale(const std::optional<CrossValidation>& cross_validation,
                      int camera);
 
-// Per component of [w; dt], the leave-out spread over the covariance's
-// sigma, at least 1: the scales S of the extrinsics' rows in an underwater
-// calibration's sidecar (one scale for all six, as the air sidecar has it,
-// would carry the ratio of the best-known component, often the rotation
-// about the optical axis, to the others).
-Eigen::Matrix<double, 6, 1> ExtrinsicsLeaveOutScales(
-    const ExtrinsicChange& change);
+// The names of the blocks of UnderwaterCovariance that make the held
+// geometry h below, in its order: cam1_from_cam0, then each camera's
+// air_gap and port_tilt (those present).
+std::vector<std::string> HeldGeometryBlocks(
+    const UnderwaterCalibration& result);
+
+// How much wider than the covariance the leave-views-out replicates spread
+// the held geometry h (below), as one factor s^2 >= 1: with C the
+// covariance of h given the lenses (the fit's marginal, conditioned on the
+// lens blocks when the lenses were estimated; the replicates hold them) and
+// J the replicates' jackknife covariance (UnderwaterLeaveOut::covariance),
+//
+//   s^2 = max(1, trace(C^+ J) / rank C),
+//
+// the mean squared whitened spread (C^+ in correlation form, directions
+// below 1e-12 of the largest dropped). One factor keeps the covariance's
+// shape: the fit trades an air gap against the translation and a port's
+// tilt against cam1's rotation, and a target-free estimate holds all of them,
+// so their errors largely cancel in what they do to n; per-component
+// factors would break that cancellation (a factor 3 on the rotation, 1 on
+// the tilt) and claim errors of n that the rig does not have. 1 without a
+// leave-out.
+double GeometryLeaveOutScale(const UnderwaterCalibration& result);
 
 // The sidecar of an underwater calibration: medium water, no drift prior
 // (the extrinsics and the lenses were measured in this dive), and the
-// joint covariance of the extrinsics [w; dt] and the lenses: the lenses'
-// from the joint fit (air views given) or from the air rig's
-// calibration_uncertainty() when it has one; the extrinsics' E from the
-// bundle adjustment with their covariance with the lenses X
-// (UnderwaterCalibration::extrinsics_lens_covariance) and the lenses'
-// share of their own. The extrinsics' covariance given the lenses, E_e|L
-// (ConditionalCovariance), is scaled by the leave-out spread per component
-// (ExtrinsicsLeaveOutScales, S), the lenses' share and X kept as the fit
-// has them:
+// joint covariance of the held geometry h and the lenses: the lenses' from
+// the joint fit (air views given) or from the air rig's
+// calibration_uncertainty() when it has one; h = [w; dt; q], the
+// extrinsics' change and, when the calibration estimated them, the ports'
+// parameters (calibration_uncertainty.h), with G from the bundle
+// adjustment, its covariance with the lenses X (UnderwaterCalibration::
+// extrinsics_lens_covariance, port_lens_covariance) and the lenses' share
+// of its own. h's covariance given the lenses, G_h|L (ConditionalCovariance),
+// is widened to the leave-out spread (GeometryLeaveOutScale, s^2), the
+// lenses' share and X kept as the fit has them:
 //
-//   E' = S E_e|L S + (E - E_e|L),   X' = X,
+//   G' = s^2 G_h|L + (G - G_h|L),   X' = X,
 //
 // positive semi-definite with the lenses' block (its Schur complement is
-// S E_e|L S). Scaling X too would claim a response of the extrinsics to a
-// lens error that the rig does not have, which a target-free estimate then
-// counts as an error of n. Without X, E' = S E S. One camera: the air
-// calibration's extrinsics and their uncertainty are kept.
+// s^2 G_h|L). Scaling X too would claim a response of h to a lens error
+// that the rig does not have, which a target-free estimate then counts as
+// an error of n. Without X, G' = s^2 G. The ports' rows go to the file's
+// `ports` block. One camera: the air calibration's extrinsics and their
+// uncertainty are kept. An air gap estimated under water trades against
+// the translation along the axis, so that given the ports the translation
+// is known far better than its marginal says; the estimators that hold
+// both carry them jointly (calibration_propagation.h).
 CalibrationCovarianceFile UnderwaterCalibrationCovariance(
     const UnderwaterCalibration& result, const StereoRig& air_rig);
 

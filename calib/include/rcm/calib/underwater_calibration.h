@@ -245,6 +245,9 @@ struct UnderwaterLeaveOut {
   // UnderwaterCovariance::matrix (w of the extrinsics about the full
   // solution, left perturbation).
   Eigen::VectorXd sigma;
+  // Their jackknife covariance, (g - 1) / g sum_k (x_k - mean)(x_k -
+  // mean)^T, same layout (the squares of sigma on its diagonal).
+  Eigen::MatrixXd covariance;
   // The held-out error of each input view (the evidence of
   // underwater_model_selection.h): with the parameters of the replicate
   // that left the view out held, the view's target pose is fitted to its
@@ -349,6 +352,26 @@ struct UnderwaterCalibration {
       Eigen::Matrix<double, 6, 6>::Zero();
   ExtrinsicChange extrinsic_change;
   std::array<PortEstimate, 2> ports;
+  // The ports' parameters q = [d0, a0, b0, d1, a1, b1]
+  // (CalibrationUncertainty's order: air gap, tilt (N_x, N_y) / N_z per
+  // camera) as the fit has them, zero where a parameter was not estimated:
+  // Cov(q) and Cov([w; dt], q) from the covariance (the change's convention,
+  // as extrinsic_change.covariance), and their response to the lenses as
+  // for the extrinsics above: Cov(q, lenses) (6 x (p0 + p1); empty when not
+  // computed) and, from the lens refits, q's share of the lenses' covariance
+  // of [w; dt; q], sum_{c,i} dq_{c,i} [de_{c,i}; dq_{c,i}]^T (zero with the
+  // lenses estimated: the covariance counts them). What the sidecar's
+  // `ports` block carries (calibration_covariance.h).
+  Eigen::Matrix<double, 6, 6> port_covariance =
+      Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 6> extrinsics_port_covariance =
+      Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::MatrixXd port_lens_covariance;
+  Eigen::Matrix<double, 6, 12> port_covariance_from_lenses =
+      Eigen::Matrix<double, 6, 12>::Zero();
+  // True when a port parameter was estimated (port_covariance is not zero
+  // by construction).
+  bool ports_estimated = false;
   // The board's warp (m; zero when not estimated), as in StereoCalibration.
   bool board_warp_estimated = false;
   Eigen::Vector2d board_warp = Eigen::Vector2d::Zero();

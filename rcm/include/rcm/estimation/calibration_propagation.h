@@ -10,6 +10,9 @@
 //   dt (3, a change of cam1_from_cam0's translation, meters),
 //   the lens parameters of each camera (Camera::params order), when the
 //   calibration measured their covariance,
+//   the ports' parameters q = [d, a, b] of each camera (air gap, tilt;
+//   CalibrationUncertainty::port_covariance), when the calibration
+//   estimated them and the rig has a thick port,
 //
 // (StereoRig::WithCam1Moved's convention), one row j_i = dr_i / d(n, w, dt,
 // lenses) per inlier: the Sampson coplanarity residual of a thin port
@@ -17,7 +20,9 @@
 // thick one (generalized_epipolar_error.h). dr/dn comes from ceres::Jet,
 // the rest from central differences (steps 1e-6 rad, 1e-6 m and
 // 1e-6 (1 + |p|); the residuals are smooth and the truncation error is
-// ~1e-12 relative). The estimators keep
+// ~1e-12 relative; an air gap within a step of 0, where the port has no
+// thinner side, by the forward difference, whose error is ~1e-6 relative).
+// The estimators keep
 // the sums
 //
 //   M = sum_i j_i j_i^T,   g = sum_i r_i j_i,   C = sum_i r_i^2,
@@ -118,7 +123,10 @@
 namespace rcm {
 
 // Columns of j_i: n, w (3), dt (3), the lens parameters of each camera
-// whose covariance the rig's calibration uncertainty has, then with a
+// whose covariance the rig's calibration uncertainty has, the ports'
+// parameters q (kNumPorts) when it has their covariance and the rig a
+// thick port (a thin rig's residual is the thin port's, which has no port
+// parameters: its port covariance is not propagated), then with a
 // systematic error floor the kNumSystematic coefficients of the systematic
 // residual field (the file comment), then with the focal scales estimated
 // the two focal scales (e_l, e_r) of calibration_uncertainty.h's focal
@@ -130,8 +138,13 @@ struct CalibrationParameterLayout {
   static constexpr int kTranslation = 4;
   static constexpr int kNumSystematic = 6;
   static constexpr int kNumFocal = 2;
+  static constexpr int kNumPorts = CalibrationUncertainty::kNumPortParams;
   int num_left_lens = 0;
   int num_right_lens = 0;
+  // kNumPorts or 0; with them, which of q carry variance (the others'
+  // columns are left 0, not computed).
+  int num_ports = 0;
+  bool port_varies[CalibrationUncertainty::kNumPortParams] = {};
   // Standard deviation of each systematic coefficient, pixels; 0: none.
   double systematic_px = 0.0;
   // The focal scales' columns (estimated under the focal drift prior).
@@ -150,7 +163,8 @@ struct CalibrationParameterLayout {
                                        bool estimate_focal = false);
   int LeftLens() const { return 7; }
   int RightLens() const { return 7 + num_left_lens; }
-  int Systematic() const { return 7 + num_left_lens + num_right_lens; }
+  int Ports() const { return 7 + num_left_lens + num_right_lens; }
+  int Systematic() const { return Ports() + num_ports; }
   int NumSystematic() const { return systematic_px > 0.0 ? kNumSystematic : 0; }
   int Focal() const { return Systematic() + NumSystematic(); }
   int NumFocal() const { return focal ? kNumFocal : 0; }
@@ -161,6 +175,7 @@ struct CalibrationParameterLayout {
 // (no heap), so that the online estimators' memory stays constant.
 struct LocusNormalEquations {
   static constexpr int kMaxSize = 7 + 2 * kMaxLensParams +
+                                  CalibrationParameterLayout::kNumPorts +
                                   CalibrationParameterLayout::kNumSystematic +
                                   CalibrationParameterLayout::kNumFocal;
   using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0,
@@ -314,13 +329,17 @@ struct CalibrationPropagation {
   double sigma_n_noise = 0.0;
   double sigma_n_calibration = 0.0;
   // Of sigma_n_calibration^2: the estimated rotation's prior share and the
-  // held parameters' (w when held, dt, lenses). The lenses' share counts
+  // held parameters' (w when held, dt, lenses, ports). The lenses' share counts
   // their correlation with the extrinsics, when the calibration measured
   // one, and is then negative where the extrinsics fitted through the
   // lenses cancel more than the lenses add.
   double variance_rotation = 0.0;
   double variance_translation = 0.0;
   double variance_lenses = 0.0;
+  // The held ports' share, with their correlation with the extrinsics and
+  // the lenses (an air gap fitted with the translation: negative where the
+  // two cancel more than the ports add).
+  double variance_ports = 0.0;
   // With a prior on n (RefinementOptions::n_prior): its share, part of
   // sigma_n_calibration^2 (the medium's uncertainty).
   double variance_medium = 0.0;

@@ -53,6 +53,21 @@
 //   | X_r^T       0     Sigma_r   |       = [X_l  X_r]  (6 x (p_l + p_r)),
 //
 // and without X (empty) the blocks are independent.
+//
+// The ports can be uncertain too: an underwater calibration that estimated
+// the ports' air gaps and tilts (calib/underwater_calibration.h) fitted them
+// with the extrinsics, and an air gap trades against cam1_from_cam0's
+// translation along the axis (the gap moves the refracted rays' apparent
+// centre), so that the translation's marginal is millimetres while given the
+// ports it is a fraction of one. The ports' parameters
+//
+//   q = [d_l, a_l, b_l, d_r, a_r, b_r]   (kNumPortParams),
+//
+// d the air gap (meters), (a, b) = (N_x / N_z, N_y / N_z) the port normal's
+// tilt (flat_port_geometry.h), then join the joint covariance after the
+// lenses, with their covariance with everything before them
+// (port_cross_covariance), so that an estimator that holds the ports carries
+// their error with its correlations (calibration_propagation.h).
 #ifndef RCM_GEOMETRY_CALIBRATION_UNCERTAINTY_H_
 #define RCM_GEOMETRY_CALIBRATION_UNCERTAINTY_H_
 
@@ -69,6 +84,8 @@ struct CalibrationUncertainty {
   static constexpr double kDefaultDriftMillimeters = 0.1;
   // The default focal drift prior of an air calibration, percent.
   static constexpr double kDefaultFocalDriftPercent = 0.3;
+  // The ports' parameters q above.
+  static constexpr int kNumPortParams = 6;
 
   // Covariance of [w; dt] above (rad^2, rad m, m^2).
   Eigen::Matrix<double, 6, 6> extrinsics_covariance =
@@ -84,6 +101,13 @@ struct CalibrationUncertainty {
   // relative position the extrinsics tie: the difference of the principal
   // points is known far better than either.)
   Eigen::MatrixXd lens_cross_covariance;
+  // Cov(q) of the ports' parameters above, kNumPortParams square; empty =
+  // the ports are exact (a component not estimated has zero variance).
+  Eigen::MatrixXd port_covariance;
+  // Cov([w; dt; left params; right params], q), (6 + p_l + p_r) x
+  // kNumPortParams, a lens's rows only when its covariance is given;
+  // empty = uncorrelated. Needs port_covariance.
+  Eigen::MatrixXd port_cross_covariance;
   // The focal drift prior s_f that the lens covariances contain
   // (AddFocalDrift; several add as the root of the sum of squares), 0 when
   // none: an estimator that estimates each camera's focal scale under this
@@ -133,7 +157,7 @@ struct CalibrationUncertainty {
   // The covariance of w given the rest held at the camchain's values, the
   // prior of an estimator that self-calibrates w with dt and the lenses
   // held (batch_refinement.h, online_estimator.h): with q = [dt; left
-  // params; right params] and the joint covariance above,
+  // params; right params; ports] and the joint covariance above,
   //
   //   Sigma_w|q = Sigma_ww - Sigma_wq Sigma_qq^+ Sigma_qw
   //
@@ -150,16 +174,19 @@ struct CalibrationUncertainty {
   Eigen::Matrix3d RotationPriorCovariance() const;
   // True when nothing is uncertain (every entry zero, no lens covariance).
   bool IsZero() const;
-  // The joint covariance of [w; dt; left params; right params] above (the
-  // lens blocks of size 0 when empty; zero cross blocks without
-  // extrinsics_lens_covariance or lens_cross_covariance).
+  // The joint covariance of [w; dt; left params; right params; q] above
+  // (the lens and port blocks of size 0 when empty; zero cross blocks
+  // without extrinsics_lens_covariance, lens_cross_covariance or
+  // port_cross_covariance).
   Eigen::MatrixXd JointCovariance() const;
 
   // Finite, symmetric (to a relative 1e-9) and positive semi-definite
   // matrices; lens covariances empty or of the cameras' parameter counts;
   // extrinsics_lens_covariance empty, or 6 x (p_l + p_r), and
   // lens_cross_covariance empty, or p_l x p_r, each with both lens
-  // covariances given and the joint covariance positive semi-definite.
+  // covariances given; port_covariance empty or kNumPortParams square,
+  // port_cross_covariance empty or (6 + the lens rows) x kNumPortParams with
+  // port_covariance given; the joint covariance positive semi-definite.
   // Errors name the matrix: "cam1_from_cam0 covariance is not positive
   // semi-definite".
   Status Check(int left_num_params, int right_num_params) const;

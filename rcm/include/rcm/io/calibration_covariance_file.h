@@ -28,13 +28,23 @@
 //     ...                        # columns), written by an underwater
 //                                # calibration (the extrinsics fitted through
 //                                # the air lenses move with them)
+//   ports:                       # cam0's and cam1's flat ports, as an
+//     covariance:                # underwater calibration estimated them:
+//     - [...]                    # 6x6, of q = [d0, a0, b0, d1, a1, b1], d the
+//     ...                        # air gap (m), (a, b) = (N_x, N_y) / N_z the
+//                                # normal's tilt (calibration_uncertainty.h)
+//     cross_covariance:          # 6 + p0 + p1 rows: [w; dt] of cam1's
+//     - [...]                    # T_cn_cnm1, cam0's intrinsics, cam1's (a
+//     ...                        # camera's rows only when it has
+//                                # intrinsics_covariance) against q
 //
 // Every key but `medium` is optional (a camera without intrinsics_covariance
 // has lenses taken as exact; cam0 never has T_cn_cnm1_covariance). A
 // camera's T_cn_cnm1_intrinsics_covariance needs its T_cn_cnm1_covariance
 // and both cameras' intrinsics_covariance, and the joint covariance they
 // make (CalibrationUncertainty::JointCovariance) must be positive
-// semi-definite. Numbers
+// semi-definite; so must the joint covariance with `ports`, whose
+// cross_covariance needs its covariance. Numbers
 // are written as the shortest text that reads back to the same double, so
 // that a file reads back bit for bit; matrices are written symmetrized,
 // (M + M^T) / 2. Reading never throws; errors are one
@@ -76,6 +86,11 @@ struct CalibrationCovarianceFile {
   double drift_focal_sigma = 0.0;
   // cameras[k] is camk.
   std::vector<Camera> cameras;
+  // cam0's and cam1's ports (key ports): Cov(q) and Cov([w; dt; cam0's
+  // intrinsics; cam1's], q) (CalibrationUncertainty::port_covariance,
+  // port_cross_covariance); empty when absent.
+  Eigen::MatrixXd port_covariance;
+  Eigen::MatrixXd port_cross_covariance;
 };
 
 // camchain.yaml -> camchain-covariance.yaml (same folder, the camchain's
@@ -101,12 +116,12 @@ Status WriteCalibrationCovariance(const std::string& path,
 // the two cameras' intrinsics covariances, and the extrinsics' covariance
 // of T_cn_cnm1 and its cross-covariance with the intrinsics when
 // right_index = left_index + 1 (other pairs chain several transforms:
-// their extrinsics get the drift prior alone), plus the file's
-// drift prior, or `drift_override` (rotation, translation sigmas) when
-// given, and the file's focal drift prior on `left_params` and
-// `right_params` (the cameras' Camera::params()), or `focal_override`.
-// `source` names the file in CalibrationUncertainty::source. Fails on an
-// index beyond the file's cameras.
+// their extrinsics get the drift prior alone), the ports' covariances for
+// the pair (cam0, cam1), plus the file's drift prior, or `drift_override`
+// (rotation, translation sigmas) when given, and the file's focal drift prior
+// on `left_params` and `right_params` (the cameras' Camera::params()), or
+// `focal_override`. `source` names the file in CalibrationUncertainty::source.
+// Fails on an index beyond the file's cameras.
 StatusOr<CalibrationUncertainty> PairCalibrationUncertainty(
     const CalibrationCovarianceFile& file, int left_index, int right_index,
     const std::string& source, const Eigen::VectorXd& left_params,
