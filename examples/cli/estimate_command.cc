@@ -118,6 +118,11 @@ DEFINE_double(systematic_px, -1.0,
               "(lighting gradients, sub-pixel interpolation), carried into "
               "sigma_n; default: 0.03 for matches of the image front end "
               "(measured on renders), 0 for --matches");
+DEFINE_bool(detect_systematic, true,
+            "refine: test the residuals for a smooth field beyond the pixel "
+            "noise (matches off the rigid scene: a water surface's mirror "
+            "image, a swimmer) and, where they show one (p < 1 %), widen "
+            "sigma_n by the field they estimate");
 DEFINE_double(mask_eta, 0.3,
               "closed-form: use a match when sqrt|u| sqrt|v| > eta, (u, v) "
               "its normalized left coordinates");
@@ -358,6 +363,7 @@ RefinementOptions RefinementOptionsFromFlags() {
   options.refine_rotation = FLAGS_refine_rotation;
   options.self_calibrate_rotation = FLAGS_self_calibrate;
   options.self_calibrate_focal = FLAGS_self_calibrate_focal;
+  options.detect_systematic = FLAGS_detect_systematic;
   options.systematic_px =
       FLAGS_systematic_px >= 0.0
           ? FLAGS_systematic_px
@@ -744,6 +750,19 @@ nlohmann::json CalibrationJson(const Report& report, const StereoRig& rig) {
       {"sigma_inflation_if_free", JsonNumber(p.rotation_sigma_inflation)}};
 }
 
+// The residuals' test for a systematic field (calibration_propagation.h);
+// null when not run.
+nlohmann::json SystematicFieldJson(const Report& report) {
+  if (!report.calibration || report.calibration->systematic_dof == 0) {
+    return nullptr;
+  }
+  const CalibrationPropagation& p = *report.calibration;
+  return {{"chi_squared", p.systematic_chi_squared},
+          {"dof", p.systematic_dof},
+          {"p_value", p.systematic_p_value},
+          {"detected_px", p.systematic_detected_px}};
+}
+
 nlohmann::json ConsistencyJson(const std::optional<FrameConsistency>& c) {
   if (!c) return nullptr;
   return {{"frames", c->frames},
@@ -800,9 +819,12 @@ std::vector<std::string> UncertaintyWarnings(const Report& report,
   }
   // The lenses' possible change since the calibration (the focal drift
   // prior of an air calibration) is most of a sigma_n too wide to use.
+  // (A share above the whole sigma_n^2 is one that the held parameters
+  // fitted with the lenses cancel, not most of it.)
   if (report.calibration && report.sigma_n > kWideSigmaN &&
       report.calibration->variance_lenses >
-          0.5 * report.sigma_n * report.sigma_n) {
+          0.5 * report.sigma_n * report.sigma_n &&
+      report.calibration->variance_lenses <= report.sigma_n * report.sigma_n) {
     warnings.push_back(
         "sigma_n " + FormatFixed(report.sigma_n, 3) +
         " is mostly the lenses' (" +
@@ -812,6 +834,19 @@ std::vector<std::string> UncertaintyWarnings(const Report& report,
         report.calibration->source +
         ") from n; calibrate in the water (rcm calibrate --underwater, with "
         "the air views: --air-left/--air-right) for a better n");
+  }
+  if (report.calibration && report.calibration->systematic_detected_px > 0.0) {
+    const CalibrationPropagation& p = *report.calibration;
+    warnings.push_back(
+        "the residuals show a smooth field beyond the pixel noise (chi2 " +
+        FormatFixed(p.systematic_chi_squared, 1) + " for " +
+        std::to_string(p.systematic_dof) + " dof, " +
+        FormatFixed(p.systematic_detected_px, 3) +
+        " px per coefficient): matches off the rigid scene (a water "
+        "surface's mirror image, a swimmer, particles) or a lens model's "
+        "error; sigma_n counts it (matches' systematic error " +
+        FormatFixed(p.sigma_n_systematic, 4) +
+        "); matches of the rigid scene only (--matches) give a better n");
   }
   if (report.consistency && report.consistency->inflation > 1.0) {
     warnings.push_back(
@@ -1201,6 +1236,7 @@ int RunEstimate() {
   json["sigma_n_calibration"] = JsonNumber(report->sigma_n_calibration);
   json["sigma_n_systematic"] = JsonNumber(report->sigma_n_systematic);
   json["systematic_px"] = refinement.systematic_px;
+  json["systematic_field"] = SystematicFieldJson(*report);
   json["calibration"] = CalibrationJson(*report, *rig);
   json["consistency"] = ConsistencyJson(report->consistency);
   json["n_closed_form"] = JsonNumber(report->n_closed_form);

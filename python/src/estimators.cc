@@ -88,6 +88,7 @@ std::vector<OptionField> RefinementFields(RefinementOptions* o) {
           BoolOption("self_calibrate_rotation", &o->self_calibrate_rotation),
           BoolOption("self_calibrate_focal", &o->self_calibrate_focal),
           DoubleOption("systematic_px", &o->systematic_px),
+          BoolOption("detect_systematic", &o->detect_systematic),
           IntOption("max_num_iterations", &o->max_num_iterations),
           IntOption("num_threads", &o->num_threads)};
 }
@@ -125,6 +126,9 @@ py::object CalibrationDict(const std::optional<CalibrationPropagation>& c) {
   d["sigma_n_noise"] = c->sigma_n_noise;
   d["sigma_n_calibration"] = c->sigma_n_calibration;
   d["sigma_n_systematic"] = c->sigma_n_systematic;
+  d["systematic_chi_squared"] = c->systematic_chi_squared;
+  d["systematic_p_value"] = c->systematic_p_value;
+  d["systematic_detected_px"] = c->systematic_detected_px;
   d["variance_rotation"] = c->variance_rotation;
   d["variance_translation"] = c->variance_translation;
   d["variance_lenses"] = c->variance_lenses;
@@ -452,7 +456,7 @@ Keyword options (RefinementOptions, same names and defaults):
   inlier_threshold_px=2.0 (pixels, inf keeps all), num_scan_points=51,
   min_inliers=10, max_crlb_per_px=0.1, refine_rotation=False,
   self_calibrate_rotation=True, self_calibrate_focal=True,
-  systematic_px=0.0 (pixels),
+  systematic_px=0.0 (pixels), detect_systematic=True,
   n_prior=None (a prior on n: 'fresh', 'sea', 'N:SIGMA' or (n, sigma); with
   refine_rotation=True it gives cam1's turn on a narrow rig),
   max_num_iterations=100, num_threads=2.

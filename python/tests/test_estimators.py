@@ -190,7 +190,8 @@ def test_option_keywords():
         "loss": "cauchy", "loss_scale_px": 1.0, "inlier_threshold_px": 2.0,
         "num_scan_points": 51, "min_inliers": 10, "max_crlb_per_px": 0.1,
         "refine_rotation": False, "self_calibrate_rotation": True,
-        "self_calibrate_focal": True, "systematic_px": 0.0, "max_num_iterations": 100, "num_threads": 2,
+        "self_calibrate_focal": True, "systematic_px": 0.0,
+        "detect_systematic": True, "max_num_iterations": 100, "num_threads": 2,
         "n_prior": None}
 
 
@@ -367,3 +368,27 @@ def test_water_refractive_index_and_medium_prior():
         rcm.medium_prior("brine")
     assert "expected fresh, sea or N:SIGMA" in one_line(error)
 
+
+
+def test_a_field_off_the_rigid_scene_widens_sigma(realistic_rig):
+    # The right pixels of the top third moved down by 0.5 px in every
+    # frame (a surface's mirror image): the residuals' test finds the field
+    # (p < 1 %) and sigma_n grows by its share; with detect_systematic=False
+    # the same matches give the pixel noise's sigma alone. Clean matches
+    # show no field (the test's false alarm rate is 1 %; this seed passes).
+    n = 1.333
+    exact = sample(realistic_rig, n, frames=10, per_frame=300, seed=21)
+    noisy = rcm.add_pixel_noise(exact, 0.3, seed=22)
+    clean = rcm.refine_refractive_index(realistic_rig, noisy)
+    assert clean.calibration is None or \
+        clean.calibration["systematic_detected_px"] == 0.0
+    moved = noisy.to_array()  # (N, 5): frame, xl, yl, xr, yr
+    top = moved[:, 2] < 540 / 3.0
+    moved[top, 4] += 0.5
+    found = rcm.refine_refractive_index(realistic_rig, moved)
+    blind = rcm.refine_refractive_index(realistic_rig, moved,
+                                        detect_systematic=False)
+    assert found.calibration["systematic_p_value"] < 0.01
+    assert found.calibration["systematic_detected_px"] > 0.05
+    assert found.sigma_n_systematic > 3.0 * blind.sigma_n
+    assert abs(found.n - n) < 3.0 * found.sigma_n

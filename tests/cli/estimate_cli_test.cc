@@ -99,6 +99,46 @@ TEST(EstimateCli, ExactDataGiveTrueIndexAsJson) {
   EXPECT_EQ(json["frames"].get<int>(), 4);
 }
 
+// Matches off the rigid scene: the right pixels of the top third moved
+// down by 0.5 px in every frame (a surface's mirror image), 0.3 px of
+// noise. The residuals' test finds the field: one warning line, the JSON's
+// systematic_field, sigma_n widened so that it covers the error;
+// --nodetect-systematic turns it off (null, the same matches' narrow
+// sigma).
+TEST(EstimateCli, FieldOffTheRigidSceneIsFlaggedAndWidensSigma) {
+  StereoSamplerOptions options;
+  options.n = 1.333;
+  options.num_frames = 4;
+  options.per_frame = 250;
+  options.non_rigid_layer.image_fraction = 1.0 / 3.0;
+  options.non_rigid_layer.offset_px = 0.5;
+  std::vector<StereoCorrespondence> matches =
+      SampleStereoCorrespondences(AlphasenseFrontRectifiedRig(), options)
+          .value();
+  AddPixelNoise(0.3, 5, &matches);
+  const std::string csv =
+      test::WriteTempFile("layer.csv", FormatCorrespondenceCsv(matches));
+  const RunResult found =
+      Rcm({"estimate", "--calib", kRig, "--matches", csv, "--json"});
+  ASSERT_EQ(found.exit_code, 0) << found.err;
+  EXPECT_NE(found.err.find("the residuals show a smooth field"),
+            std::string::npos)
+      << found.err;
+  const nlohmann::json json = nlohmann::json::parse(found.out);
+  ASSERT_TRUE(json["systematic_field"].is_object()) << found.out;
+  EXPECT_LT(json["systematic_field"]["p_value"].get<double>(), 0.01);
+  EXPECT_GT(json["systematic_field"]["detected_px"].get<double>(), 0.0);
+  EXPECT_LE(std::abs(json["n"].get<double>() - 1.333),
+            3.0 * json["sigma_n"].get<double>());
+  const RunResult blind = Rcm({"estimate", "--calib", kRig, "--matches", csv,
+                               "--json", "--nodetect-systematic"});
+  ASSERT_EQ(blind.exit_code, 0) << blind.err;
+  const nlohmann::json off = nlohmann::json::parse(blind.out);
+  EXPECT_TRUE(off["systematic_field"].is_null()) << blind.out;
+  EXPECT_GT(json["sigma_n_systematic"].get<double>(),
+            2.0 * off["sigma_n_systematic"].get<double>());
+}
+
 TEST(EstimateCli, ClosedFormOnExactData) {
   const RunResult result =
       Rcm({"estimate", "--calib", kRig, "--matches", ExactMatches(1.333),

@@ -289,7 +289,8 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
   const bool with_rotation = mode != RotationMode::kHeld;
   // The focal scales, estimated under the focal drift prior.
   const CalibrationParameterLayout layout = CalibrationParameterLayout::Of(
-      rig, options.systematic_px, options.self_calibrate_focal);
+      rig, options.systematic_px, options.self_calibrate_focal,
+      options.detect_systematic);
   const bool with_focal = layout.focal;
   FocalScales focal;
   focal.prior_sigma = uncertainty.focal_drift_sigma;
@@ -520,8 +521,10 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
     correction.correlation_with_n = propagation->focal_scale_correlation_with_n;
     summary.focal = correction;
   }
-  if (rig.calibration_uncertainty() || layout.NumSystematic() > 0 ||
-      options.n_prior) {
+  // (A rig made in code is exact: no calibration report unless a floor,
+  // a prior on n or a field the residuals show.)
+  if (rig.calibration_uncertainty() || layout.systematic_px > 0.0 ||
+      propagation->systematic_detected_px > 0.0 || options.n_prior) {
     summary.calibration = *propagation;
   }
   summary.normal_equations = std::move(equations);

@@ -3,6 +3,7 @@
 #include <ceres/jet.h>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <algorithm>
 #include <array>
@@ -35,6 +36,9 @@ constexpr double kRotationStep = 1e-6;     // radians
 constexpr double kTranslationStep = 1e-6;  // meters
 constexpr double kLensStepScale = 1e-6;    // times (1 + |p|)
 constexpr double kPortStep = 1e-6;         // meters (air gap), tilt
+// The least systematic field detected, pixels: far below any matcher's
+// (0.03 px for rcm's front end), far above rounding.
+constexpr double kMinSystematicPx = 1e-6;
 
 // The camera with parameter `index` of params() moved by `step`; nullopt
 // when the moved camera is invalid (a parameter at the edge of its range).
@@ -93,11 +97,12 @@ std::optional<FlatPort> MovedPort(const FlatPort& port, int k, double step) {
 
 }  // namespace
 
-CalibrationParameterLayout CalibrationParameterLayout::Of(const StereoRig& rig,
-                                                          double systematic_px,
-                                                          bool estimate_focal) {
+CalibrationParameterLayout CalibrationParameterLayout::Of(
+    const StereoRig& rig, double systematic_px, bool estimate_focal,
+    bool detect_systematic) {
   CalibrationParameterLayout layout;
   layout.systematic_px = systematic_px;
+  layout.detect_systematic = detect_systematic;
   if (const std::optional<CalibrationUncertainty>& uncertainty =
           rig.calibration_uncertainty()) {
     if (uncertainty->left_lens_covariance.size() > 0) {
@@ -548,9 +553,67 @@ StatusOr<CalibrationPropagation> PropagateCalibration(
           cross.transpose();
     }
   }
+  double systematic_variance = layout.systematic_px * layout.systematic_px;
+  if (layout.detect_systematic && sigma_px > 0.0) {
+    // The field the residuals show: with x the estimated columns and c the
+    // field's, u = g_c - M_cx M_xx^-1 g_x (the residuals projected off what
+    // the fit absorbed) has Cov(u) = tau^2 A A + sigma^2 A for c ~ N(0,
+    // tau^2 I), A = M_cc - M_cx M_xx^-1 M_xc, so that u^T A^+ u / sigma^2
+    // is chi^2 of rank A degrees of freedom without a field and
+    //   tau^2 = (u^T A^+ u - sigma^2 rank A) / trace A.
+    std::vector<int> x = {0};
+    if (mode != RotationMode::kHeld) x.insert(x.end(), {1, 2, 3});
+    if (layout.focal) x.insert(x.end(), {layout.Focal(), layout.Focal() + 1});
+    const int nx = static_cast<int>(x.size());
+    const int nc = layout.NumSystematic();
+    Eigen::MatrixXd m_xx(nx, nx), m_xc(nx, nc);
+    Eigen::VectorXd g_x(nx);
+    for (int r = 0; r < nx; ++r) {
+      g_x[r] = equations.gradient[x[r]];
+      for (int c = 0; c < nx; ++c) m_xx(r, c) = m(x[r], x[c]);
+      for (int c = 0; c < nc; ++c)
+        m_xc(r, c) = m(x[r], layout.Systematic() + c);
+    }
+    const Eigen::FullPivLU<Eigen::MatrixXd> lu_xx(m_xx);
+    if (lu_xx.isInvertible()) {
+      const Eigen::MatrixXd m_cc =
+          m.block(layout.Systematic(), layout.Systematic(), nc, nc);
+      const Eigen::MatrixXd a_cc = m_cc - m_xc.transpose() * lu_xx.solve(m_xc);
+      const Eigen::VectorXd u =
+          equations.gradient.segment(layout.Systematic(), nc) -
+          m_xc.transpose() * lu_xx.solve(g_x);
+      const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(a_cc);
+      const double largest = eigen.eigenvalues().maxCoeff();
+      double statistic = 0.0;
+      int rank = 0;
+      for (int k = 0; k < nc; ++k) {
+        const double value = eigen.eigenvalues()[k];
+        if (!(value > 1e-12 * largest)) continue;
+        const double projection = eigen.eigenvectors().col(k).dot(u);
+        statistic += projection * projection / value;
+        ++rank;
+      }
+      const double variance_px = sigma_px * sigma_px;
+      if (rank > 0) {
+        result.systematic_chi_squared = statistic / variance_px;
+        result.systematic_dof = rank;
+        result.systematic_p_value =
+            ChiSquaredUpperTail(result.systematic_chi_squared, rank);
+        // (Exact data leave residuals of rounding, 1e-14 px, whose pattern
+        // is no field: below kMinSystematicPx nothing is detected.)
+        const double tau2 =
+            std::max(0.0, (statistic - variance_px * rank) / a_cc.trace());
+        if (result.systematic_p_value < FrameConsistency::kInflationP &&
+            tau2 > kMinSystematicPx * kMinSystematicPx) {
+          result.systematic_detected_px = std::sqrt(tau2);
+          systematic_variance = std::max(systematic_variance, tau2);
+        }
+      }
+    }
+  }
   for (int k = 0; k < layout.NumSystematic(); ++k) {
     calibration(layout.Systematic() + k, layout.Systematic() + k) =
-        layout.systematic_px * layout.systematic_px;
+        systematic_variance;
   }
   const double focal_variance =
       uncertainty.focal_drift_sigma * uncertainty.focal_drift_sigma;

@@ -321,8 +321,8 @@ StatusOr<ThickPortRefinementSummary> RefineRefractiveIndexThickPort(
   raw.reserve(matches.size());
   for (const int64_t i : prepared.source_index)
     raw.push_back(correspondences[i]);
-  const CalibrationParameterLayout layout =
-      CalibrationParameterLayout::Of(*at, options.base.systematic_px);
+  const CalibrationParameterLayout layout = CalibrationParameterLayout::Of(
+      *at, options.base.systematic_px, false, options.base.detect_systematic);
   LocusNormalEquations equations(layout.Size());
   std::vector<LocusNormalEquations> per_frame;
   const Eigen::Vector3d rotation(parameters.rotation[0], parameters.rotation[1],
@@ -347,7 +347,8 @@ StatusOr<ThickPortRefinementSummary> RefineRefractiveIndexThickPort(
     summary.calibration = *propagation;
   } else {
     summary.sigma_n_noise *= inflation;
-    if (at->calibration_uncertainty() || layout.NumSystematic() > 0) {
+    if (at->calibration_uncertainty() || layout.systematic_px > 0.0 ||
+        options.base.detect_systematic) {
       StatusOr<CalibrationPropagation> propagation = PropagateCalibration(
           equations, layout,
           at->calibration_uncertainty().value_or(CalibrationUncertainty()),
@@ -355,7 +356,12 @@ StatusOr<ThickPortRefinementSummary> RefineRefractiveIndexThickPort(
       if (!propagation.ok()) return propagation.status();
       summary.sigma_n_calibration = propagation->sigma_n_calibration;
       summary.sigma_n_systematic = propagation->sigma_n_systematic;
-      summary.calibration = *propagation;
+      // (A rig made in code is exact: no calibration report unless a floor
+      // or a field the residuals show.)
+      if (at->calibration_uncertainty() || layout.systematic_px > 0.0 ||
+          propagation->systematic_detected_px > 0.0) {
+        summary.calibration = *propagation;
+      }
     }
   }
   summary.sigma_n =

@@ -91,6 +91,26 @@
 // and propagated like the calibration (its columns are part of p above).
 // Its share is reported as sigma_n_systematic.
 //
+// A field the residuals show (layout.detect_systematic,
+// RefinementOptions::detect_systematic): matches off the rigid scene (a
+// water surface's mirror image, a swimmer) have residuals far above the
+// floor, part of which the fit absorbs into n. With x the estimated
+// columns and c the field's, the gradient projected off what the fit
+// absorbed,
+//
+//   u = g_c - M_cx M_xx^-1 g_x,   A = M_cc - M_cx M_xx^-1 M_xc,
+//
+// has Cov(u) = tau^2 A A + sigma^2 A for c ~ N(0, tau^2 I), so that
+// without a field u^T A^+ u / sigma^2 is chi^2 with rank A degrees of
+// freedom, and E[u^T A^+ u] = tau^2 trace A + sigma^2 rank A gives
+//
+//   tau^2 = (u^T A^+ u - sigma^2 rank A) / trace A.
+//
+// At p < 1 % (FrameConsistency::kInflationP: 1 % of clean data is widened
+// needlessly) c takes the standard deviation max(systematic_px, tau): the
+// random-effects model of the field (its absorbed part as large as the part
+// the residuals show).
+//
 // Consistency of frames: with s_f = sum_{i in f} r_i dr_i/dn and
 // G_f = sum_{i in f} (dr_i/dn)^2, frame f's own n is n_hat - s_f / G_f to
 // first order, with variance sigma^2 / G_f, so
@@ -147,6 +167,9 @@ struct CalibrationParameterLayout {
   bool port_varies[CalibrationUncertainty::kNumPortParams] = {};
   // Standard deviation of each systematic coefficient, pixels; 0: none.
   double systematic_px = 0.0;
+  // The systematic field's columns even without a floor, for its test on
+  // the data (PropagateCalibration: a field the residuals show).
+  bool detect_systematic = false;
   // The focal scales' columns (estimated under the focal drift prior).
   bool focal = false;
   // Each camera's calibrated focal lengths (fx, fy), for g.
@@ -160,12 +183,15 @@ struct CalibrationParameterLayout {
   // columns.
   static CalibrationParameterLayout Of(const StereoRig& rig,
                                        double systematic_px = 0.0,
-                                       bool estimate_focal = false);
+                                       bool estimate_focal = false,
+                                       bool detect_systematic = false);
   int LeftLens() const { return 7; }
   int RightLens() const { return 7 + num_left_lens; }
   int Ports() const { return 7 + num_left_lens + num_right_lens; }
   int Systematic() const { return Ports() + num_ports; }
-  int NumSystematic() const { return systematic_px > 0.0 ? kNumSystematic : 0; }
+  int NumSystematic() const {
+    return systematic_px > 0.0 || detect_systematic ? kNumSystematic : 0;
+  }
   int Focal() const { return Systematic() + NumSystematic(); }
   int NumFocal() const { return focal ? kNumFocal : 0; }
   int Size() const { return Focal() + NumFocal(); }
@@ -347,6 +373,15 @@ struct CalibrationPropagation {
   // sigma_n, reported apart from the calibration's.
   double variance_systematic = 0.0;
   double sigma_n_systematic = 0.0;
+  // The systematic field the residuals show (layout.detect_systematic): its
+  // test statistic u^T A^+ u / sigma^2 with its degrees of freedom and upper
+  // tail probability, and the coefficients' standard deviation estimated
+  // from it (0 unless p < FrameConsistency::kInflationP and it is above
+  // 1e-6 px, rounding), which replaces systematic_px when larger.
+  double systematic_chi_squared = 0.0;
+  int systematic_dof = 0;
+  double systematic_p_value = 1.0;
+  double systematic_detected_px = 0.0;
   // dn/dw and dn/dt with everything but n held (per radian, per meter).
   Eigen::Vector3d dn_drotation = Eigen::Vector3d::Zero();
   Eigen::Vector3d dn_dtranslation = Eigen::Vector3d::Zero();

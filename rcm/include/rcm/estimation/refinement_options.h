@@ -100,6 +100,11 @@ struct RefinementOptions {
   // independent, as simulated matches' are. rcm estimate gives matches of
   // its image front end 0.03 px.
   double systematic_px = 0.0;
+  // Test the residuals for that field and, where they show one (p < 1 %),
+  // widen sigma_n by the field the data estimate (calibration_propagation.h,
+  // systematic_detected_px): matches off the rigid scene (a surface's
+  // mirror image, a swimmer) bias n by more than their pixel noise says.
+  bool detect_systematic = true;
   // A prior on n from the physics of the medium (medium_prior.h, rcm
   // estimate --medium), batch refinement of thin ports only: the term
   // (sigma_px (n - prior.n) / prior.sigma)^2 joins the least squares as
