@@ -118,6 +118,7 @@ budgeted=(
   'UnderwaterModelSelection.*'
   'UnderwaterCalibration.LensCovarianceReachesN'
   'UnderwaterCalibration.LensCorrelationKeepsTargetFreeSigmaHonest'
+  'UnderwaterCalibration.PortsInTheSidecarKeepTargetFreeSigmaHonest'
   'CalibrationPropagation.*'
   'MediumDrift.*'
   'MediumPrior.*'
