@@ -456,7 +456,7 @@ Keyword options (RefinementOptions, same names and defaults):
   inlier_threshold_px=2.0 (pixels, inf keeps all), num_scan_points=51,
   min_inliers=10, max_crlb_per_px=0.1, refine_rotation=False,
   self_calibrate_rotation=True, self_calibrate_focal=True,
-  systematic_px=0.0 (pixels), detect_systematic=True,
+  systematic_px=0.0 (pixels), detect_systematic=False,
   n_prior=None (a prior on n: 'fresh', 'sea', 'N:SIGMA' or (n, sigma); with
   refine_rotation=True it gives cam1's turn on a narrow rig),
   max_num_iterations=100, num_threads=2.

@@ -104,7 +104,10 @@ struct RefinementOptions {
   // widen sigma_n by the field the data estimate (calibration_propagation.h,
   // systematic_detected_px): matches off the rigid scene (a surface's
   // mirror image, a swimmer) bias n by more than their pixel noise says.
-  bool detect_systematic = true;
+  // Off by default (simulated matches have no field, and a rendered front
+  // end's own field is the floor's); rcm estimate turns it on
+  // (--detect-systematic).
+  bool detect_systematic = false;
   // A prior on n from the physics of the medium (medium_prior.h, rcm
   // estimate --medium), batch refinement of thin ports only: the term
   // (sigma_px (n - prior.n) / prior.sigma)^2 joins the least squares as
