@@ -492,21 +492,7 @@ Eigen::Matrix<double, 7, 1> ReportedChange(
   return reported;
 }
 
-// sqrt((g - 1) / g * sum_k (x_k - mean x)^2), per component.
-Eigen::VectorXd JackknifeSigma(const std::vector<Eigen::VectorXd>& samples) {
-  const int g = static_cast<int>(samples.size());
-  Eigen::VectorXd mean = Eigen::VectorXd::Zero(samples[0].size());
-  for (const Eigen::VectorXd& x : samples) mean += x;
-  mean /= g;
-  Eigen::VectorXd sum = Eigen::VectorXd::Zero(mean.size());
-  for (const Eigen::VectorXd& x : samples) {
-    sum += (x - mean).cwiseAbs2();
-  }
-  return ((g - 1.0) / g * sum).cwiseSqrt();
-}
-
-// (g - 1) / g sum_k (x_k - mean)(x_k - mean)^T: the jackknife covariance,
-// whose diagonal is JackknifeSigma's square.
+// (g - 1) / g sum_k (x_k - mean)(x_k - mean)^T: the jackknife covariance.
 Eigen::MatrixXd JackknifeCovariance(
     const std::vector<Eigen::VectorXd>& samples) {
   const int g = static_cast<int>(samples.size());
@@ -518,6 +504,11 @@ Eigen::MatrixXd JackknifeCovariance(
     sum += (x - mean) * (x - mean).transpose();
   }
   return (g - 1.0) / g * sum;
+}
+
+// sqrt((g - 1) / g * sum_k (x_k - mean x)^2), per component: its diagonal.
+Eigen::VectorXd JackknifeSigma(const std::vector<Eigen::VectorXd>& samples) {
+  return JackknifeCovariance(samples).diagonal().cwiseSqrt();
 }
 
 // One refit of sigma_n_lenses (header): camera `camera`'s lens moved by
