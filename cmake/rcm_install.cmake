@@ -31,6 +31,8 @@ endif()
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/rcm/include/
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
         FILES_MATCHING PATTERN "*.h" ${rcm_header_excludes})
+install(FILES ${PROJECT_BINARY_DIR}/rcm/include/rcm/version.h
+        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/rcm)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/calib/include/
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
         FILES_MATCHING PATTERN "*.h")

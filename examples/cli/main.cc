@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "command.h"
+#include "rcm/version.h"
 
 namespace rcm::cli {
 extern const Subcommand kCalibrateCommand;
@@ -51,7 +52,7 @@ int main(int argc, char** argv) {
   // the subcommands report in their own words) stay out of them. CHECK
   // failures (programmer errors) still print.
   FLAGS_minloglevel = google::GLOG_ERROR;
-  gflags::SetVersionString("0.1.0");
+  gflags::SetVersionString(rcm::kVersion);
 
   if (argc < 2) {
     std::cerr << "rcm: error: no subcommand (try rcm --help)" << std::endl;
@@ -63,7 +64,7 @@ int main(int argc, char** argv) {
     return rcm::cli::kExitOk;
   }
   if (name == "--version") {
-    std::cout << "rcm 0.1.0" << std::endl;
+    std::cout << "rcm " << rcm::kVersion << std::endl;
     return rcm::cli::kExitOk;
   }
   for (const Subcommand* subcommand : kSubcommands) {

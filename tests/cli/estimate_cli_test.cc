@@ -14,6 +14,7 @@
 #include "rcm/io/correspondence_csv.h"
 #include "rcm/sim/reference_rigs.h"
 #include "rcm/sim/stereo_sampler.h"
+#include "rcm/version.h"
 #include "support/temp_file.h"
 
 namespace rcm {
@@ -457,7 +458,11 @@ TEST(EstimateCli, HelpListsOwnFlagsOnly) {
 TEST(EstimateCli, TopLevelHelpAndVersion) {
   EXPECT_EQ(Rcm({"--help"}).exit_code, 0);
   EXPECT_NE(Rcm({"--help"}).out.find("estimate"), std::string::npos);
-  EXPECT_EQ(Rcm({"--version"}).out, "rcm 0.1.0\n");
+  // The version is the top-level CMakeLists.txt's project(VERSION), as
+  // the library's header, the package files and Python's have it.
+  EXPECT_EQ(Rcm({"--version"}).out,
+            std::string("rcm ") + RCM_PROJECT_VERSION + "\n");
+  EXPECT_STREQ(rcm::kVersion, RCM_PROJECT_VERSION);
 }
 
 TEST(EstimateCli, NoSubcommand) {
