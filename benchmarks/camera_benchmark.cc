@@ -9,8 +9,8 @@
 #include "rcm/camera/camera.h"
 #include "rcm/camera/refractive_camera.h"
 #include "rcm/camera/virtual_pinhole_remap.h"
-#include "rcm/camera/virtual_pinhole_rig.h"
 #include "rcm/sim/reference_rigs.h"
+#include "rcm/stereo/virtual_pinhole_rig.h"
 
 namespace rcm {
 namespace {
@@ -28,10 +28,9 @@ Camera CameraFor(LensModelId model) {
     // The three of issue 21 on the sizes of the tests' cameras
     // (tests/support/test_rigs.cc).
     case LensModelId::kRational:
-      return Camera::Create(LensModelId::kRational, 752, 480,
-                            {461.3, 460.8, 371.9, 243.6},
-                            {0.5, 0.1, 9.0e-4, -6.0e-4, 0.001, 0.75, 0.2,
-                             0.001})
+      return Camera::Create(
+                 LensModelId::kRational, 752, 480, {461.3, 460.8, 371.9, 243.6},
+                 {0.5, 0.1, 9.0e-4, -6.0e-4, 0.001, 0.75, 0.2, 0.001})
           .value();
     case LensModelId::kDoubleSphere:
       return Camera::Create(LensModelId::kDoubleSphere, 640, 480,

@@ -19,10 +19,10 @@
 #include "rcm/estimation/sampson_coplanarity_error.h"
 #include "rcm/estimation/sliding_window_estimator.h"
 #include "rcm/estimation/thick_port_refinement.h"
-#include "rcm/geometry/epipolar.h"
-#include "rcm/geometry/observability.h"
 #include "rcm/sim/reference_rigs.h"
 #include "rcm/sim/stereo_sampler.h"
+#include "rcm/stereo/epipolar.h"
+#include "rcm/stereo/observability.h"
 
 namespace rcm {
 namespace {

@@ -9,7 +9,7 @@
 # builds it against a fresh install).
 include(CMakePackageConfigHelpers)
 
-set(rcm_install_targets rcm rcm_calib)
+set(rcm_install_targets rcm rcm_calib rcm_sim rcm_viz)
 if(TARGET rcm_rosbag)
   list(APPEND rcm_install_targets rcm_rosbag)
 endif()
@@ -26,7 +26,7 @@ endif()
 # with it only.
 set(rcm_header_excludes "")
 if(NOT TARGET rcm_rosbag)
-  set(rcm_header_excludes PATTERN "bag_*.h" EXCLUDE)
+  set(rcm_header_excludes PATTERN "rosbag" EXCLUDE)
 endif()
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/rcm/include/
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}

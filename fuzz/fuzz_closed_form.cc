@@ -1,8 +1,8 @@
 // Fuzzes the closed form of the paper (eq. 14, rcm/estimation/closed_form.h)
 // and the steps that feed it: a rig's normalization of a correspondence
-// (rcm/geometry/stereo_rig.h), the paper's observability mask
+// (rcm/stereo/stereo_rig.h), the paper's observability mask
 // (paper_online_estimator.h) and the first-order sigma of n
-// (rcm/geometry/observability.h), over arbitrary doubles.
+// (rcm/stereo/observability.h), over arbitrary doubles.
 //
 // Properties: no crash or undefined behaviour for any input; ClosedFormN
 // returns a finite positive n or nothing, and its square is eq. 14's n^2;
@@ -19,8 +19,8 @@
 #include "fuzz_input.h"
 #include "rcm/estimation/closed_form.h"
 #include "rcm/estimation/paper_online_estimator.h"
-#include "rcm/geometry/observability.h"
-#include "rcm/geometry/stereo_rig.h"
+#include "rcm/stereo/observability.h"
+#include "rcm/stereo/stereo_rig.h"
 
 namespace {
 
@@ -28,13 +28,12 @@ using rcm::fuzz::ConsumeDouble;
 using rcm::fuzz::FuzzCheck;
 
 void FuzzClosedForm(const rcm::NormalizedCorrespondence& match) {
-  const double n_squared =
-      rcm::ClosedFormNSquared(match.left.x(), match.left.y(), match.right.x(),
-                              match.right.y());
+  const double n_squared = rcm::ClosedFormNSquared(
+      match.left.x(), match.left.y(), match.right.x(), match.right.y());
   using Jet = ceres::Jet<double, 4>;
-  const Jet jet_n_squared = rcm::ClosedFormNSquared(
-      Jet(match.left.x(), 0), Jet(match.left.y(), 1), Jet(match.right.x(), 2),
-      Jet(match.right.y(), 3));
+  const Jet jet_n_squared =
+      rcm::ClosedFormNSquared(Jet(match.left.x(), 0), Jet(match.left.y(), 1),
+                              Jet(match.right.x(), 2), Jet(match.right.y(), 3));
   // Jet division multiplies by the inverse: a rounding or two apart, and
   // subnormals lose their relative precision (hence the absolute term).
   if (std::isfinite(n_squared) && std::isfinite(jet_n_squared.a)) {
@@ -59,18 +58,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* bytes, size_t size) {
   normalized.right = Eigen::Vector2d(ConsumeDouble(data, -3.0, 3.0),
                                      ConsumeDouble(data, -3.0, 3.0));
   FuzzClosedForm(normalized);
-  rcm::PassesObservabilityMask(normalized.left,
-                               ConsumeDouble(data, 0.0, 1.0));
+  rcm::PassesObservabilityMask(normalized.left, ConsumeDouble(data, 0.0, 1.0));
 
   // The same through a rig: raw pixels of two pinhole cameras.
   const double f = ConsumeDouble(data, 1.0, 2000.0);
   const rcm::StatusOr<rcm::Camera> camera = rcm::Camera::Create(
       rcm::LensModelId::kPinhole, 640, 480, {f, f, 320.0, 240.0}, {});
   rcm::Rigid3d right_from_left;
-  right_from_left.translation =
-      Eigen::Vector3d(ConsumeDouble(data, -1.0, 1.0),
-                      ConsumeDouble(data, -0.1, 0.1),
-                      ConsumeDouble(data, -0.1, 0.1));
+  right_from_left.translation = Eigen::Vector3d(ConsumeDouble(data, -1.0, 1.0),
+                                                ConsumeDouble(data, -0.1, 0.1),
+                                                ConsumeDouble(data, -0.1, 0.1));
   rcm::StereoCorrespondence match;
   match.left_pixel = Eigen::Vector2d(ConsumeDouble(data, -100.0, 700.0),
                                      ConsumeDouble(data, -100.0, 600.0));

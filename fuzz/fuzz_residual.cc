@@ -24,8 +24,8 @@
 #include "rcm/estimation/generalized_epipolar_error.h"
 #include "rcm/estimation/prepared_correspondence.h"
 #include "rcm/estimation/sampson_coplanarity_error.h"
-#include "rcm/geometry/epipolar.h"
-#include "rcm/geometry/stereo_rig.h"
+#include "rcm/stereo/epipolar.h"
+#include "rcm/stereo/stereo_rig.h"
 
 namespace {
 
@@ -48,11 +48,11 @@ std::optional<rcm::Camera> ConsumeCamera(FuzzedDataProvider& data) {
     distortion[0] = ConsumeDouble(data, 0.0, 0.7);  // alpha
     distortion[1] = ConsumeDouble(data, 0.5, 2.0);  // beta
   }
-  rcm::StatusOr<rcm::Camera> camera = rcm::Camera::Create(
-      model, 720, 540,
-      {f, f, ConsumeDouble(data, 300.0, 420.0),
-       ConsumeDouble(data, 220.0, 320.0)},
-      distortion);
+  rcm::StatusOr<rcm::Camera> camera =
+      rcm::Camera::Create(model, 720, 540,
+                          {f, f, ConsumeDouble(data, 300.0, 420.0),
+                           ConsumeDouble(data, 220.0, 320.0)},
+                          distortion);
   if (!camera.ok()) return std::nullopt;
   return *camera;
 }
@@ -104,16 +104,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* bytes, size_t size) {
   const std::optional<rcm::PreparedCorrespondence> prepared =
       rcm::PrepareCorrespondence(*rig, match);
   if (!prepared) return 0;
-  const bool in_domain = n >= 1.0 && n <= 2.0 &&
-                         left->InImage(match.left_pixel) &&
-                         right->InImage(match.right_pixel) &&
-                         rcm::fuzz::AllFinite(correction, 3);
+  const bool in_domain =
+      n >= 1.0 && n <= 2.0 && left->InImage(match.left_pixel) &&
+      right->InImage(match.right_pixel) && rcm::fuzz::AllFinite(correction, 3);
 
   // Thin port, with and without the rotation correction.
   const Eigen::Matrix3d essential = rcm::EssentialMatrix(right_from_left);
   double residual = 0.0;
   if (rcm::SampsonCoplanarityResidual<double>(essential, *prepared, n, nullptr,
-                                      &residual) &&
+                                              &residual) &&
       in_domain) {
     FuzzCheck(std::isfinite(residual), "Sampson residual not finite");
   }

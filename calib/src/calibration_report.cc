@@ -14,10 +14,10 @@
 #include "rcm/calib/projection_uncertainty.h"
 #include "rcm/io/atomic_file.h"
 #include "rcm/io/image_file.h"
-#include "rcm/io/number_format.h"
-#include "rcm/viz/color_map.h"
-#include "rcm/viz/figure.h"
-#include "rcm/viz/line_plot.h"
+#include "rcm/plot/color_map.h"
+#include "rcm/plot/figure.h"
+#include "rcm/plot/line_plot.h"
+#include "rcm/util/number_format.h"
 
 namespace rcm::calib {
 namespace {
@@ -143,7 +143,7 @@ std::vector<double> Values(const cv::Mat& samples) {
 }
 
 // ---------------------------------------------------------------------------
-// Drawing, on an rcm::Figure (rcm/viz/figure.h).
+// Drawing, on an rcm::Figure (rcm/plot/figure.h).
 
 // An image-sized panel with a title strip above, a legend strip of
 // `legend_lines` lines below and `extra_right` z-scaled pixels on the right.

@@ -7,7 +7,7 @@
 #include <utility>
 
 #include "rcm/io/atomic_file.h"
-#include "rcm/io/number_format.h"
+#include "rcm/util/number_format.h"
 
 namespace rcm::calib {
 namespace {
@@ -40,7 +40,8 @@ std::optional<double> ParseNumber(std::string_view field) {
   return value;
 }
 
-Status ErrorAt(const std::string& source_name, int line, const std::string& what) {
+Status ErrorAt(const std::string& source_name, int line,
+               const std::string& what) {
   return Status::Error(source_name + ":" + std::to_string(line) + ": " + what);
 }
 
@@ -84,10 +85,10 @@ StatusOr<std::string> FormatCornersFile(
     }
     const TargetObservation& observation = *image.observation;
     if (observation.point_ids.size() != observation.pixels.size()) {
-      return Status::Error("corners file: " + name + ": " +
-                           std::to_string(observation.point_ids.size()) +
-                           " point ids but " +
-                           std::to_string(observation.pixels.size()) + " pixels");
+      return Status::Error(
+          "corners file: " + name + ": " +
+          std::to_string(observation.point_ids.size()) + " point ids but " +
+          std::to_string(observation.pixels.size()) + " pixels");
     }
     std::fill(by_id.begin(), by_id.end(), nullptr);
     for (int k = 0; k < observation.size(); ++k) {
@@ -207,9 +208,9 @@ StatusOr<std::vector<CornersFileImage>> ParseCornersFile(
     if (fields.size() == 4) {
       const std::optional<double> level = ParseNumber(fields[3]);
       if (!level) {
-        return ErrorAt(source_name, line_number,
-                       "level must be a number or '-', got " +
-                           Quoted(fields[3]));
+        return ErrorAt(
+            source_name, line_number,
+            "level must be a number or '-', got " + Quoted(fields[3]));
       }
       if (*level < 0.0) continue;  // mrcal: a negative level is not found
     }

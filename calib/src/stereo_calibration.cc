@@ -14,7 +14,7 @@
 #include "rcm/calib/board_reprojection_error.h"
 #include "rcm/calib/board_warp.h"
 #include "rcm/calib/calibration_initialization.h"
-#include "rcm/io/number_format.h"
+#include "rcm/util/number_format.h"
 
 namespace rcm::calib {
 namespace {

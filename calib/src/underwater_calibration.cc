@@ -18,7 +18,7 @@
 #include "rcm/calib/underwater_reprojection_error.h"
 #include "rcm/camera/refractive_model.h"
 #include "rcm/geometry/calibration_uncertainty.h"
-#include "rcm/io/number_format.h"
+#include "rcm/util/number_format.h"
 
 namespace rcm::calib {
 namespace {

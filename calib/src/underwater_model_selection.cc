@@ -7,7 +7,7 @@
 #include <string>
 #include <utility>
 
-#include "rcm/io/number_format.h"
+#include "rcm/util/number_format.h"
 #include "rcm/util/parallel_for.h"
 
 namespace rcm::calib {

@@ -5,8 +5,8 @@
 // the last column the largest |bias| over the glass thicknesses of the
 // estimate that is given the port (the thick-port model).
 //
-// The approximation table of docs/thin_port_bias.md is its output with the defaults; a test
-// recomputes every cell of that table.
+// The approximation table of docs/thin_port_bias.md is its output with the
+// defaults; a test recomputes every cell of that table.
 #include <gflags/gflags.h>
 #include <glog/logging.h>
 
@@ -24,7 +24,7 @@
 
 DEFINE_string(calib, "",
               "Kalibr camchain YAML of the rig (default: the dataset rig of "
-              "DESIGN.md Sec. 5 on rectified extrinsics)");
+              "docs/design.md Sec. 6 on rectified extrinsics)");
 DEFINE_double(n, 1.333, "true refractive index of the water");
 DEFINE_double(glass_index, 1.49, "refractive index of the port glass");
 DEFINE_double(min_depth, 0.6, "nearest scene depth (m)");

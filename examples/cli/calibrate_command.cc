@@ -33,11 +33,11 @@
 #include "rcm/calib/projection_uncertainty.h"
 #include "rcm/calib/stereo_calibration.h"
 #include "rcm/calib/target_detector.h"
-#include "rcm/geometry/stereo_rig.h"
 #include "rcm/io/atomic_file.h"
 #include "rcm/io/calibration_covariance_file.h"
 #include "rcm/io/camchain.h"
-#include "rcm/io/number_format.h"
+#include "rcm/stereo/stereo_rig.h"
+#include "rcm/util/number_format.h"
 #include "target_flags.h"
 
 DEFINE_string(report, "",

@@ -31,8 +31,8 @@
 #include "rcm/io/calibration_covariance_file.h"
 #include "rcm/io/camchain.h"
 #include "rcm/io/image_file.h"
-#include "rcm/io/number_format.h"
 #include "rcm/io/stereo_rig_file.h"
+#include "rcm/util/number_format.h"
 
 DEFINE_bool(underwater, false,
             "calibrate under water: n and the extrinsics cam1_from_cam0 as "

@@ -12,7 +12,7 @@
 
 #include "progress.h"
 #include "rcm/calib/target_detector.h"
-#include "rcm/io/number_format.h"
+#include "rcm/util/number_format.h"
 
 namespace rcm::cli {
 namespace {
@@ -93,9 +93,8 @@ std::string BoardFlatnessText(bool estimated, const Eigen::Vector2d& warp,
          WithSigma(1e3 * warp.sum(), 1e3 * std::sqrt(covariance.sum()), 2,
                    leave_out_mm) +
          " mm at the centre (x " +
-         WithSigma(1e3 * warp.x(), 1e3 * sigma.x(), 2, std::nullopt) +
-         ", y " + WithSigma(1e3 * warp.y(), 1e3 * sigma.y(), 2, std::nullopt) +
-         " mm)";
+         WithSigma(1e3 * warp.x(), 1e3 * sigma.x(), 2, std::nullopt) + ", y " +
+         WithSigma(1e3 * warp.y(), 1e3 * sigma.y(), 2, std::nullopt) + " mm)";
 }
 
 nlohmann::json BoardFlatnessJson(bool estimated, const Eigen::Vector2d& warp,
@@ -167,8 +166,8 @@ StatusOr<Detections> DetectTargets(StereoImageSource* source,
       }
       const std::lock_guard<std::mutex> lock(mutex);
       const bool one_camera = result->pair.ok() && result->pair->right.empty();
-      found += one_camera ? result->view.left.has_value()
-                          : result->view.stereo();
+      found +=
+          one_camera ? result->view.left.has_value() : result->view.stereo();
       progress.Update(++done, std::to_string(found) +
                                   (one_camera ? " with the target"
                                               : " with the target in both"));
@@ -223,8 +222,8 @@ StatusOr<Detections> DetectTargets(StereoImageSource* source,
     view.right_name = pair.right_name;
     view.timestamp = pair.timestamp.value_or(0.0);
     if (!view.note.empty() && !one_camera) {
-      detections.warnings.push_back(pair.left_name + " and " +
-                                    pair.right_name + ": " + view.note);
+      detections.warnings.push_back(pair.left_name + " and " + pair.right_name +
+                                    ": " + view.note);
     }
     detections.views.push_back(std::move(view));
   }
@@ -232,9 +231,9 @@ StatusOr<Detections> DetectTargets(StereoImageSource* source,
   return detections;
 }
 
-Status WriteCamchainWithCovariance(const std::string& camchain_path,
-                                   const Camchain& camchain,
-                                   const CalibrationCovarianceFile& covariance) {
+Status WriteCamchainWithCovariance(
+    const std::string& camchain_path, const Camchain& camchain,
+    const CalibrationCovarianceFile& covariance) {
   const std::string covariance_path = CovarianceSidecarPath(camchain_path);
   RCM_RETURN_IF_ERROR(WriteCalibrationCovariance(covariance_path, covariance));
   const Status written = WriteCamchain(camchain_path, camchain);
@@ -263,12 +262,12 @@ Status CheckDetections(const Detections& detections, bool one_camera) {
     return Status::Ok();
   }
   if (detections.stereo == 0) {
-    return Status::Error(
-        "the target was found in both images of no pair (" +
-        std::to_string(detections.left_only) + " left only, " +
-        std::to_string(detections.right_only) + " right only, of " +
-        std::to_string(detections.views.size()) +
-        "); check the target flags and the images");
+    return Status::Error("the target was found in both images of no pair (" +
+                         std::to_string(detections.left_only) + " left only, " +
+                         std::to_string(detections.right_only) +
+                         " right only, of " +
+                         std::to_string(detections.views.size()) +
+                         "); check the target flags and the images");
   }
   return Status::Ok();
 }

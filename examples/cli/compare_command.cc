@@ -16,7 +16,7 @@
 #include "rcm/io/atomic_file.h"
 #include "rcm/io/camera_file.h"
 #include "rcm/io/image_file.h"
-#include "rcm/io/number_format.h"
+#include "rcm/util/number_format.h"
 #include "rcm/viz/image_error_map.h"
 
 DEFINE_string(water, "",
@@ -147,8 +147,8 @@ int RunCompare() {
     map_options.region_label = "compared region";
     const StatusOr<cv::Mat> picture =
         DrawImageErrorMap(comparison->residual_field, map_options);
-    Status status = picture.ok() ? WritePng(*picture, picture_path)
-                                 : picture.status();
+    Status status =
+        picture.ok() ? WritePng(*picture, picture_path) : picture.status();
     if (status.ok()) {
       status = WriteFileAtomically(
           (std::filesystem::path(FLAGS_out) / "compare.json").string(),
@@ -160,9 +160,9 @@ int RunCompare() {
     }
   }
 
-  const double seconds = std::chrono::duration<double>(
-                             std::chrono::steady_clock::now() - start)
-                             .count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count();
   if (FLAGS_json) {
     json["seconds"] = seconds;
     std::cout << json.dump() << std::endl;
@@ -176,15 +176,15 @@ int RunCompare() {
             << FormatSignificant(fit.sigma_n)
             << " (formal: the residuals are model error, not noise)\n";
   if (options.estimate_principal_point_shift) {
-    std::cout << "  principal point shift (" << FormatFixed(fit.principal_point_shift.x(), 2)
-              << ", " << FormatFixed(fit.principal_point_shift.y(), 2)
-              << ") px\n";
+    std::cout << "  principal point shift ("
+              << FormatFixed(fit.principal_point_shift.x(), 2) << ", "
+              << FormatFixed(fit.principal_point_shift.y(), 2) << ") px\n";
   }
   std::cout << "  residual: RMS " << FormatFixed(stats.rms_px, 3)
-            << " px, median " << FormatFixed(stats.median_px, 3)
-            << " px, max " << FormatFixed(stats.max_px, 3) << " px over "
-            << stats.num_samples << " pixels ("
-            << FormatFixed(100.0 * options.inset, 0) << " % inset)\n";
+            << " px, median " << FormatFixed(stats.median_px, 3) << " px, max "
+            << FormatFixed(stats.max_px, 3) << " px over " << stats.num_samples
+            << " pixels (" << FormatFixed(100.0 * options.inset, 0)
+            << " % inset)\n";
   if (comparison->num_unusable > 0) {
     std::cout << "  " << comparison->num_unusable
               << " pixels not compared (past total internal reflection or "

@@ -23,14 +23,14 @@
 #include "rcm/estimation/robust_locus_fit.h"
 #include "rcm/estimation/sliding_window_estimator.h"
 #include "rcm/frontend/stereo_front_end.h"
-#include "rcm/geometry/epipolar.h"
-#include "rcm/geometry/stereo_rectification.h"
 #include "rcm/io/atomic_file.h"
 #include "rcm/io/image_file.h"
-#include "rcm/io/number_format.h"
 #include "rcm/io/stereo_rig_file.h"
+#include "rcm/plot/line_plot.h"
 #include "rcm/sim/sequence_simulator.h"
-#include "rcm/viz/line_plot.h"
+#include "rcm/stereo/epipolar.h"
+#include "rcm/stereo/stereo_rectification.h"
+#include "rcm/util/number_format.h"
 #include "simulation_flags.h"
 
 namespace rcm::cli {

@@ -14,18 +14,18 @@
 #include "command.h"
 #include "index_flag.h"
 #include "lens_model_flag.h"
-#include "reference_depth_flag.h"
 #include "rcm/camera/refractive_camera.h"
-#include "rcm/camera/virtual_pinhole_rig.h"
 #include "rcm/estimation/water_side_model_fit.h"
+#include "rcm/io/atomic_file.h"
 #include "rcm/io/camchain.h"
 #include "rcm/io/camera_file.h"
 #include "rcm/io/camera_info.h"
 #include "rcm/io/image_file.h"
-#include "rcm/io/atomic_file.h"
-#include "rcm/io/number_format.h"
 #include "rcm/io/stereo_rig_file.h"
+#include "rcm/stereo/virtual_pinhole_rig.h"
+#include "rcm/util/number_format.h"
 #include "rcm/viz/image_error_map.h"
+#include "reference_depth_flag.h"
 #include "rig_flags.h"
 
 DEFINE_double(fit_inset, 0.05,
@@ -85,8 +85,8 @@ StatusOr<Camchain> FittedCamchain(const StereoRig& fitted_rig) {
   if (!left.ok() || !right.ok()) {
     return Status::Error(FLAGS_calib + ": cameras not found");
   }
-  if (Status status = CopyCamchainImuAndTopics(*source, *left, *right,
-                                               &camchain);
+  if (Status status =
+          CopyCamchainImuAndTopics(*source, *left, *right, &camchain);
       !status.ok()) {
     return status.WithContext(FLAGS_calib);
   }
@@ -183,8 +183,8 @@ int RunExport() {
     }
     StatusOr<WaterSideModelFit> fit = FitWaterSideModel(*camera, options);
     if (!fit.ok()) {
-      PrintError(command, std::string(names[k]) + " camera: " +
-                              fit.status().message());
+      PrintError(command,
+                 std::string(names[k]) + " camera: " + fit.status().message());
       return kExitFailure;
     }
     if (fit->num_not_invertible > 0) {
@@ -197,11 +197,11 @@ int RunExport() {
     }
     fits.push_back(std::move(fit).value());
   }
-  const StatusOr<StereoRig> fitted_rig = StereoRig::Create(
-      fits[0].camera, fits[1].camera, rig->right_from_left());
-  const StatusOr<Camchain> camchain = fitted_rig.ok()
-                                          ? FittedCamchain(*fitted_rig)
-                                          : StatusOr<Camchain>(fitted_rig.status());
+  const StatusOr<StereoRig> fitted_rig =
+      StereoRig::Create(fits[0].camera, fits[1].camera, rig->right_from_left());
+  const StatusOr<Camchain> camchain =
+      fitted_rig.ok() ? FittedCamchain(*fitted_rig)
+                      : StatusOr<Camchain>(fitted_rig.status());
   if (!camchain.ok()) {
     PrintError(command, camchain.status().message());
     return kExitFailure;
@@ -225,18 +225,17 @@ int RunExport() {
     const std::string name = names[k];
     if (!CheckCameraInfoModel(fits[k].camera).ok()) {
       // ds, eucm: the camchain is the only file that can hold them.
-    } else if (Status status = WriteCameraInfo(
-                   paths.prefix + name + ".yaml",
-                   CameraInfoFromCamera(name, fits[k].camera));
+    } else if (Status status =
+                   WriteCameraInfo(paths.prefix + name + ".yaml",
+                                   CameraInfoFromCamera(name, fits[k].camera));
                !status.ok()) {
       PrintError(command, status.message());
       return kExitFailure;
     }
     ImageErrorMapOptions map_options;
-    map_options.title = name + " camera: " +
-                        std::string(LensModelName(*model)) +
-                        " fit to the refractive model, n = " +
-                        FormatFixed(*n, 4);
+    map_options.title =
+        name + " camera: " + std::string(LensModelName(*model)) +
+        " fit to the refractive model, n = " + FormatFixed(*n, 4);
     // Scaled to the fit region's errors, so that its structure shows; the
     // corners outside it saturate (their figures are in the legend).
     map_options.color_max = fits[k].inset.max_px;
@@ -266,9 +265,9 @@ int RunExport() {
     return kExitFailure;
   }
 
-  const double seconds = std::chrono::duration<double>(
-                             std::chrono::steady_clock::now() - start)
-                             .count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count();
   if (FLAGS_json) {
     json["seconds"] = seconds;
     std::cout << json.dump() << std::endl;
@@ -281,8 +280,9 @@ int RunExport() {
   for (int k = 0; k < 2; ++k) {
     const WaterSideModelFit& fit = fits[k];
     const Camera& camera = fit.camera;
-    std::cout << "  " << names[k] << ": intrinsics [" << FormatFixed(camera.fx(), 3)
-              << ", " << FormatFixed(camera.fy(), 3) << ", "
+    std::cout << "  " << names[k] << ": intrinsics ["
+              << FormatFixed(camera.fx(), 3) << ", "
+              << FormatFixed(camera.fy(), 3) << ", "
               << FormatFixed(camera.cx(), 3) << ", "
               << FormatFixed(camera.cy(), 3) << "], distortion [";
     const std::vector<double> distortion = camera.Distortion();
@@ -291,9 +291,9 @@ int RunExport() {
     }
     std::cout << "]\n    fit error: RMS " << Px(fit.inset.rms_px) << ", max "
               << Px(fit.inset.max_px) << " inside the fit region ("
-              << FormatFixed(100.0 * options.fit_inset, 0)
-              << " % inset); RMS " << Px(fit.full.rms_px) << ", max "
-              << Px(fit.full.max_px) << " over the whole image\n";
+              << FormatFixed(100.0 * options.fit_inset, 0) << " % inset); RMS "
+              << Px(fit.full.rms_px) << ", max " << Px(fit.full.max_px)
+              << " over the whole image\n";
   }
   std::cout << "  wrote " << paths.camchain << ", " << paths.prefix
             << "{left,right}.yaml (camera_info), " << paths.prefix

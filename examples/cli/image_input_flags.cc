@@ -4,7 +4,7 @@
 
 #include "rcm/io/stereo_image_folders.h"
 #ifdef RCM_HAVE_ROSBAG
-#include "rcm/io/bag_stereo_source.h"
+#include "rcm/rosbag/bag_stereo_source.h"
 #endif
 
 DEFINE_string(left, "", "folder of the left camera's images");
@@ -24,7 +24,8 @@ DEFINE_double(from, NAN,
               "use the pairs from this many seconds after the first one "
               "(needs timestamps: bag stamps, or file names that are "
               "stamps)");
-DEFINE_double(to, NAN, "use the pairs up to this many seconds after the "
+DEFINE_double(to, NAN,
+              "use the pairs up to this many seconds after the "
               "first one");
 DEFINE_int32(stride, 1, "use every stride-th pair");
 
@@ -45,8 +46,8 @@ FrameSelection SelectionFromFlags() {
 }  // namespace
 
 bool ImageInputGiven() {
-  return !FLAGS_left.empty() || !FLAGS_right.empty() ||
-         !FLAGS_pairs.empty() || !FLAGS_bag.empty();
+  return !FLAGS_left.empty() || !FLAGS_right.empty() || !FLAGS_pairs.empty() ||
+         !FLAGS_bag.empty();
 }
 
 StatusOr<std::unique_ptr<StereoImageSource>> OpenImageInputFromFlags(

@@ -1,6 +1,6 @@
 #include "reference_depth_flag.h"
 
-#include "rcm/io/number_format.h"
+#include "rcm/util/number_format.h"
 
 DEFINE_double(reference_depth, 2.0,
               "with a thick port (camchain port blocks): depth in meters at "

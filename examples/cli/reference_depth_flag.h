@@ -8,7 +8,7 @@
 
 #include <string>
 
-#include "rcm/geometry/stereo_rig.h"
+#include "rcm/stereo/stereo_rig.h"
 
 DECLARE_double(reference_depth);
 

@@ -21,7 +21,7 @@ DEFINE_double(frame_rate, 20.0,
               "a board in twenty frames)");
 DEFINE_string(rig, "alphasense",
               "built-in rig when --calib is not given: alphasense (the "
-              "dataset rig of DESIGN.md Sec. 5 on rectified extrinsics), "
+              "dataset rig of docs/design.md Sec. 6 on rectified extrinsics), "
               "alphasense-unrectified (0.5 deg rotation, baseline off axis) "
               "or narrow (a hand-built housing: 640x480 radtan, f 500 px, "
               "65 mm baseline, 2.5 deg toe-in)");
@@ -72,7 +72,8 @@ Status ExtrinsicDriftFromFlag(SequenceOptions* options) {
                          "millimetres), e.g. 0.5,0,0");
   }
   const std::vector<double>& v = values.value();
-  options->cam1_drift.rotation = Eigen::Vector3d(v[0], v[1], v[2]) * kRadiansPerDegree;
+  options->cam1_drift.rotation =
+      Eigen::Vector3d(v[0], v[1], v[2]) * kRadiansPerDegree;
   if (v.size() == 6) {
     options->cam1_drift.translation = Eigen::Vector3d(v[3], v[4], v[5]) * 1e-3;
   }

@@ -8,8 +8,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "rcm/geometry/stereo_rig.h"
 #include "rcm/sim/sequence_simulator.h"
+#include "rcm/stereo/stereo_rig.h"
 #include "rcm/util/status.h"
 
 DECLARE_string(media);

@@ -20,17 +20,18 @@
 #include "command.h"
 #include "image_input_flags.h"
 #include "index_flag.h"
-#include "reference_depth_flag.h"
 #include "progress.h"
-#include "rcm/camera/virtual_pinhole_rig.h"
 #include "rcm/io/camchain.h"
 #include "rcm/io/camera_info.h"
+#include "rcm/io/corrected_rig_files.h"
 #include "rcm/io/image_file.h"
-#include "rcm/io/number_format.h"
 #include "rcm/io/stereo_rig_file.h"
+#include "rcm/stereo/virtual_pinhole_rig.h"
+#include "rcm/util/number_format.h"
+#include "reference_depth_flag.h"
 #include "rig_flags.h"
 #ifdef RCM_HAVE_ROSBAG
-#include "rcm/io/bag_image_rewriter.h"
+#include "rcm/rosbag/bag_image_rewriter.h"
 #endif
 
 DEFINE_string(fit, "no-border",
@@ -209,7 +210,8 @@ std::string CameraLine(const std::string& name,
   const Camera& pinhole = camera.pinhole;
   std::ostringstream line;
   line << "  " << name << "K' = [fx " << FormatFixed(pinhole.fx(), 2) << ", fy "
-       << FormatFixed(pinhole.fy(), 2) << ", cx " << FormatFixed(pinhole.cx(), 2) << ", cy "
+       << FormatFixed(pinhole.fy(), 2) << ", cx "
+       << FormatFixed(pinhole.cx(), 2) << ", cy "
        << FormatFixed(pinhole.cy(), 2) << "], "
        << SizeText(pinhole.width(), pinhole.height()) << ", focal "
        << FormatFixed(camera.FocalScale(), 4) << " x K_n, "
@@ -566,7 +568,8 @@ int RunUndistort() {
                   {"per_pair", report->total_ms / pairs}};
     json["out"] = FLAGS_out;
     json["port"] = rig->HasThickPort() ? "thick" : "thin";
-    if (rig->HasThickPort()) json["reference_depth_m"] = options->reference_depth;
+    if (rig->HasThickPort())
+      json["reference_depth_m"] = options->reference_depth;
     json.update(report->extra);
     std::cout << json.dump(2) << std::endl;
     return kExitOk;
@@ -580,9 +583,10 @@ int RunUndistort() {
        << CameraLine("left   ", corrected->left()) << "\n"
        << CameraLine("right  ", corrected->right()) << "\n"
        << "  images " << report->images << " written (" << report->pairs
-       << " pairs); maps built once in " << FormatFixed(corrected->build_ms(), 0)
-       << " ms, remap " << FormatFixed(Median(report->remap_ms), 2)
-       << " ms per image (median), " << FormatFixed(report->total_ms / pairs, 1)
+       << " pairs); maps built once in "
+       << FormatFixed(corrected->build_ms(), 0) << " ms, remap "
+       << FormatFixed(Median(report->remap_ms), 2) << " ms per image (median), "
+       << FormatFixed(report->total_ms / pairs, 1)
        << " ms per pair with reading and writing\n"
        << "  wrote ";
   for (const std::string& path : report->written) text << " " << path;

@@ -9,10 +9,10 @@
 // pinhole camera of the corrected images at that n.
 #include <cstdio>
 
-#include "rcm/camera/virtual_pinhole_rig.h"
 #include "rcm/estimation/batch_refinement.h"
 #include "rcm/io/correspondence_csv.h"
 #include "rcm/io/stereo_rig_file.h"
+#include "rcm/stereo/virtual_pinhole_rig.h"
 
 int main(int argc, char** argv) {
   if (argc != 3) {
@@ -40,8 +40,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "consumer: %s\n", summary.status().message().c_str());
     return 1;
   }
-  std::printf("n = %.17g\nsigma_n = %.17g\ninliers = %zu of %lld\n",
-              summary->n, summary->sigma_n, summary->inliers.size(),
+  std::printf("n = %.17g\nsigma_n = %.17g\ninliers = %zu of %lld\n", summary->n,
+              summary->sigma_n, summary->inliers.size(),
               static_cast<long long>(summary->num_correspondences));
 
   // The corrected pair at that n: rectified pinhole images whose model a

@@ -4,10 +4,10 @@ calibrated in air (a refractive camera model for underwater stereo).
 NumPy in, NumPy out, vectorized; the names mirror the C++ library's in
 snake_case (rcm::RefineRefractiveIndex -> rcm.refine_refractive_index).
 
-Conventions (DESIGN.md Sec. 3): camera frame x right, y down, z forward;
-the port normal is +z; pixel centers at integer coordinates; lengths in
-meters, angles in radians; ``cam1_from_cam0`` maps points in cam0 (the left
-camera) into cam1 (the right camera). Correspondences are raw
+Conventions (docs/design.md, "Conventions"): camera frame x right, y down,
+z forward; the port normal is +z; pixel centers at integer coordinates;
+lengths in meters, angles in radians; ``cam1_from_cam0`` maps points in cam0
+(the left camera) into cam1 (the right camera). Correspondences are raw
 (lens-distorted) pixels [xl, yl, xr, yr].
 
 Errors: every library failure is raised with the library's one-line

@@ -7,7 +7,7 @@
 
 #include "rcm/camera/camera.h"
 #include "rcm/camera/flat_port_geometry.h"
-#include "rcm/geometry/stereo_rig.h"
+#include "rcm/stereo/stereo_rig.h"
 
 namespace rcm::python {
 

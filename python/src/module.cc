@@ -7,7 +7,8 @@ PYBIND11_MODULE(_rcm, module) {
   module.doc() =
       "rcm: the refractive index n of water from stereo images of a camera "
       "calibrated in air (the compiled bindings; import rcm).\n\n"
-      "Conventions (DESIGN.md Sec. 3): camera frame x right, y down, z "
+      "Conventions (docs/design.md, Sec. 4): camera frame x right, y down, "
+      "z "
       "forward; the port normal is +z; pixel centers at integers; lengths in "
       "meters, angles in radians unless a name says degrees; cam1_from_cam0 "
       "maps points in cam0 (the left camera) into cam1.";

@@ -9,10 +9,10 @@
 #include "bindings.h"
 #include "conversions.h"
 #include "errors.h"
-#include "rcm/geometry/stereo_rig.h"
 #include "rcm/io/camchain.h"
 #include "rcm/io/stereo_rig_file.h"
 #include "rcm/sim/reference_rigs.h"
+#include "rcm/stereo/stereo_rig.h"
 
 namespace rcm::python {
 namespace {

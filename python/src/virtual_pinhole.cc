@@ -9,8 +9,9 @@
 #include "bindings.h"
 #include "conversions.h"
 #include "errors.h"
-#include "rcm/camera/virtual_pinhole_rig.h"
 #include "rcm/io/camchain.h"
+#include "rcm/io/corrected_rig_files.h"
+#include "rcm/stereo/virtual_pinhole_rig.h"
 
 namespace rcm::python {
 namespace {

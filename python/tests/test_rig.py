@@ -5,7 +5,8 @@ import pytest
 import rcm
 from conftest import one_line, thick_port
 
-# DESIGN.md Sec. 5: the published calibration of the dataset's front pair.
+# docs/design.md, "The reference rig": the published calibration of the
+# dataset's front pair.
 CAM0_INTRINSICS = [346.68681661781403, 346.7780959214622, 360.53325988648163,
                    271.0179819820658]
 CAM0_DISTORTION = [-0.037934508908317364, -0.0009855550912794707,

@@ -54,10 +54,11 @@
 #include <vector>
 
 #include "rcm/camera/virtual_pinhole_remap.h"
-#include "rcm/camera/virtual_pinhole_rig.h"
+#include "rcm/io/corrected_rig_files.h"
 #include "rcm/io/stereo_rig_file.h"
 #include "rcm/live/latest_slot.h"
 #include "rcm/live/live_pipeline.h"
+#include "rcm/stereo/virtual_pinhole_rig.h"
 #include "rcm_ros/RefractiveIndex.h"
 #include "rcm_ros/Reset.h"
 #include "ros_image_message.h"

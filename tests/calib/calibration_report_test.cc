@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "rcm/io/atomic_file.h"
-#include "rcm/io/number_format.h"
+#include "rcm/util/number_format.h"
 #include "support/temp_file.h"
 #include "support/test_rigs.h"
 
@@ -320,8 +320,10 @@ TEST(CalibrationReport, StatisticsOfAHandBuiltCalibration) {
   EXPECT_NEAR(cam0.view_rms_limit_px, 3.0 * cam0.rms_px, kRmsTolerance);
   // Uncertainty over the image: ordered, positive, finite.
   EXPECT_GT(cam0.intrinsics_only_uncertainty_median_px, 0.0);
-  EXPECT_LE(cam0.intrinsics_only_uncertainty_median_px, cam0.intrinsics_only_uncertainty_p95_px);
-  EXPECT_LE(cam0.intrinsics_only_uncertainty_p95_px, cam0.intrinsics_only_uncertainty_max_px);
+  EXPECT_LE(cam0.intrinsics_only_uncertainty_median_px,
+            cam0.intrinsics_only_uncertainty_p95_px);
+  EXPECT_LE(cam0.intrinsics_only_uncertainty_p95_px,
+            cam0.intrinsics_only_uncertainty_max_px);
   // No view reaches 3x its camera's RMS.
   for (const CalibrationReport::View& view : report.views) {
     EXPECT_FALSE(view.flagged) << view.view;
@@ -337,7 +339,8 @@ TEST(CalibrationReport, UncertaintyStatisticsOfAPinhole) {
       SummarizeCalibration(calibration, NamedViews(10), kVga, kVga);
   const double corner = 0.1 * std::sqrt(1.0 + 0.8 * 0.8);
   EXPECT_LT(report.cameras[0].intrinsics_only_uncertainty_max_px, corner);
-  EXPECT_GT(report.cameras[0].intrinsics_only_uncertainty_max_px, 0.99 * corner);
+  EXPECT_GT(report.cameras[0].intrinsics_only_uncertainty_max_px,
+            0.99 * corner);
   EXPECT_GT(report.cameras[0].intrinsics_only_uncertainty_median_px, 0.1);
 }
 
@@ -413,7 +416,9 @@ TEST(CalibrationReport, WarnsAboutUncertaintyExactlyAboveTheMaximum) {
   const CalibrationReport reference =
       SummarizeCalibration(calibration, NamedViews(10), kVga, kVga);
   const double p95 = reference.cameras[0].intrinsics_only_uncertainty_p95_px;
-  ASSERT_GT(p95, 10.0 * reference.cameras[1].intrinsics_only_uncertainty_p95_px * 0.999);
+  ASSERT_GT(
+      p95,
+      10.0 * reference.cameras[1].intrinsics_only_uncertainty_p95_px * 0.999);
   CalibrationReportOptions options;
   options.max_uncertainty_px = p95 * (1.0 + 1e-9);
   EXPECT_TRUE(
@@ -423,7 +428,9 @@ TEST(CalibrationReport, WarnsAboutUncertaintyExactlyAboveTheMaximum) {
   const CalibrationReport report =
       SummarizeCalibration(calibration, NamedViews(10), kVga, kVga, options);
   ASSERT_EQ(report.warnings.size(), 1u);
-  EXPECT_EQ(report.warnings[0].rfind("cam0: intrinsics-only projection uncertainty", 0), 0u)
+  EXPECT_EQ(report.warnings[0].rfind(
+                "cam0: intrinsics-only projection uncertainty", 0),
+            0u)
       << report.warnings[0];
 }
 
@@ -710,8 +717,8 @@ TEST(CalibrationReport, WritesEveryFile) {
   // This calibration is made by hand, without the covariance of every
   // unknown: no mean-frames map (CalibrateCli.FoldersToCamchainAndReport
   // sees it written).
-  EXPECT_FALSE(fs::exists(fs::path(directory) /
-                          "projection_uncertainty_cam0.png"));
+  EXPECT_FALSE(
+      fs::exists(fs::path(directory) / "projection_uncertainty_cam0.png"));
   const std::string csv = ReadFileToString(directory + "/per_view.csv").value();
   std::istringstream lines(csv);
   std::string line;

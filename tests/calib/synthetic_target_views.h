@@ -18,7 +18,7 @@
 #include "rcm/calib/target_observation.h"
 #include "rcm/camera/flat_port_camera.h"
 #include "rcm/camera/refractive_model.h"
-#include "rcm/geometry/stereo_rig.h"
+#include "rcm/stereo/stereo_rig.h"
 
 namespace rcm::calib::test {
 

@@ -16,8 +16,8 @@
 #include "rcm/calib/calibration_target.h"
 #include "rcm/calib/target_image.h"
 #include "rcm/calib/target_renderer.h"
-#include "rcm/geometry/stereo_rig.h"
 #include "rcm/sim/reference_rigs.h"
+#include "rcm/stereo/stereo_rig.h"
 
 namespace rcm::calib {
 namespace {

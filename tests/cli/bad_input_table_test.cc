@@ -1,10 +1,11 @@
 // Bad input to every subcommand of the rcm executable, as a table: each row
 // writes one bad input into a fresh folder, runs rcm on it and checks what
-// DESIGN.md Sec. 4 promises: a normal exit with a non-zero code (never a
-// signal), exactly one line on stderr that names the problem, no message
-// of a library (libpng, libjpeg, glog, a sanitizer), and no output that
-// looks complete (no final camchain, JSON, CSV or report; no truncated
-// image; every file that was there before unchanged).
+// docs/design.md, "The parts and their contracts", promises: a normal exit
+// with a non-zero code (never a signal), exactly one line on stderr that
+// names the problem, no message of a library (libpng, libjpeg, glog, a
+// sanitizer), and no output that looks complete (no final camchain, JSON,
+// CSV or report; no truncated image; every file that was there before
+// unchanged).
 //
 // Every row is its own test, e.g.
 // BadInput/CliBadInput.Refuses/EstimateMatchesWrongColumnCount.
@@ -27,7 +28,7 @@
 #include "support/camera_info_text.h"
 #include "support/temp_file.h"
 #ifdef RCM_HAVE_ROSBAG
-#include "rcm/io/bag_image_writer.h"
+#include "rcm/rosbag/bag_image_writer.h"
 #endif
 
 namespace rcm {

@@ -22,7 +22,7 @@
 #include "rcm/io/camchain.h"
 #include "support/temp_file.h"
 #ifdef RCM_HAVE_ROSBAG
-#include "rcm/io/bag_image_writer.h"
+#include "rcm/rosbag/bag_image_writer.h"
 #endif
 
 namespace rcm {

@@ -29,7 +29,8 @@ using test::IsOneLine;
 using test::RunResult;
 
 constexpr double kTrueN = 1.342;
-// The drift of the real housing of DESIGN.md Sec. 7 (0.49 degrees).
+// The drift of the real housing of docs/design.md, "Rigs that drift"
+// (0.49 degrees).
 const double kDriftDeg[3] = {0.25, 0.41, 0.08};
 
 RunResult Rcm(const std::vector<std::string>& args) {
@@ -518,7 +519,8 @@ TEST(UnderwaterCli, JointAirAndWater) {
     const double sigma =
         k < 3 ? change["rotation_sigma_deg"][k].get<double>() * M_PI / 180.0
               : 1e-3 * change["translation_sigma_mm"][k - 3].get<double>();
-    const double variance = (*written.cameras[1].from_previous_covariance)(k, k);
+    const double variance =
+        (*written.cameras[1].from_previous_covariance)(k, k);
     EXPECT_GE(variance, (1.0 - 1e-9) * sigma * sigma) << k;
     EXPECT_LE(variance, (1.0 + 1e-9) * widening * sigma * sigma) << k;
   }

@@ -12,11 +12,11 @@
 #include <vector>
 
 #include "cli/cli_runner.h"
-#include "rcm/io/image_file.h"
 #include "rcm/io/correspondence_csv.h"
+#include "rcm/io/image_file.h"
 #include "support/temp_file.h"
 #ifdef RCM_HAVE_ROSBAG
-#include "rcm/io/bag_image_writer.h"
+#include "rcm/rosbag/bag_image_writer.h"
 #endif
 
 namespace rcm {
@@ -82,15 +82,13 @@ TEST(EstimateImagesCli, FoldersGiveNAndThePictures) {
   EXPECT_GT(picture.cols, 720);
   EXPECT_GT(picture.rows, 540);
   // The matches are kept, and estimate reads them back to the same n.
-  const RunResult again =
-      Rcm({"estimate", "--calib", Dive() + "/camchain.yaml", "--matches",
-           out + "/matches.csv", "--json"});
+  const RunResult again = Rcm({"estimate", "--calib", Dive() + "/camchain.yaml",
+                               "--matches", out + "/matches.csv", "--json"});
   ASSERT_EQ(again.exit_code, 0) << again.err;
   EXPECT_NEAR(nlohmann::json::parse(again.out)["n"].get<double>(),
               json["n"].get<double>(), 1e-9);
   const std::string per_frame = test::ReadWholeFile(out + "/per_frame.csv");
-  EXPECT_EQ(std::count(per_frame.begin(), per_frame.end(), '\n'),
-            kFrames + 1);
+  EXPECT_EQ(std::count(per_frame.begin(), per_frame.end(), '\n'), kFrames + 1);
 }
 
 TEST(EstimateImagesCli, EveryEstimatorRunsOnImages) {
@@ -101,8 +99,8 @@ TEST(EstimateImagesCli, EveryEstimatorRunsOnImages) {
              estimator, "--json"});
     ASSERT_EQ(result.exit_code, 0) << estimator << ": " << result.err;
     const double n = nlohmann::json::parse(result.out)["n"].get<double>();
-    // The closed form is the paper's biased baseline (DESIGN.md Sec. 2):
-    // only a sanity bound for it.
+    // The closed form is the paper's biased baseline (docs/design.md,
+    // "The estimator of record"): only a sanity bound for it.
     EXPECT_NEAR(n, kNTrue,
                 std::string(estimator) == "closed-form" ? 0.1 : kNTolerance)
         << estimator;
@@ -131,14 +129,14 @@ TEST(EstimateImagesCli, BadImageInputIsOneLine) {
   ExpectFailsWithOneLine(
       Rcm({"estimate", "--calib", calib, "--left", Dive() + "/left"}), 1,
       "--left and --right go together");
-  ExpectFailsWithOneLine(Rcm({"estimate", "--calib", calib, "--left",
-                              Dive() + "/left", "--right", Dive() + "/right",
-                              "--features", "surf"}),
-                         2, "unknown --features 'surf'");
-  ExpectFailsWithOneLine(Rcm({"estimate", "--calib", calib, "--left",
-                              Dive() + "/left", "--right", Dive() + "/right",
-                              "--from", "1"}),
-                         1, "a time range needs timestamps");
+  ExpectFailsWithOneLine(
+      Rcm({"estimate", "--calib", calib, "--left", Dive() + "/left", "--right",
+           Dive() + "/right", "--features", "surf"}),
+      2, "unknown --features 'surf'");
+  ExpectFailsWithOneLine(
+      Rcm({"estimate", "--calib", calib, "--left", Dive() + "/left", "--right",
+           Dive() + "/right", "--from", "1"}),
+      1, "a time range needs timestamps");
   // Images of another size than the calibration.
   const std::string small = Folder("small_images");
   fs::create_directories(small + "/left");
@@ -163,18 +161,18 @@ std::string DiveBag() {
     char name[32];
     std::snprintf(name, sizeof(name), "/%06d.png", i);
     const double stamp = 1700000000.0 + 0.05 * i;
-    EXPECT_TRUE(writer
-                    ->WriteImage("/cam0/image_raw", stamp,
-                                 ReadImage(Dive() + "/left" + name, true)
-                                     .value(),
-                                 "mono8", "cam0")
-                    .ok());
-    EXPECT_TRUE(writer
-                    ->WriteCompressed(
-                        "/cam1/image_raw/compressed", stamp + 0.0004,
-                        ReadImage(Dive() + "/right" + name, true).value(),
-                        "png", "cam1")
-                    .ok());
+    EXPECT_TRUE(
+        writer
+            ->WriteImage("/cam0/image_raw", stamp,
+                         ReadImage(Dive() + "/left" + name, true).value(),
+                         "mono8", "cam0")
+            .ok());
+    EXPECT_TRUE(
+        writer
+            ->WriteCompressed("/cam1/image_raw/compressed", stamp + 0.0004,
+                              ReadImage(Dive() + "/right" + name, true).value(),
+                              "png", "cam1")
+            .ok());
   }
   EXPECT_TRUE(writer->Close().ok());
   return path;
@@ -205,8 +203,7 @@ TEST(EstimateImagesCli, BagGivesTheSameNAsTheFolders) {
            "/cam1/image_raw/compressed", "--from", "0.04", "--to", "0.11",
            "--json"});
   ASSERT_EQ(ranged.exit_code, 0) << ranged.err;
-  EXPECT_EQ(nlohmann::json::parse(ranged.out)["images"]["pairs"].get<int>(),
-            2);
+  EXPECT_EQ(nlohmann::json::parse(ranged.out)["images"]["pairs"].get<int>(), 2);
 }
 
 TEST(EstimateImagesCli, BagWithoutTheTopicsIsOneLine) {
@@ -217,13 +214,12 @@ TEST(EstimateImagesCli, BagWithoutTheTopicsIsOneLine) {
            "/cam1/image_raw/compressed"}),
       1, "no topic /alphasense/cam0/image_raw");
   ExpectFailsWithOneLine(
-      Rcm({"estimate", "--calib", Dive() + "/camchain.yaml", "--bag", bag}),
-      1, "--bag needs --left-topic and --right-topic");
-  ExpectFailsWithOneLine(
-      Rcm({"estimate", "--calib", Dive() + "/camchain.yaml", "--bag",
-           Dive() + "/camchain.yaml", "--left-topic", "/a", "--right-topic",
-           "/b"}),
-      1, "not a readable ROS1 bag");
+      Rcm({"estimate", "--calib", Dive() + "/camchain.yaml", "--bag", bag}), 1,
+      "--bag needs --left-topic and --right-topic");
+  ExpectFailsWithOneLine(Rcm({"estimate", "--calib", Dive() + "/camchain.yaml",
+                              "--bag", Dive() + "/camchain.yaml",
+                              "--left-topic", "/a", "--right-topic", "/b"}),
+                         1, "not a readable ROS1 bag");
 }
 #endif  // RCM_HAVE_ROSBAG
 

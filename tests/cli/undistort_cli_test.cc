@@ -11,15 +11,15 @@
 #include <vector>
 
 #include "cli/cli_runner.h"
-#include "rcm/camera/virtual_pinhole_rig.h"
 #include "rcm/io/camchain.h"
 #include "rcm/io/camera_info.h"
 #include "rcm/io/image_file.h"
 #include "rcm/io/stereo_rig_file.h"
+#include "rcm/stereo/virtual_pinhole_rig.h"
 #include "support/temp_file.h"
 #ifdef RCM_HAVE_ROSBAG
-#include "rcm/io/bag_image_writer.h"
-#include "rcm/io/bag_stereo_source.h"
+#include "rcm/rosbag/bag_image_writer.h"
+#include "rcm/rosbag/bag_stereo_source.h"
 #endif
 
 namespace rcm {
@@ -447,10 +447,10 @@ TEST(UndistortCli, ThickPortIsCorrectedAtTheReferenceDepth) {
   const std::string rig = dive + "/thick_rig.yaml";
   ASSERT_TRUE(WriteCamchain(rig, camchain).ok());
   const std::string out = Folder("out");
-  const RunResult result = Rcm(
-      {"undistort", "--calib", rig, "--n", "1.333", "--left", dive + "/left",
-       "--right", dive + "/right", "--out", out, "--reference-depth", "1.5",
-       "--json"});
+  const RunResult result =
+      Rcm({"undistort", "--calib", rig, "--n", "1.333", "--left",
+           dive + "/left", "--right", dive + "/right", "--out", out,
+           "--reference-depth", "1.5", "--json"});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const nlohmann::json json = nlohmann::json::parse(result.out);
   EXPECT_EQ(json["port"], "thick");

@@ -12,12 +12,12 @@
 #include "rcm/estimation/online_estimator.h"
 #include "rcm/estimation/sampson_coplanarity_error.h"
 #include "rcm/estimation/sliding_window_estimator.h"
-#include "rcm/geometry/epipolar.h"
 #include "rcm/io/stereo_rig_file.h"
 #include "rcm/sim/exposure_delay.h"
 #include "rcm/sim/non_rigid_layer.h"
 #include "rcm/sim/sequence_simulator.h"
 #include "rcm/sim/stereo_sampler.h"
+#include "rcm/stereo/epipolar.h"
 #include "support/test_budget.h"
 #include "support/test_rigs.h"
 

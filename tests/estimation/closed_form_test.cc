@@ -7,8 +7,8 @@
 #include <random>
 
 #include "rcm/estimation/paper_online_estimator.h"
-#include "rcm/geometry/observability.h"
 #include "rcm/sim/stereo_sampler.h"
+#include "rcm/stereo/observability.h"
 #include "support/test_rigs.h"
 
 namespace rcm {

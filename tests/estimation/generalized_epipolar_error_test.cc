@@ -9,8 +9,8 @@
 
 #include "rcm/estimation/prepared_correspondence.h"
 #include "rcm/estimation/sampson_coplanarity_error.h"
-#include "rcm/geometry/epipolar.h"
 #include "rcm/sim/stereo_sampler.h"
+#include "rcm/stereo/epipolar.h"
 #include "support/test_rigs.h"
 
 namespace rcm {
@@ -81,8 +81,8 @@ TEST(GeneralizedEpipolarError, ThinPortIsTheCoplanarityResidual) {
     double coplanarity = 0.0;
     ASSERT_TRUE(GeneralizedEpipolarResidual(Stereo(rig, thin), match, 1.333,
                                             0.0, &generalized));
-    ASSERT_TRUE(SampsonCoplanarityResidual<double>(essential, match, 1.333, nullptr,
-                                           &coplanarity));
+    ASSERT_TRUE(SampsonCoplanarityResidual<double>(essential, match, 1.333,
+                                                   nullptr, &coplanarity));
     EXPECT_NEAR(std::abs(generalized), std::abs(coplanarity),
                 1e-3 + 0.01 * std::abs(coplanarity));
   }
@@ -110,15 +110,15 @@ TEST(GeneralizedEpipolarError, JacobianMatchesCentralDifferences) {
     ASSERT_TRUE(cost->Evaluate(blocks, &residual, jacobians));
     const auto value = [&](double n_value, double gap_value) {
       double r = 0.0;
-      EXPECT_TRUE(GeneralizedEpipolarResidual(Stereo(rig, HousingPort()),
-                                              matches[i], n_value, gap_value,
-                                              &r));
+      EXPECT_TRUE(GeneralizedEpipolarResidual(
+          Stereo(rig, HousingPort()), matches[i], n_value, gap_value, &r));
       return r;
     };
     const double numeric_n =
         (value(n + 1e-5, 0.0) - value(n - 1e-5, 0.0)) / 2e-5;
     const double numeric_gap = (value(n, 1e-5) - value(n, -1e-5)) / 2e-5;
-    EXPECT_NEAR(jacobian_n, numeric_n, 1e-4 * std::max(1.0, std::abs(numeric_n)));
+    EXPECT_NEAR(jacobian_n, numeric_n,
+                1e-4 * std::max(1.0, std::abs(numeric_n)));
     EXPECT_NEAR(jacobian_gap, numeric_gap,
                 1e-4 * std::max(1.0, std::abs(numeric_gap)));
   }

@@ -11,8 +11,8 @@
 
 #include "rcm/estimation/prepared_correspondence.h"
 #include "rcm/estimation/sampson_coplanarity_error.h"
-#include "rcm/geometry/epipolar.h"
 #include "rcm/sim/stereo_sampler.h"
+#include "rcm/stereo/epipolar.h"
 #include "support/test_rigs.h"
 
 namespace rcm {

@@ -8,8 +8,8 @@
 #include <string>
 
 #include "rcm/estimation/medium_drift.h"
-#include "rcm/io/number_format.h"
 #include "rcm/sim/stereo_sampler.h"
+#include "rcm/util/number_format.h"
 #include "support/test_budget.h"
 #include "support/test_rigs.h"
 
@@ -41,7 +41,8 @@ TEST(WaterRefractiveIndex, PureWaterAtTwentyDegreesAndTheSodiumLine) {
 }
 
 // Salt raises n (about 2e-4 per g/kg), heat and longer waves lower it.
-TEST(WaterRefractiveIndex, IncreasesWithSalinityDecreasesWithTemperatureAndWavelength) {
+TEST(WaterRefractiveIndex,
+     IncreasesWithSalinityDecreasesWithTemperatureAndWavelength) {
   const double base = WaterRefractiveIndex(20.0, 15.0, 550.0).value();
   EXPECT_NEAR((WaterRefractiveIndex(21.0, 15.0, 550.0).value() - base), 1.9e-4,
               0.2e-4);
@@ -62,10 +63,13 @@ TEST(WaterRefractiveIndex, OutsideTheEquationsRangeIsAnError) {
 // uniform n over the range.
 TEST(MediumPrior, FreshAndSeaWater) {
   const MediumPrior fresh = ParseMediumPrior("fresh").value();
-  EXPECT_NEAR(fresh.min_n, WaterRefractiveIndex(0.0, 30.0, 650.0).value(), 1e-12);
-  EXPECT_NEAR(fresh.max_n, WaterRefractiveIndex(1.0, 0.0, 450.0).value(), 1e-12);
+  EXPECT_NEAR(fresh.min_n, WaterRefractiveIndex(0.0, 30.0, 650.0).value(),
+              1e-12);
+  EXPECT_NEAR(fresh.max_n, WaterRefractiveIndex(1.0, 0.0, 450.0).value(),
+              1e-12);
   const MediumPrior sea = ParseMediumPrior("sea").value();
-  EXPECT_NEAR(sea.min_n, WaterRefractiveIndex(30.0, 30.0, 650.0).value(), 1e-12);
+  EXPECT_NEAR(sea.min_n, WaterRefractiveIndex(30.0, 30.0, 650.0).value(),
+              1e-12);
   EXPECT_NEAR(sea.max_n, WaterRefractiveIndex(35.0, 0.0, 450.0).value(), 1e-12);
   for (const MediumPrior& medium : {fresh, sea}) {
     EXPECT_NEAR(medium.n, 0.5 * (medium.min_n + medium.max_n), 1e-15);
@@ -121,8 +125,9 @@ TEST(MediumDrift, ExactDataGiveTheTurnOfANarrowRig) {
   constexpr double kTrueN = 1.342;
   const StereoRig nominal = test::NarrowRadtanRig();
   const Eigen::Vector3d drift = Eigen::Vector3d(0.3, 0.4, 0.0) * kDegree;
-  const std::vector<StereoCorrespondence> exact = AtOneDepth(
-      nominal.WithCam1Moved(drift).value(), kTrueN, StereoSamplerOptions().seed);
+  const std::vector<StereoCorrespondence> exact =
+      AtOneDepth(nominal.WithCam1Moved(drift).value(), kTrueN,
+                 StereoSamplerOptions().seed);
   const MediumDrift turned =
       EstimateDriftAssumingMedium(nominal, exact, RefinementOptions(),
                                   ParseMediumPrior("1.342:0.003").value())

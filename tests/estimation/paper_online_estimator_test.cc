@@ -6,8 +6,8 @@
 #include <limits>
 
 #include "rcm/estimation/closed_form.h"
-#include "rcm/geometry/observability.h"
 #include "rcm/sim/stereo_sampler.h"
+#include "rcm/stereo/observability.h"
 #include "support/test_rigs.h"
 
 namespace rcm {
@@ -132,9 +132,10 @@ TEST(PaperOnlineEstimator, StandardErrorIsHonestInMeanSquare) {
 }
 
 TEST(PaperOnlineEstimator, BiasedUpwardUnderHalfPixelNoise) {
-  // The measurement of DESIGN.md Sec. 2: at 0.5 px the paper's pipeline
-  // reads ~1.42 for a true 1.333 (here 1.41). This pins the baseline: if it
-  // ever reads right, it is no longer the paper's estimator.
+  // The measurement of docs/design.md, "The estimator of record": at 0.5 px
+  // the paper's pipeline reads ~1.42 for a true 1.333 (here 1.41). This
+  // pins the baseline: if it ever reads right, it is no longer the paper's
+  // estimator.
   const StereoRig rig = test::AlphasenseIdealRig();
   std::vector<StereoCorrespondence> data = test::ExactMatches(rig, 1.333, 2000);
   AddPixelNoise(0.5, 2, &data);

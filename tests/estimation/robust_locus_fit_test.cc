@@ -5,8 +5,8 @@
 
 #include <cmath>
 
-#include "rcm/geometry/epipolar.h"
 #include "rcm/sim/stereo_sampler.h"
+#include "rcm/stereo/epipolar.h"
 #include "support/test_rigs.h"
 
 namespace rcm {

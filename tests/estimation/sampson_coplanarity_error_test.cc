@@ -9,8 +9,8 @@
 #include <memory>
 #include <random>
 
-#include "rcm/geometry/epipolar.h"
 #include "rcm/sim/stereo_sampler.h"
+#include "rcm/stereo/epipolar.h"
 #include "support/test_rigs.h"
 
 namespace rcm {

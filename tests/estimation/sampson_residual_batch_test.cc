@@ -12,8 +12,8 @@
 #include "rcm/estimation/locus_cost_function.h"
 #include "rcm/estimation/prepared_correspondence.h"
 #include "rcm/estimation/sampson_coplanarity_error.h"
-#include "rcm/geometry/epipolar.h"
 #include "rcm/sim/stereo_sampler.h"
+#include "rcm/stereo/epipolar.h"
 #include "support/test_rigs.h"
 
 namespace rcm {
@@ -71,8 +71,9 @@ double WorstAgainstJet(const Eigen::Matrix3d& essential,
 
 TEST(SampsonResidualBatch, MatchesTheJetFormOnDatasetRig) {
   const StereoRig rig = test::AlphasenseRealisticRig();
-  const double worst = WorstAgainstJet(EssentialMatrix(rig.right_from_left()),
-                                       test::NoisyPreparedMatches(rig, 1.333, 300, 0.5, 3));
+  const double worst =
+      WorstAgainstJet(EssentialMatrix(rig.right_from_left()),
+                      test::NoisyPreparedMatches(rig, 1.333, 300, 0.5, 3));
   std::printf("worst error against the Jet form: %.3g of the tolerance\n",
               worst);
   EXPECT_LE(worst, 1.0);
@@ -83,8 +84,9 @@ TEST(SampsonResidualBatch, MatchesTheJetFormOnEveryTestCamera) {
   // EUCM: rays near grazing, where m's derivatives are largest.
   for (const Camera& camera : test::AllTestCameras()) {
     const StereoRig rig = test::IdealRig(camera, camera, 0.2);
-    const double worst = WorstAgainstJet(EssentialMatrix(rig.right_from_left()),
-                                         test::NoisyPreparedMatches(rig, 1.1, 200, 0.5, 5));
+    const double worst =
+        WorstAgainstJet(EssentialMatrix(rig.right_from_left()),
+                        test::NoisyPreparedMatches(rig, 1.1, 200, 0.5, 5));
     EXPECT_LE(worst, 1.0) << camera.width() << "x" << camera.height();
   }
 }

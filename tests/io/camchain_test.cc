@@ -12,8 +12,8 @@
 #include "rcm/io/atomic_file.h"
 #include "rcm/sim/reference_rigs.h"
 #include "support/reader_inputs.h"
-#include "support/test_rigs.h"
 #include "support/temp_file.h"
+#include "support/test_rigs.h"
 
 namespace rcm {
 namespace {
@@ -21,8 +21,8 @@ namespace {
 using ::testing::HasSubstr;
 using ::testing::StartsWith;
 
-// The front pair of the paper's dataset (DESIGN.md section 5) as Kalibr
-// writes it: Python's yaml.dump(..., default_flow_style=None) of the
+// The front pair of the paper's dataset (docs/design.md, "The reference rig")
+// as Kalibr writes it: Python's yaml.dump(..., default_flow_style=None) of the
 // camchain dictionary produced exactly these bytes, including the wrapped
 // distortion_coeffs lines. T_cn_cnm1 is the rotation of angle-axis
 // (0.0021, -0.0113, 0.0016) rad with a 0.11 m baseline.
@@ -459,21 +459,20 @@ TEST(Camchain, RejectsBadNewModelEntries) {
             "ds.yaml:4: cam0.intrinsics: ds xi = 1.2 is outside (-1, 1]");
   EXPECT_EQ(error(ReplaceOnce(kKalibrDs, "[-0.2, 0.58, ", "[-0.2, 1.5, ")),
             "ds.yaml:4: cam0.intrinsics: ds alpha = 1.5 is outside [0, 1]");
-  EXPECT_EQ(
-      error(ReplaceOnce(ReplaceOnce(kKalibrDs, "ds\n", "eucm\n"),
-                        "[-0.2, 0.58, ", "[0.6, -1, ")),
-      "ds.yaml:4: cam0.intrinsics: eucm beta = -1 is outside (0, 1000]");
+  EXPECT_EQ(error(ReplaceOnce(ReplaceOnce(kKalibrDs, "ds\n", "eucm\n"),
+                              "[-0.2, 0.58, ", "[0.6, -1, ")),
+            "ds.yaml:4: cam0.intrinsics: eucm beta = -1 is outside (0, 1000]");
   EXPECT_THAT(error(ReplaceOnce(kKalibrDs, "[-0.2, 0.58, ", "[")),
               HasSubstr("cam0.intrinsics: expected 6"));
   EXPECT_EQ(error(ReplaceOnce(kKalibrDs, "model: none", "model: radtan")),
             "ds.yaml:3: cam0.distortion_model: camera_model 'ds' takes "
             "distortion_model 'none', got 'radtan'");
-  EXPECT_THAT(error(ReplaceOnce(ReplaceOnce(kKalibrDs, "model: ds",
-                                            "model: pinhole"),
-                                "model: none", "model: ds")),
-              HasSubstr("unknown model 'ds' (supported: none, radtan, "
-                        "equidistant, rational; 'ds' is a camera_model, "
-                        "with distortion_model 'none')"));
+  EXPECT_THAT(
+      error(ReplaceOnce(ReplaceOnce(kKalibrDs, "model: ds", "model: pinhole"),
+                        "model: none", "model: ds")),
+      HasSubstr("unknown model 'ds' (supported: none, radtan, "
+                "equidistant, rational; 'ds' is a camera_model, "
+                "with distortion_model 'none')"));
   EXPECT_EQ(error(ReplaceOnce(kKalibrDs, "  distortion_model",
                               "  distortion_coeffs: [0.1]\n  "
                               "distortion_model")),
@@ -538,9 +537,9 @@ TEST(Camchain, PortNormalIsNormalized) {
 
 TEST(Camchain, RejectsBadPortBlocks) {
   const auto with_port = [](const std::string& port) {
-    return ParseError(ReplaceOnce(kMinimal, "  resolution: [720, 540]\ncam1:\n",
-                                  "  resolution: [720, 540]\n  port: " + port +
-                                      "\ncam1:\n"));
+    return ParseError(
+        ReplaceOnce(kMinimal, "  resolution: [720, 540]\ncam1:\n",
+                    "  resolution: [720, 540]\n  port: " + port + "\ncam1:\n"));
   };
   EXPECT_THAT(with_port("3"), HasSubstr("cam0.port: expected a map"));
   EXPECT_THAT(with_port("{glass_thickness: 0.005}"),
@@ -560,13 +559,15 @@ TEST(Camchain, RejectsBadPortBlocks) {
               HasSubstr("outside [0, 0.5]"));
   EXPECT_THAT(with_port("{air_gap: .nan, glass_thickness: 0.0}"),
               HasSubstr("cam0.port.air_gap"));
-  EXPECT_THAT(with_port("{air_gap: 0.01, glass_thickness: 0.0, normal: [0, 1]}"),
-              HasSubstr("cam0.port.normal"));
+  EXPECT_THAT(
+      with_port("{air_gap: 0.01, glass_thickness: 0.0, normal: [0, 1]}"),
+      HasSubstr("cam0.port.normal"));
   EXPECT_THAT(
       with_port("{air_gap: 0.01, glass_thickness: 0.0, normal: [0, 1, 0]}"),
       HasSubstr("tilted 90 degrees"));
-  EXPECT_THAT(with_port("{air_gap: 0.01, glass_thickness: 0.0, glass_index: 3}"),
-              HasSubstr("glass_index = 3 is outside [1, 2]"));
+  EXPECT_THAT(
+      with_port("{air_gap: 0.01, glass_thickness: 0.0, glass_index: 3}"),
+      HasSubstr("glass_index = 3 is outside [1, 2]"));
 }
 
 TEST(Camchain, NoneModelMayOmitCoefficients) {

@@ -227,7 +227,7 @@ TEST(SequenceSimulator, DriftMovesTheRigThatMakesTheDataOnly) {
   // The housing drifted by 0.5 degrees: the data are those of the moved
   // rig (thin port, exact: it returns n to 1e-9), while rig() stays the
   // calibration, on which the same matches give a confidently wrong n
-  // (DESIGN.md Sec. 7; 1.77 for the true 1.34).
+  // (docs/design.md, "Rigs that drift"; 1.77 for the true 1.34).
   const StereoRig rig = NarrowFieldRig();
   SequenceOptions options = MatchesOnly({{1.34, 20}});
   options.cam1_drift.rotation = Eigen::Vector3d(0.0, 0.5, 0.0) * M_PI / 180.0;

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "rcm/io/number_format.h"
+#include "rcm/util/number_format.h"
 
 namespace rcm::test {
 

@@ -10,11 +10,12 @@
 #include "rcm/camera/camera.h"
 #include "rcm/estimation/prepared_correspondence.h"
 #include "rcm/geometry/stereo_correspondence.h"
-#include "rcm/geometry/stereo_rig.h"
+#include "rcm/stereo/stereo_rig.h"
 
 namespace rcm::test {
 
-// The paper's Alphasense front pair, 720x540, equidistant (DESIGN.md Sec. 5).
+// The paper's Alphasense front pair, 720x540, equidistant (docs/design.md,
+// "The reference rig").
 Camera AlphasenseCam0();
 Camera AlphasenseCam1();
 // EuRoC MAV cam0, 752x480, radtan.

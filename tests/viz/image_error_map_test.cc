@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "rcm/viz/color_map.h"
+#include "rcm/plot/color_map.h"
 
 namespace rcm {
 namespace {

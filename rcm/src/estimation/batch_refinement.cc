@@ -21,7 +21,7 @@
 #include "rcm/estimation/robust_locus_fit.h"
 #include "rcm/estimation/sampson_coplanarity_error.h"
 #include "rcm/estimation/thick_port_refinement.h"
-#include "rcm/geometry/epipolar.h"
+#include "rcm/stereo/epipolar.h"
 
 namespace rcm {
 namespace {

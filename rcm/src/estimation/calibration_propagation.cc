@@ -13,7 +13,7 @@
 
 #include "rcm/estimation/generalized_epipolar_error.h"
 #include "rcm/estimation/sampson_coplanarity_error.h"
-#include "rcm/geometry/epipolar.h"
+#include "rcm/stereo/epipolar.h"
 
 namespace rcm {
 

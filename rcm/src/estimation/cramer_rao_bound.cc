@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "rcm/estimation/sampson_coplanarity_error.h"
-#include "rcm/geometry/epipolar.h"
+#include "rcm/stereo/epipolar.h"
 
 namespace rcm {
 

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "rcm/io/number_format.h"
+#include "rcm/util/number_format.h"
 
 namespace rcm {
 
@@ -35,9 +35,9 @@ StatusOr<MediumDrift> EstimateDriftAssumingMedium(
           : std::sqrt(std::max(0.0, covariance.trace() / 3.0));
   drift.turned = drift.angle > kMediumDriftSigmas * drift.sigma_angle;
   const double degrees = 180.0 / M_PI;
-  const Eigen::Vector3d axis =
-      drift.angle > 0.0 ? Eigen::Vector3d(w / drift.angle)
-                        : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d axis = drift.angle > 0.0
+                                   ? Eigen::Vector3d(w / drift.angle)
+                                   : Eigen::Vector3d::Zero();
   drift.message = "assuming " + medium.name + ", cam1 has turned by " +
                   FormatFixed(drift.angle * degrees, 3) + " +- " +
                   FormatFixed(drift.sigma_angle * degrees, 3) +

@@ -5,7 +5,7 @@
 #include <cstdlib>
 #include <limits>
 
-#include "rcm/io/number_format.h"
+#include "rcm/util/number_format.h"
 
 namespace rcm {
 namespace {
@@ -83,8 +83,8 @@ StatusOr<double> WaterRefractiveIndex(double salinity_g_per_kg,
 }
 
 std::string MediumPrior::Describe() const {
-  std::string text = name + " (n " + FormatFixed(min_n, 4) + "-" +
-                     FormatFixed(max_n, 4);
+  std::string text =
+      name + " (n " + FormatFixed(min_n, 4) + "-" + FormatFixed(max_n, 4);
   if (name == "fresh water") return text + ": " + ConditionsText(kFresh) + ")";
   if (name == "sea water") return text + ": " + ConditionsText(kSea) + ")";
   return text + ")";
@@ -134,9 +134,10 @@ MediumCheck CheckAgainstMedium(double n, double sigma_n,
   check.z = std::abs(n - medium.n) / sigma;
   check.contradicts = check.z > kMediumContradictionZ;
   if (check.contradicts) {
-    check.message = "n " + FormatFixed(n, 4) + " +- " + FormatFixed(sigma_n, 4) +
-                    " contradicts " + medium.Describe() + " by " +
-                    FormatFixed(check.z, 1) + " sigma";
+    check.message = "n " + FormatFixed(n, 4) + " +- " +
+                    FormatFixed(sigma_n, 4) + " contradicts " +
+                    medium.Describe() + " by " + FormatFixed(check.z, 1) +
+                    " sigma";
   }
   return check;
 }

@@ -12,7 +12,7 @@
 #include "rcm/estimation/batch_refinement.h"
 #include "rcm/estimation/prepared_correspondence.h"
 #include "rcm/estimation/robust_locus_fit.h"
-#include "rcm/geometry/epipolar.h"
+#include "rcm/stereo/epipolar.h"
 
 namespace rcm {
 

@@ -5,7 +5,7 @@
 #include <limits>
 
 #include "rcm/estimation/sampson_coplanarity_error.h"
-#include "rcm/geometry/epipolar.h"
+#include "rcm/stereo/epipolar.h"
 #include "rcm/util/golden_section.h"
 #include "rcm/util/parallel_for.h"
 

@@ -7,8 +7,8 @@
 
 #include "rcm/io/atomic_file.h"
 #include "rcm/io/camchain.h"
-#include "rcm/io/number_format.h"
 #include "rcm/io/yaml_fields.h"
+#include "rcm/util/number_format.h"
 
 namespace rcm {
 namespace {

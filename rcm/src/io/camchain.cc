@@ -13,9 +13,9 @@
 #include <utility>
 
 #include "rcm/io/atomic_file.h"
-#include "rcm/io/number_format.h"
 #include "rcm/io/yaml_fields.h"
 #include "rcm/util/message_text.h"
+#include "rcm/util/number_format.h"
 
 namespace rcm {
 namespace {
@@ -44,8 +44,8 @@ const YAML::Node* Find(const YamlEntries& entries, std::string_view key) {
 
 // The `port` block of a camera (flat_port_geometry.h): air_gap and
 // glass_thickness required, glass_index and normal optional; a normal
-// that is not of unit length is normalized. An unknown key is an error here (a misspelt key of a
-// port would silently give the thin port).
+// that is not of unit length is normalized. An unknown key is an error here (a
+// misspelt key of a port would silently give the thin port).
 StatusOr<FlatPort> ReadPort(const YamlReader& reader, const YAML::Node& node,
                             const std::string& field) {
   if (!node.IsMap()) {
@@ -57,8 +57,8 @@ StatusOr<FlatPort> ReadPort(const YamlReader& reader, const YAML::Node& node,
   const StatusOr<YamlEntries> entries = reader.Entries(node, field);
   if (!entries.ok()) return entries.status();
   for (const auto& [key, entry] : *entries) {
-    if (key != "air_gap" && key != "glass_thickness" &&
-        key != "glass_index" && key != "normal") {
+    if (key != "air_gap" && key != "glass_thickness" && key != "glass_index" &&
+        key != "normal") {
       return reader.Error(entry.key, field + "." + key,
                           "unknown key (a port has air_gap, "
                           "glass_thickness, glass_index, normal)");
@@ -503,15 +503,16 @@ void AppendCamera(const std::string& name, const CamchainCamera& entry,
   if (unified) {
     const std::vector<double> distortion = camera.Distortion();
     intrinsics.insert(intrinsics.begin(), distortion.begin(), distortion.end());
-    *out += "  camera_model: " + std::string(LensModelName(camera.model())) +
-            "\n";
+    *out +=
+        "  camera_model: " + std::string(LensModelName(camera.model())) + "\n";
     *out += "  distortion_coeffs: []\n";
     *out += "  distortion_model: none\n";
   } else {
     *out += "  camera_model: pinhole\n";
     AppendListField("distortion_coeffs", FloatItems(camera.Distortion()), out);
-    *out += "  distortion_model: " +
-            std::string(LensModelName(camera.model())) + "\n";
+    *out +=
+        "  distortion_model: " + std::string(LensModelName(camera.model())) +
+        "\n";
   }
   AppendListField("intrinsics", FloatItems(intrinsics), out);
   AppendListField(
@@ -667,10 +668,10 @@ StatusOr<StereoRig> StereoRigFromCamchain(const Camchain& camchain,
 
 Camchain CamchainFromStereoRig(const StereoRig& rig) {
   Camchain camchain;
-  CamchainCamera left{rig.left(), std::nullopt, std::nullopt, std::nullopt,
-                      {1}, ""};
-  CamchainCamera right{rig.right(), rig.right_from_left(), std::nullopt,
-                       std::nullopt, {0}, ""};
+  CamchainCamera left{rig.left(),   std::nullopt, std::nullopt,
+                      std::nullopt, {1},          ""};
+  CamchainCamera right{
+      rig.right(), rig.right_from_left(), std::nullopt, std::nullopt, {0}, ""};
   if (rig.ports().has_value()) {
     left.port = rig.ports()->left;
     right.port = rig.ports()->right;

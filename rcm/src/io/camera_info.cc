@@ -11,9 +11,9 @@
 
 #include "rcm/geometry/rigid3d.h"
 #include "rcm/io/atomic_file.h"
-#include "rcm/io/number_format.h"
 #include "rcm/io/yaml_fields.h"
 #include "rcm/util/message_text.h"
+#include "rcm/util/number_format.h"
 
 namespace rcm {
 namespace {

@@ -20,8 +20,8 @@
 
 #include "rcm/io/atomic_file.h"
 #include "rcm/io/image_file.h"
-#include "rcm/io/number_format.h"
 #include "rcm/util/message_text.h"
+#include "rcm/util/number_format.h"
 
 namespace rcm {
 namespace {

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "rcm/io/number_format.h"
+#include "rcm/util/number_format.h"
 
 namespace rcm {
 namespace {
@@ -30,9 +30,9 @@ Status FrameSelection::Check() const {
   return Status::Ok();
 }
 
-StatusOr<std::vector<size_t>> SelectFrames(const std::vector<double>& timestamps,
-                                           size_t num_pairs,
-                                           const FrameSelection& selection) {
+StatusOr<std::vector<size_t>> SelectFrames(
+    const std::vector<double>& timestamps, size_t num_pairs,
+    const FrameSelection& selection) {
   if (const Status status = selection.Check(); !status.ok()) return status;
   CHECK(timestamps.empty() || timestamps.size() == num_pairs)
       << "one timestamp per pair, or none";

@@ -8,7 +8,7 @@
 #include <utility>
 
 #include "rcm/frontend/image_preprocessing.h"
-#include "rcm/io/number_format.h"
+#include "rcm/util/number_format.h"
 
 namespace rcm {
 namespace {
@@ -151,8 +151,8 @@ void LivePipeline::StartBuild(double n) {
 
 bool LivePipeline::CollectBuild(bool wait) {
   if (!pending_.valid()) return false;
-  if (!wait && pending_.wait_for(std::chrono::seconds(0)) !=
-                   std::future_status::ready) {
+  if (!wait &&
+      pending_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
     return false;
   }
   StatusOr<VirtualPinholeRig> built = pending_.get();
@@ -176,8 +176,7 @@ bool LivePipeline::WaitForMaps() { return CollectBuild(/*wait=*/true); }
 
 Status LivePipeline::Reset(std::optional<double> n) {
   if (n && !(*n >= 1.0 && *n <= 2.0)) {
-    return Status::Error("reset: n must be in [1, 2], not " +
-                         FormatDouble(*n));
+    return Status::Error("reset: n must be in [1, 2], not " + FormatDouble(*n));
   }
   StatusOr<SlidingWindowRefractiveIndexEstimator> estimator =
       SlidingWindowRefractiveIndexEstimator::Create(rig_, options_.refinement,
@@ -199,11 +198,11 @@ StatusOr<LiveFrame> LivePipeline::Process(const cv::Mat& left,
   const Camera& camera = rig_.left();
   if (valid.ok() &&
       (left.cols != camera.width() || left.rows != camera.height())) {
-    valid = Status::Error("the images are " + std::to_string(left.cols) +
-                          " x " + std::to_string(left.rows) +
-                          ", the calibration's " +
-                          std::to_string(camera.width()) + " x " +
-                          std::to_string(camera.height()));
+    valid =
+        Status::Error("the images are " + std::to_string(left.cols) + " x " +
+                      std::to_string(left.rows) + ", the calibration's " +
+                      std::to_string(camera.width()) + " x " +
+                      std::to_string(camera.height()));
   }
   if (valid.ok() && options_.min_contrast > 0.0) {
     const double contrast = std::min(Contrast(left), Contrast(right));
@@ -242,8 +241,8 @@ StatusOr<LiveFrame> LivePipeline::Process(const cv::Mat& left,
       estimator_.AddFrame(out.frame, matches);
   out.estimate_ms = Milliseconds(estimate_start);
   if (update.frame_estimate.ok()) {
-    guide_ = NextPairGuide(update.frame_estimate->n,
-                           update.frame_estimate->sigma_n);
+    guide_ =
+        NextPairGuide(update.frame_estimate->n, update.frame_estimate->sigma_n);
   } else {
     guide_.reset();
   }

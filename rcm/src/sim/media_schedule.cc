@@ -6,7 +6,7 @@
 #include <optional>
 #include <sstream>
 
-#include "rcm/io/number_format.h"
+#include "rcm/util/number_format.h"
 
 namespace rcm {
 namespace {

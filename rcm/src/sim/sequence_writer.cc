@@ -11,7 +11,7 @@
 #include "rcm/io/camchain.h"
 #include "rcm/io/correspondence_csv.h"
 #include "rcm/io/image_file.h"
-#include "rcm/io/number_format.h"
+#include "rcm/util/number_format.h"
 
 namespace rcm {
 namespace {

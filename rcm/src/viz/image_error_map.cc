@@ -8,10 +8,10 @@
 #include <opencv2/imgproc.hpp>
 #include <utility>
 
-#include "rcm/io/number_format.h"
-#include "rcm/viz/color_map.h"
-#include "rcm/viz/figure.h"
-#include "rcm/viz/line_plot.h"
+#include "rcm/plot/color_map.h"
+#include "rcm/plot/figure.h"
+#include "rcm/plot/line_plot.h"
+#include "rcm/util/number_format.h"
 
 namespace rcm {
 namespace {
@@ -98,7 +98,7 @@ struct ColorScale {
 };
 
 // ---------------------------------------------------------------------------
-// Drawing, on an rcm::Figure (rcm/viz/figure.h).
+// Drawing, on an rcm::Figure (rcm/plot/figure.h).
 
 // The dashes of the closed polygon `corners`: pieces `dash` long with
 // `gap` (> 0) between them, the pattern running on round the corners.
@@ -222,43 +222,6 @@ struct ArrowPlan {
 }  // namespace
 
 // ---------------------------------------------------------------------------
-
-Status ImageErrorField::Check() const {
-  const auto error = [](const std::string& what) {
-    return Status::Error("image error field: " + what);
-  };
-  if (image_width <= 0 || image_height <= 0) {
-    return error("image size " + Int(image_width) + " x " + Int(image_height) +
-                 " is not positive");
-  }
-  if (cols < 1 || rows < 1) {
-    return error("sample grid " + Int(cols) + " x " + Int(rows) + " is empty");
-  }
-  if (!(Finite(step) && step > 0.0)) {
-    return error("step " + FormatDouble(step) + " is not positive and finite");
-  }
-  if (!origin.allFinite()) {
-    return error("origin (" + FormatDouble(origin.x()) + ", " +
-                 FormatDouble(origin.y()) + ") is not finite");
-  }
-  const unsigned long long expected = static_cast<unsigned long long>(cols) *
-                                      static_cast<unsigned long long>(rows);
-  if (errors.size() != expected) {
-    return error(std::to_string(errors.size()) + " errors for a " + Int(cols) +
-                 " x " + Int(rows) + " grid, expected " +
-                 std::to_string(expected));
-  }
-  for (size_t i = 0; i < errors.size(); ++i) {
-    if (errors[i] && !errors[i]->allFinite()) {
-      const size_t c = static_cast<size_t>(cols);
-      return error("error (" + FormatDouble(errors[i]->x()) + ", " +
-                   FormatDouble(errors[i]->y()) + ") at column " +
-                   std::to_string(i % c) + ", row " + std::to_string(i / c) +
-                   " is not finite");
-    }
-  }
-  return Status::Ok();
-}
 
 Status ImageErrorMapOptions::Check() const {
   const auto error = [](const std::string& what) {

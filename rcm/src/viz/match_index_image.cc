@@ -1,13 +1,13 @@
 #include "rcm/viz/match_index_image.h"
 
-#include <algorithm>
-#include <cmath>
 #include <glog/logging.h>
 
+#include <algorithm>
+#include <cmath>
 #include <opencv2/imgproc.hpp>
 
-#include "rcm/io/number_format.h"
-#include "rcm/viz/color_map.h"
+#include "rcm/plot/color_map.h"
+#include "rcm/util/number_format.h"
 
 namespace rcm {
 namespace {
@@ -49,8 +49,8 @@ cv::Mat DrawMatchesByRefractiveIndex(
     const cv::Point center(static_cast<int>(std::lround(pixels[i].x())),
                            static_cast<int>(std::lround(pixels[i].y())));
     if (!n[i]) {
-      cv::circle(picture, center, options.radius, cv::Scalar(150, 150, 150),
-                 1, cv::LINE_AA);
+      cv::circle(picture, center, options.radius, cv::Scalar(150, 150, 150), 1,
+                 cv::LINE_AA);
       continue;
     }
     const cv::Vec3b color = Turbo(scale(*n[i]));
@@ -63,14 +63,15 @@ cv::Mat DrawMatchesByRefractiveIndex(
   const int height = picture.rows + kTitleHeight;
   cv::Mat canvas(height, width, CV_8UC3, kPaper);
   picture.copyTo(canvas(cv::Rect(0, kTitleHeight, picture.cols, picture.rows)));
-  cv::putText(canvas, options.title, cv::Point(8, 23),
-              cv::FONT_HERSHEY_SIMPLEX, 0.55, kInk, 1, cv::LINE_AA);
+  cv::putText(canvas, options.title, cv::Point(8, 23), cv::FONT_HERSHEY_SIMPLEX,
+              0.55, kInk, 1, cv::LINE_AA);
   // Color bar, high values on top.
   const int bar_x = picture.cols + kBarMargin;
   const int bar_top = kTitleHeight + 10;
   const int bar_height = picture.rows - 20;
   for (int y = 0; y < bar_height; ++y) {
-    const cv::Vec3b color = Turbo(1.0 - static_cast<double>(y) / (bar_height - 1));
+    const cv::Vec3b color =
+        Turbo(1.0 - static_cast<double>(y) / (bar_height - 1));
     cv::line(canvas, cv::Point(bar_x, bar_top + y),
              cv::Point(bar_x + kBarWidth - 1, bar_top + y),
              cv::Scalar(color[0], color[1], color[2]));
@@ -78,7 +79,8 @@ cv::Mat DrawMatchesByRefractiveIndex(
   cv::rectangle(canvas, cv::Rect(bar_x, bar_top, kBarWidth, bar_height), kInk);
   for (int k = 0; k < kTicks; ++k) {
     const double t = static_cast<double>(k) / (kTicks - 1);
-    const int y = bar_top + static_cast<int>(std::lround((1.0 - t) * (bar_height - 1)));
+    const int y =
+        bar_top + static_cast<int>(std::lround((1.0 - t) * (bar_height - 1)));
     cv::line(canvas, cv::Point(bar_x + kBarWidth, y),
              cv::Point(bar_x + kBarWidth + 4, y), kInk);
     cv::putText(canvas, FormatFixed(low + t * 2.0 * options.half_range, 3),

@@ -24,8 +24,8 @@
 #include "rcm/calib/cross_validation.h"
 #include "rcm/calib/stereo_calibration.h"
 #include "rcm/calib/underwater_calibration.h"
-#include "rcm/geometry/stereo_rig.h"
 #include "rcm/io/calibration_covariance_file.h"
+#include "rcm/stereo/stereo_rig.h"
 
 namespace rcm::calib {
 

@@ -1,11 +1,11 @@
 // Underwater refinement of a stereo rig calibrated in air: the refractive
 // index n of the water, the extrinsics cam1_from_cam0 as they are under
 // water (housings drift: a few tenths of a degree move the epipolar
-// estimate of n across its whole range, DESIGN.md Sec. 7) and optionally
-// the ports' air gaps and tilts, from ~20 views of a planar target shown to
-// the rig at the start of a dive. The lens intrinsics of the air
-// calibration are held fixed: water does not change a lens, and the port
-// model is what distinguishes refraction from distortion.
+// estimate of n across its whole range, docs/design.md, "Rigs that drift")
+// and optionally the ports' air gaps and tilts, from ~20 views of a planar
+// target shown to the rig at the start of a dive. The lens intrinsics of
+// the air calibration are held fixed: water does not change a lens, and
+// the port model is what distinguishes refraction from distortion.
 //
 // Unknowns:
 //   n                  in [1, 2]
@@ -104,7 +104,7 @@
 #include "rcm/calib/target_observation.h"
 #include "rcm/camera/flat_port_geometry.h"
 #include "rcm/geometry/rigid3d.h"
-#include "rcm/geometry/stereo_rig.h"
+#include "rcm/stereo/stereo_rig.h"
 #include "rcm/util/status.h"
 
 namespace rcm::calib {

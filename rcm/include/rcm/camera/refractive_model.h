@@ -2,10 +2,10 @@
 // camera behind a thin flat port whose normal is the optical axis, the port
 // and the lens center at negligible distance.
 //
-// Notation (DESIGN.md Sec. 1): (xb, yb) are the lens-undistorted normalized
-// coordinates of a pixel, i.e. the tangent of the ray in air,
-// rb^2 = xb^2 + yb^2 = tan^2(theta_a); theta_w is the angle of the same ray
-// in the medium of refractive index n.
+// Notation (docs/design.md, "The refractive model"): (xb, yb) are the
+// lens-undistorted normalized coordinates of a pixel, i.e. the tangent of
+// the ray in air, rb^2 = xb^2 + yb^2 = tan^2(theta_a); theta_w is the
+// angle of the same ray in the medium of refractive index n.
 //
 //   Snell (eq. 1):         sin(theta_a) = n sin(theta_w)
 //   Radial factor (eq. 5): m(n, rb) = tan(theta_a) / tan(theta_w)

@@ -1,5 +1,5 @@
 // Joint refinement of the refractive index n over captured stereo pairs:
-// the estimator of record (DESIGN.md Sec. 2).
+// the estimator of record (docs/design.md, "The estimator of record").
 //
 // One Ceres problem over all correspondences of all frames, with one
 // Sampson coplanarity residual each (sampson_coplanarity_error.h), n
@@ -19,9 +19,10 @@
 //   crlb       = sigma_px / sqrt(sum_i (dr_i/dn)^2)
 //
 // crlb is the Cramer-Rao bound (as a standard deviation) of n with the
-// extrinsics known (DESIGN.md: 1 / sum (de_i/dn)^2 / sigma_px^2 is its
-// square). With n alone sigma_n equals it; with the rotation correction,
-// sigma_n >= crlb shows what estimating the rotation costs.
+// extrinsics known (docs/design.md, "The estimator of record":
+// 1 / sum (de_i/dn)^2 / sigma_px^2 is its square). With n alone sigma_n
+// equals it; with the rotation correction, sigma_n >= crlb shows what
+// estimating the rotation costs.
 //
 // Rotation correction (options.refine_rotation): a small rotation of cam1
 // about its own center (sampson_coplanarity_error.h). The pixel-space
@@ -43,7 +44,7 @@
 #include "rcm/estimation/calibration_propagation.h"
 #include "rcm/estimation/refinement_options.h"
 #include "rcm/geometry/stereo_correspondence.h"
-#include "rcm/geometry/stereo_rig.h"
+#include "rcm/stereo/stereo_rig.h"
 #include "rcm/util/status.h"
 
 namespace rcm {

@@ -36,9 +36,9 @@
 #include <vector>
 
 #include "rcm/camera/camera.h"
+#include "rcm/estimation/image_error_field.h"
 #include "rcm/estimation/pixel_error_stats.h"
 #include "rcm/util/status.h"
-#include "rcm/viz/image_error_map.h"
 
 namespace rcm {
 

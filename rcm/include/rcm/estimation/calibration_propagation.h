@@ -137,7 +137,7 @@
 #include "rcm/estimation/prepared_correspondence.h"
 #include "rcm/geometry/calibration_uncertainty.h"
 #include "rcm/geometry/stereo_correspondence.h"
-#include "rcm/geometry/stereo_rig.h"
+#include "rcm/stereo/stereo_rig.h"
 #include "rcm/util/status.h"
 
 namespace rcm {

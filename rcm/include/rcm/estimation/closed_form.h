@@ -11,7 +11,8 @@
 // the same value with less cancellation. It is exact on exact data, but ill
 // conditioned near the image axes and for distant points (a -> 0 and
 // yl -> yr), so noisy data give heavy tails and undefined values: it is a
-// seed and the paper's baseline, not the estimator of record (DESIGN.md).
+// seed and the paper's baseline, not the estimator of record
+// (docs/design.md, "The estimator of record").
 #ifndef RCM_ESTIMATION_CLOSED_FORM_H_
 #define RCM_ESTIMATION_CLOSED_FORM_H_
 

@@ -1,5 +1,5 @@
-// The Cramer-Rao bound of n from a set of correspondences (DESIGN.md
-// Sec. 2), as a standard deviation:
+// The Cramer-Rao bound of n from a set of correspondences (docs/design.md,
+// "The estimator of record"), as a standard deviation:
 //
 //   crlb = sigma_px / sqrt(sum_i (dr_i/dn)^2),
 //
@@ -17,7 +17,7 @@
 
 #include "rcm/estimation/prepared_correspondence.h"
 #include "rcm/geometry/stereo_correspondence.h"
-#include "rcm/geometry/stereo_rig.h"
+#include "rcm/stereo/stereo_rig.h"
 
 namespace rcm {
 

@@ -7,8 +7,8 @@
 #include <Eigen/Core>
 #include <string_view>
 
+#include "rcm/estimation/image_error_field.h"
 #include "rcm/util/status.h"
-#include "rcm/viz/image_error_map.h"
 
 namespace rcm {
 

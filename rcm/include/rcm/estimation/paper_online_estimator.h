@@ -27,7 +27,8 @@
 //     spread / RMS reported value stays within 0.97-1.02.
 //
 // The estimator assumes an ideal rectified rig; on other rigs it is biased
-// (DESIGN.md Sec. 2 measured 1.26 for a true 1.338 at 0.5 degrees).
+// (docs/design.md, "The estimator of record"; 1.26 was measured for a
+// true 1.338 at 0.5 degrees).
 #ifndef RCM_ESTIMATION_PAPER_ONLINE_ESTIMATOR_H_
 #define RCM_ESTIMATION_PAPER_ONLINE_ESTIMATOR_H_
 
@@ -36,7 +37,7 @@
 #include <optional>
 
 #include "rcm/geometry/stereo_correspondence.h"
-#include "rcm/geometry/stereo_rig.h"
+#include "rcm/stereo/stereo_rig.h"
 #include "rcm/util/status.h"
 
 namespace rcm {

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "rcm/geometry/stereo_correspondence.h"
-#include "rcm/geometry/stereo_rig.h"
+#include "rcm/stereo/stereo_rig.h"
 #include "rcm/util/status.h"
 
 namespace rcm {

@@ -1,6 +1,7 @@
-// The residual of the estimator of record (DESIGN.md Sec. 2): how far a
-// correspondence lies from the refractive epipolar locus of a refractive
-// index n, in pixels, for a general calibrated rig (no rectification).
+// The residual of the estimator of record (docs/design.md, "The estimator
+// of record"): how far a correspondence lies from the refractive epipolar
+// locus of a refractive index n, in pixels, for a general calibrated rig
+// (no rectification).
 //
 // Coplanarity of the two water-side bearings (epipolar.h; the paper's
 // eqs. 10-11 without the rectification of Sec. III-C):

@@ -78,7 +78,7 @@
 #include "rcm/estimation/online_estimator.h"
 #include "rcm/estimation/refinement_options.h"
 #include "rcm/geometry/stereo_correspondence.h"
-#include "rcm/geometry/stereo_rig.h"
+#include "rcm/stereo/stereo_rig.h"
 #include "rcm/util/status.h"
 
 namespace rcm {

@@ -37,7 +37,7 @@
 #include "rcm/estimation/batch_refinement.h"
 #include "rcm/estimation/refinement_options.h"
 #include "rcm/geometry/stereo_correspondence.h"
-#include "rcm/geometry/stereo_rig.h"
+#include "rcm/stereo/stereo_rig.h"
 #include "rcm/util/status.h"
 
 namespace rcm {

@@ -8,13 +8,13 @@
 //
 // Why a central model can: behind a thin port the refractive camera is
 // central (every ray in the medium passes through the camera center,
-// DESIGN.md Sec. 1), so only its radial profile changes: the raw pixel at
-// air angle theta_a sees the medium at theta_w = asin(sin(theta_a) / n)
-// (Snell, paper eq. 1), and the fitted lens has to image theta_w at that
-// pixel. Its polynomial follows the profile near the center and departs
-// from it toward the corners, where theta_a reaches 80 degrees on the
-// dataset's fisheye: the fit error is reported over the whole image and
-// over an inset region.
+// docs/design.md, "The refractive model"), so only its radial profile
+// changes: the raw pixel at air angle theta_a sees the medium at
+// theta_w = asin(sin(theta_a) / n) (Snell, paper eq. 1), and the fitted
+// lens has to image theta_w at that pixel. Its polynomial follows the
+// profile near the center and departs from it toward the corners, where
+// theta_a reaches 80 degrees on the dataset's fisheye: the fit error is
+// reported over the whole image and over an inset region.
 //
 // The fit. Pixels p_i on a grid over the raw image (every
 // options.grid_step pixels, centered), their rays in the medium
@@ -26,10 +26,10 @@
 // over the samples at least options.fit_inset of the width (height) from
 // the left and right (top and bottom) borders. Levenberg-Marquardt from
 // K_n = (n fx, n fy, cx, cy) with zero distortion (the virtual pinhole,
-// paper eq. 9; for the EUCM alpha = 0, beta = 1, its pinhole). Deterministic: there is no measurement noise, only model
-// error, so no covariance is reported; the figures of merit are the fit
-// errors. At n = 1 with M the camera's own lens model the fit returns the
-// camera itself.
+// paper eq. 9; for the EUCM alpha = 0, beta = 1, its pinhole). Deterministic:
+// there is no measurement noise, only model error, so no covariance is
+// reported; the figures of merit are the fit errors. At n = 1 with M the
+// camera's own lens model the fit returns the camera itself.
 #ifndef RCM_ESTIMATION_WATER_SIDE_MODEL_FIT_H_
 #define RCM_ESTIMATION_WATER_SIDE_MODEL_FIT_H_
 
@@ -37,9 +37,9 @@
 
 #include "rcm/camera/camera.h"
 #include "rcm/camera/refractive_camera.h"
+#include "rcm/estimation/image_error_field.h"
 #include "rcm/estimation/pixel_error_stats.h"
 #include "rcm/util/status.h"
-#include "rcm/viz/image_error_map.h"
 
 namespace rcm {
 

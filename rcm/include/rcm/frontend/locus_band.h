@@ -40,8 +40,8 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
-#include "rcm/geometry/stereo_rectification.h"
-#include "rcm/geometry/stereo_rig.h"
+#include "rcm/stereo/stereo_rectification.h"
+#include "rcm/stereo/stereo_rig.h"
 #include "rcm/util/status.h"
 
 namespace rcm {
@@ -57,8 +57,8 @@ struct RefractiveIndexInterval {
   double Width() const { return max - min; }
 
   // n +- max(sigmas * sigma_n, min_half_width), clipped to [1, 2].
-  static RefractiveIndexInterval Around(double n, double sigma_n,
-                                        double sigmas, double min_half_width);
+  static RefractiveIndexInterval Around(double n, double sigma_n, double sigmas,
+                                        double min_half_width);
 };
 
 // A keypoint's ray at both ends of the interval; `valid` is false when the
@@ -90,10 +90,10 @@ class LocusBand {
                                     const LocusBandOptions& options);
 
   // Keys of raw pixels of the left / right camera.
-  std::vector<LocusKey> LeftKeys(const std::vector<cv::KeyPoint>& keypoints)
-      const;
-  std::vector<LocusKey> RightKeys(const std::vector<cv::KeyPoint>& keypoints)
-      const;
+  std::vector<LocusKey> LeftKeys(
+      const std::vector<cv::KeyPoint>& keypoints) const;
+  std::vector<LocusKey> RightKeys(
+      const std::vector<cv::KeyPoint>& keypoints) const;
   LocusKey LeftKey(const Eigen::Vector2d& pixel) const;
   LocusKey RightKey(const Eigen::Vector2d& pixel) const;
 

@@ -33,7 +33,7 @@
 #include "rcm/frontend/locus_band.h"
 #include "rcm/frontend/subpixel_refinement.h"
 #include "rcm/geometry/stereo_correspondence.h"
-#include "rcm/geometry/stereo_rig.h"
+#include "rcm/stereo/stereo_rig.h"
 #include "rcm/util/status.h"
 
 namespace rcm {
@@ -86,7 +86,7 @@ struct StereoMatches {
   std::vector<StereoCorrespondence> matches;  // raw pixels
   int left_keypoints = 0;
   int right_keypoints = 0;
-  int descriptor_matches = 0;  // after stage 3
+  int descriptor_matches = 0;    // after stage 3
   RefractiveIndexInterval band;  // the interval the matches were found in
   bool reacquired = false;       // a guided frame matched again (above)
   FrontEndTimings timings;

@@ -53,7 +53,7 @@
 #include "rcm/camera/camera.h"
 #include "rcm/camera/flat_port_geometry.h"
 #include "rcm/geometry/rigid3d.h"
-#include "rcm/geometry/stereo_rig.h"
+#include "rcm/stereo/stereo_rig.h"
 #include "rcm/util/status.h"
 
 namespace rcm {

@@ -43,7 +43,7 @@
 #include <vector>
 
 #include "rcm/camera/camera.h"
-#include "rcm/geometry/stereo_rig.h"
+#include "rcm/stereo/stereo_rig.h"
 #include "rcm/util/status.h"
 
 namespace rcm {

@@ -1,4 +1,5 @@
-// Reading and writing stereo correspondence files (DESIGN.md Sec. 3).
+// Reading and writing stereo correspondence files (docs/design.md,
+// "Conventions").
 //
 // Format: comma-separated text with a REQUIRED header row naming the
 // columns, e.g.

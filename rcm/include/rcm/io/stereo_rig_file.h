@@ -28,7 +28,7 @@
 #include <string>
 #include <utility>
 
-#include "rcm/geometry/stereo_rig.h"
+#include "rcm/stereo/stereo_rig.h"
 #include "rcm/util/status.h"
 
 namespace rcm {

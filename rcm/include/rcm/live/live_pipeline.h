@@ -26,20 +26,20 @@
 // first pair processed after the build has finished uses the new maps
 // (LiveFrame::maps_updated). One build at a time: if n has moved on when
 // it finishes, the next pair starts another. A build costs 47-77 ms (over
-// this machine's runs) for 720x540 on one core (benchmarks/live_benchmark.cc), about a pair's whole
-// period at 20 Hz, hence the worker.
+// this machine's runs) for 720x540 on one core (benchmarks/live_benchmark.cc),
+// about a pair's whole period at 20 Hz, hence the worker.
 //
 // Cost per 720x540 pair (live_benchmark, this project's 2-core machine):
 // the window's update of all ~1200 matches and both remaps take 72 ms of
 // CPU for a rig read as `rcm` reads a camchain without a sidecar (the
 // default drift and focal drift priors: each pair's refinement estimates
 // cam1's rotation and both focal scales with n, and its normal equations,
-// taken at the window's rotation, carry the lenses' columns), 18-20 ms for a rig without them; the front
-// end's matching adds ~31-38 ms (on both cores). With all matches a pair
-// therefore takes ~100 ms of wall time: about 10 pairs a second, the rest
-// dropped whole by the caller (latest_slot.h). max_matches 400 takes the
-// estimation to 27 ms, for 20 Hz. The map threshold's default, 1e-3,
-// moves the corrected images' focal length by 0.1 %, below what a metric
+// taken at the window's rotation, carry the lenses' columns), 18-20 ms for a
+// rig without them; the front end's matching adds ~31-38 ms (on both cores).
+// With all matches a pair therefore takes ~100 ms of wall time: about 10 pairs
+// a second, the rest dropped whole by the caller (latest_slot.h). max_matches
+// 400 takes the estimation to 27 ms, for 20 Hz. The map threshold's default,
+// 1e-3, moves the corrected images' focal length by 0.1 %, below what a metric
 // depth of 1 % needs.
 //
 // Hold (SetHold): the maps stay at their n and no build starts; the
@@ -56,15 +56,15 @@
 #include <cstdint>
 #include <future>
 #include <memory>
-#include <optional>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <vector>
 
-#include "rcm/camera/virtual_pinhole_rig.h"
 #include "rcm/estimation/refinement_options.h"
 #include "rcm/estimation/sliding_window_estimator.h"
 #include "rcm/frontend/stereo_front_end.h"
-#include "rcm/geometry/stereo_rig.h"
+#include "rcm/stereo/stereo_rig.h"
+#include "rcm/stereo/virtual_pinhole_rig.h"
 #include "rcm/util/status.h"
 
 namespace rcm {
@@ -105,9 +105,9 @@ struct LivePipelineOptions {
 
 // What one pair gave.
 struct LiveFrame {
-  int64_t frame = 0;   // 0, 1, ... in the order of Process calls accepted
-  double stamp = 0.0;  // the caller's, unchanged
-  int64_t num_matches = 0;    // the front end's
+  int64_t frame = 0;        // 0, 1, ... in the order of Process calls accepted
+  double stamp = 0.0;       // the caller's, unchanged
+  int64_t num_matches = 0;  // the front end's
   int64_t num_estimated = 0;  // of them, the window's (max_matches)
   // The window estimate after this pair, or why there is none.
   StatusOr<SlidingWindowRefractiveIndexEstimator::Estimate> estimate =

@@ -49,10 +49,10 @@
 #include "rcm/camera/flat_port.h"
 #include "rcm/camera/flat_port_camera.h"
 #include "rcm/geometry/rigid3d.h"
-#include "rcm/geometry/stereo_rig.h"
 #include "rcm/sim/scene_board.h"
 #include "rcm/sim/tank_scene.h"
 #include "rcm/sim/trajectory.h"
+#include "rcm/stereo/stereo_rig.h"
 #include "rcm/util/status.h"
 
 namespace rcm {

@@ -6,13 +6,13 @@
 #include <cmath>
 
 #include "rcm/camera/camera.h"
-#include "rcm/geometry/stereo_rig.h"
+#include "rcm/stereo/stereo_rig.h"
 
 namespace rcm {
 
 // The front stereo pair of the paper's dataset (Alphasense Core, 720x540,
-// equidistant, calibrated in air with Kalibr; DESIGN.md Sec. 5). Its image
-// corners see rays 82.7 degrees off axis.
+// equidistant, calibrated in air with Kalibr; docs/design.md,
+// "The reference rig"). Its image corners see rays 82.7 degrees off axis.
 Camera AlphasenseFrontCam0();
 Camera AlphasenseFrontCam1();
 
@@ -29,11 +29,11 @@ StereoRig AlphasenseFrontRectifiedRig();
 StereoRig AlphasenseFrontUnrectifiedRig();
 
 // A narrow-field pair in a hand-built housing, like the rig of the sea
-// dives whose extrinsics drifted (DESIGN.md Sec. 7): two 640x480 pinhole
-// cameras with mild radtan distortion (k1 ~ -0.12, k2 ~ 0.05, p ~ 1e-4)
-// and slightly different intrinsics, f ~ 500 px (a field of view of
-// about 67 by 52 degrees in air, 49 by 38 in water), 65 mm apart along x
-// and toed in:
+// dives whose extrinsics drifted (docs/design.md, "Rigs that drift"): two
+// 640x480 pinhole cameras with mild radtan distortion (k1 ~ -0.12,
+// k2 ~ 0.05, p ~ 1e-4) and slightly different intrinsics, f ~ 500 px (a
+// field of view of about 67 by 52 degrees in air, 49 by 38 in water),
+// 65 mm apart along x and toed in:
 //
 //   cam1_from_cam0 = (Ry(+2.5 deg), -Ry(+2.5 deg) (0.065, 0, 0)),
 //

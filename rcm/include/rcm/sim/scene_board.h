@@ -1,6 +1,6 @@
 // SceneBoard: a printed chessboard calibration target as an object of the
 // simulated pool, as a diver holds it in front of the rig (an underwater
-// target calibration, DESIGN.md Sec. 7).
+// target calibration, docs/design.md, "Rigs that drift").
 //
 // Target frame: EXACTLY that of rcm::calib's checkerboard
 // (calib/calibration_target.h TargetPoints, calib/target_image.h), so that

@@ -44,7 +44,6 @@
 #include "rcm/camera/flat_port.h"
 #include "rcm/geometry/rigid3d.h"
 #include "rcm/geometry/stereo_correspondence.h"
-#include "rcm/geometry/stereo_rig.h"
 #include "rcm/sim/board_motion.h"
 #include "rcm/sim/exposure_delay.h"
 #include "rcm/sim/media_schedule.h"
@@ -52,6 +51,7 @@
 #include "rcm/sim/stereo_renderer.h"
 #include "rcm/sim/tank_scene.h"
 #include "rcm/sim/trajectory.h"
+#include "rcm/stereo/stereo_rig.h"
 #include "rcm/util/status.h"
 
 namespace rcm {

@@ -54,9 +54,9 @@
 
 #include "rcm/camera/flat_port.h"
 #include "rcm/geometry/rigid3d.h"
-#include "rcm/geometry/stereo_rig.h"
 #include "rcm/sim/scene_board.h"
 #include "rcm/sim/tank_scene.h"
+#include "rcm/stereo/stereo_rig.h"
 #include "rcm/util/status.h"
 
 namespace rcm {

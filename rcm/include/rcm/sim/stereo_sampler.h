@@ -22,9 +22,9 @@
 
 #include "rcm/camera/flat_port.h"
 #include "rcm/geometry/stereo_correspondence.h"
-#include "rcm/geometry/stereo_rig.h"
 #include "rcm/sim/exposure_delay.h"
 #include "rcm/sim/non_rigid_layer.h"
+#include "rcm/stereo/stereo_rig.h"
 #include "rcm/util/status.h"
 
 namespace rcm {

@@ -12,7 +12,7 @@
 //   yaw     heading = path tangent + yaw_amplitude sin(...)
 //   rock    pitch and roll wobbles of rock_amplitude
 // The camera looks along the heading, `pitch` below the horizontal; its
-// frame is x right, y down, z forward (DESIGN.md Sec. 3):
+// frame is x right, y down, z forward (docs/design.md, "Conventions"):
 //   z = (cos p cos psi, cos p sin psi, -sin p),  x0 = (sin psi, -cos psi, 0),
 //   y0 = z cross x0, then x, y rotated by the roll about z;
 // world_from_cam0 has columns (x, y, z) and translation the camera center.

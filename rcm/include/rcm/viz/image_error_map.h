@@ -15,36 +15,15 @@
 #define RCM_VIZ_IMAGE_ERROR_MAP_H_
 
 #include <Eigen/Core>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include <opencv2/core.hpp>
-
+#include "rcm/estimation/image_error_field.h"
 #include "rcm/util/status.h"
 
 namespace rcm {
-
-// Samples on a regular grid over the image (row-major: sample
-// row * cols + col at pixel origin + (col, row) * step).
-struct ImageErrorField {
-  int image_width = 0;
-  int image_height = 0;
-  int cols = 0;
-  int rows = 0;
-  Eigen::Vector2d origin = Eigen::Vector2d::Zero();
-  double step = 1.0;
-  // cols * rows error vectors in pixels; nullopt where there is no value
-  // (the model does not reach that pixel).
-  std::vector<std::optional<Eigen::Vector2d>> errors;
-
-  // Image size positive, grid at least 1 x 1 with step > 0 and finite
-  // origin, errors.size() == cols * rows, every present error finite.
-  Status Check() const;
-  Eigen::Vector2d Pixel(int col, int row) const {
-    return origin + step * Eigen::Vector2d(col, row);
-  }
-};
 
 struct ImageErrorMapOptions {
   // Title line above the image, e.g. "cam0: equidistant fit to the
