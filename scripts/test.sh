@@ -1,14 +1,16 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds, and runs every test (ctest, two jobs):
-# the Release build (build/) and its statistical and accuracy tests; the
-# installed package (scripts/test_install.sh: a consumer project, the
-# Python package and its pytest suite, the docs' snippets); then the
-# suite built with clang under AddressSanitizer and
-# UndefinedBehaviorSanitizer, every test the Release pass did not run
-# (scripts/test_passes.sh says which pass runs what), followed by a short
-# run of each fuzz target (scripts/test_sanitizers.sh, build-sanitize/).
-# Each step's wall time is printed when it ends (CI must stay under 40
-# minutes on 2 cores).
+# Installs what is missing, builds, checks that the libraries' includes
+# point down their layers (scripts/check_layers.py) and that
+# docs/layout.md is true to the tree (scripts/check_layout.py), and runs
+# every test (ctest, two jobs): the Release build (build/) and its
+# statistical and accuracy tests; the installed package
+# (scripts/test_install.sh: a consumer project, the Python package and its
+# pytest suite, the docs' snippets); then the suite built with clang under
+# AddressSanitizer and UndefinedBehaviorSanitizer, every test the Release
+# pass did not run (scripts/test_passes.sh says which pass runs what),
+# followed by a short run of each fuzz target (scripts/test_sanitizers.sh,
+# build-sanitize/). Each step's wall time is printed when it ends (CI must
+# stay under 40 minutes on 2 cores).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 start=$SECONDS
@@ -23,6 +25,11 @@ step() {
 # entry per test (ctest -R NAME), configure build/ with -DRCM_TEST_SHARDS=0.
 export RCM_TEST_SHARDS=6
 step ./scripts/build.sh -DRCM_TEST_SHARDS="$RCM_TEST_SHARDS"
+# The libraries' includes point down their layers, and docs/layout.md is
+# true to the tree (a second each; after the build, whose setup.sh
+# installs Debian's python3).
+step /usr/bin/python3 scripts/check_layers.py
+step /usr/bin/python3 scripts/check_layout.py
 # The Release pass runs the tests whose statistics or accuracy only it
 # checks (release_only, budgeted: scripts/test_passes.sh) and the node's
 # test; every other test runs once, in the sanitizer pass, which catches

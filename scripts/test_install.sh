@@ -32,6 +32,14 @@ soname=$(readelf -d "$prefix"/lib/librcm.so | sed -n 's/.*SONAME.*\[\(.*\)\]/\1/
   echo "test_install: librcm.so has SONAME '$soname', expected librcm.so.0.2" >&2
   exit 1
 }
+# rcm::rcm stands without the libraries on top of it: the simulator, the
+# pictures and the bags are libraries of their own (scripts/check_layers.py).
+for library in rcm_sim rcm_viz rcm_rosbag rcm_calib; do
+  if readelf -d "$prefix"/lib/librcm.so | grep -q "NEEDED.*lib$library"; then
+    echo "test_install: librcm.so needs lib$library" >&2
+    exit 1
+  fi
+done
 echo "installed $(find "$prefix" -type f | wc -l) files; SONAME $soname"
 
 echo "== examples/consumer against the install tree"
