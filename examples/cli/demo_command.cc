@@ -19,13 +19,14 @@
 #include "rcm/camera/refractive_camera.h"
 #include "rcm/camera/virtual_pinhole_remap.h"
 #include "rcm/estimation/batch_refinement.h"
+#include "rcm/estimation/estimate_json.h"
 #include "rcm/estimation/prepared_correspondence.h"
 #include "rcm/estimation/robust_locus_fit.h"
-#include "rcm/estimation/sliding_window_estimator.h"
 #include "rcm/frontend/stereo_front_end.h"
 #include "rcm/io/atomic_file.h"
 #include "rcm/io/image_file.h"
 #include "rcm/io/stereo_rig_file.h"
+#include "rcm/live/sequence_estimator.h"
 #include "rcm/plot/line_plot.h"
 #include "rcm/sim/sequence_simulator.h"
 #include "rcm/stereo/epipolar.h"
@@ -230,7 +231,7 @@ cv::Mat PlotNPerFrame(const std::vector<FrameResult>& frames, double n_final,
 
 // What the self-calibration found of cam1's rotation, against the
 // simulated drift.
-std::string DriftLine(const RefinementSummary& estimate,
+std::string DriftLine(const RefractiveIndexEstimate& estimate,
                       const ExtrinsicDrift& drift) {
   if (!estimate.rotation) return "";
   const Eigen::Vector3d found = estimate.rotation->angle_axis * 180.0 / M_PI;
@@ -293,21 +294,15 @@ int RunDemo() {
             << simulator.media().ToString() << ", seed " << FLAGS_seed
             << std::endl;
 
-  StatusOr<SlidingWindowRefractiveIndexEstimator> window =
-      SlidingWindowRefractiveIndexEstimator::Create(rig, refinement,
-                                                    SlidingWindowOptions());
-  CHECK(window.ok()) << window.status().message();
-  StatusOr<StereoFrontEnd> front_end =
-      StereoFrontEnd::Create(rig, StereoFrontEndOptions());
-  CHECK(front_end.ok()) << front_end.status().message();
-  // The front end follows the window's self-calibrated rotation of cam1
-  // once it moves pixels by more than kRefollowPx (a rig that turned since
-  // its calibration would otherwise lose the matches outside its band).
-  constexpr double kRefollowPx = 0.5;
-  const double focal = std::max(rig.left().fx(), rig.right().fx());
-  Eigen::Vector3d followed = Eigen::Vector3d::Zero();
+  // The pair loop of the library (sequence_estimator.h), as `rcm estimate`
+  // on images runs it: guided matching, cam1's turn followed, the window,
+  // and the estimator of record over the frames of the current medium.
+  SequenceEstimatorOptions sequence_options;
+  sequence_options.estimation.refinement = refinement;
+  StatusOr<std::unique_ptr<SequenceEstimator>> sequence =
+      SequenceEstimator::Create(rig, sequence_options);
+  CHECK(sequence.ok()) << sequence.status().message();
   std::vector<FrameResult> results;
-  std::vector<StereoCorrespondence> since_switch;  // matches of this medium
   int first_frame_of_medium = 0;
   cv::Mat first_left;
   cv::Mat first_right;
@@ -325,67 +320,40 @@ int RunDemo() {
     }
     render_seconds += SecondsSince(tick);
     tick = Clock::now();
-    // Guided by the window's estimate once there is one (the front end
-    // re-acquires with its prior range when the medium changes).
-    std::optional<RefractiveIndexInterval> guide;
-    if (const auto current = window.value().Current(); current.ok()) {
-      guide = RefractiveIndexInterval::Around(current->n, current->sigma_n, 6.0,
-                                              0.01);
-    }
-    StatusOr<StereoMatches> matched = front_end->Match(
-        frame.value().left, frame.value().right, i, frame.value().t, guide);
-    if (!matched.ok()) {
-      PrintError(command, "frame " + std::to_string(i) + ": " +
-                              matched.status().message());
+    StatusOr<SequencePair> pair = (*sequence)->AddPair(
+        frame.value().left, frame.value().right, i, frame.value().t);
+    if (!pair.ok()) {
+      PrintError(command,
+                 "frame " + std::to_string(i) + ": " + pair.status().message());
       return kExitFailure;
     }
-    const std::vector<StereoCorrespondence>& matches = matched->matches;
-    match_seconds += SecondsSince(tick);
-    tick = Clock::now();
-    const SlidingWindowRefractiveIndexEstimator::WindowUpdate update =
-        window.value().AddFrame(i, matches);
-    if (update.window.ok() && update.window->rotation &&
-        (*update.window->rotation - followed).norm() * focal > kRefollowPx) {
-      followed = *update.window->rotation;
-      StatusOr<StereoFrontEnd> turned = StereoFrontEnd::Create(
-          rig.WithCam1Moved(followed).value(), StereoFrontEndOptions());
-      CHECK(turned.ok()) << turned.status().message();
-      front_end = std::move(turned);
-    }
-    estimate_seconds += SecondsSince(tick);
+    estimate_seconds += pair->estimate_ms / 1000.0;
+    match_seconds += SecondsSince(tick) - pair->estimate_ms / 1000.0;
 
     FrameResult result;
     result.frame = i;
     result.t = frame.value().t;
     result.n_true = frame.value().n;
-    result.matches = static_cast<int64_t>(matches.size());
-    if (update.frame_estimate.ok()) {
-      result.n_frame = update.frame_estimate.value().n;
-      result.sigma_frame = update.frame_estimate.value().sigma_n;
+    result.matches = static_cast<int64_t>(pair->matches.size());
+    if (pair->own.ok()) {
+      result.n_frame = pair->own->n;
+      result.sigma_frame = pair->own->sigma_n;
     }
-    if (update.window.ok()) {
-      result.n_window = update.window.value().n;
-      result.sigma_window = update.window.value().sigma_n;
+    if (pair->window.ok()) {
+      result.n_window = pair->window->n;
+      result.sigma_window = pair->window->sigma_n;
     }
-    result.medium_switch = update.medium_switch.has_value();
+    result.medium_switch = pair->medium_switch.has_value();
     if (result.medium_switch) {
-      // The new medium began at the switch's first frame: keep its
-      // matches, drop the older ones.
+      // The new medium began at the switch's first frame.
       result.switch_first_frame =
-          static_cast<int>(update.medium_switch->first_frame);
+          static_cast<int>(pair->medium_switch->first_frame);
       first_frame_of_medium = result.switch_first_frame;
-      since_switch.erase(
-          std::remove_if(since_switch.begin(), since_switch.end(),
-                         [&](const StereoCorrespondence& match) {
-                           return match.frame < first_frame_of_medium;
-                         }),
-          since_switch.end());
     }
-    since_switch.insert(since_switch.end(), matches.begin(), matches.end());
     if (i == 0) {
       first_left = frame.value().left;
       first_right = frame.value().right;
-      first_matches = matches;
+      first_matches = pair->matches;
     }
     results.push_back(result);
     std::cerr << "rcm demo: [" << (i + 1) << "/" << num_frames << "] "
@@ -397,17 +365,26 @@ int RunDemo() {
               << (result.medium_switch ? "  (medium switch)" : "") << std::endl;
   }
 
-  // The estimator of record over every frame of the current medium.
+  // The estimator of record over every frame of the current medium, solved
+  // once by the sequence.
   auto tick = Clock::now();
-  StatusOr<RefinementSummary> summary =
-      RefineRefractiveIndex(rig, since_switch, refinement);
+  StatusOr<RefractiveIndexEstimate> summary = (*sequence)->Estimate();
   estimate_seconds += SecondsSince(tick);
   if (!summary.ok()) {
     PrintError(command, "no estimate from the matched features: " +
                             summary.status().message());
     return kExitFailure;
   }
-  const RefinementSummary& estimate = summary.value();
+  std::vector<StereoCorrespondence> since_switch;  // matches of this medium
+  for (const FrameMatches& kept : (*sequence)->frames()) {
+    if (kept.frame < first_frame_of_medium) continue;
+    since_switch.insert(since_switch.end(), kept.matches.begin(),
+                        kept.matches.end());
+  }
+  for (const std::string& warning : summary->warnings) {
+    PrintWarning(command, warning);
+  }
+  const RefractiveIndexEstimate& estimate = summary.value();
   // The rig as the estimate found it: cam1 turned by the self-calibrated
   // rotation, for the corrected pictures.
   const StereoRig estimated_rig =
@@ -578,7 +555,7 @@ int RunDemo() {
       {"frames", num_frames},
       {"frames_used", num_frames - first_frame_of_medium},
       {"matches", since_switch.size()},
-      {"inliers", estimate.inliers.size()},
+      {"inliers", estimate.inliers},
       {"median_locus_distance_px",
        {{"assuming_air", JsonNumber(residual_air)},
         {"at_estimate", JsonNumber(residual_fit)}}},
@@ -587,6 +564,8 @@ int RunDemo() {
         {"lens_corrected_water_ignored", JsonNumber(row_gap_air)},
         {"refraction_corrected", JsonNumber(row_gap_water)}}},
       {"per_frame", per_frame},
+      // The estimate as `rcm estimate --json` prints it (the same keys).
+      {"estimate", nlohmann::json::parse(EstimateJson(estimate, -1))},
       {"simulation", SimulationFlagsJson(simulation.value())},
       {"seconds",
        {{"total", seconds},
@@ -616,9 +595,8 @@ int RunDemo() {
     return kExitOk;
   }
   std::cout << "rcm demo: n = " << FormatFixed(estimate.n, 5) << " +- "
-            << FormatFixed(estimate.sigma_n, 5) << " from "
-            << estimate.inliers.size() << " matched features in "
-            << (num_frames - first_frame_of_medium)
+            << FormatFixed(estimate.sigma_n, 5) << " from " << estimate.inliers
+            << " matched features in " << (num_frames - first_frame_of_medium)
             << (first_frame_of_medium > 0 ? " frames since the last switch"
                                           : " frames")
             << " (truth " << FormatFixed(truth, 5) << ", off by "

@@ -23,12 +23,9 @@
 #include "rcm/estimation/sliding_window_estimator.h"
 
 namespace rcm::python {
-namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // The keywords of RefinementOptions, named as its fields.
-std::vector<OptionField> RefinementFields(RefinementOptions* o) {
+std::vector<OptionField> RefinementOptionFields(RefinementOptions* o) {
   OptionField loss{
       "loss",
       [o](const py::handle& value) {
@@ -93,10 +90,14 @@ std::vector<OptionField> RefinementFields(RefinementOptions* o) {
           IntOption("num_threads", &o->num_threads)};
 }
 
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
 RefinementOptions RefinementOptionsFrom(const py::dict& kwargs,
                                         const std::string& function) {
   RefinementOptions options;
-  ApplyOptions(kwargs, RefinementFields(&options), function);
+  ApplyOptions(kwargs, RefinementOptionFields(&options), function);
   ThrowIfError(options.Check());
   return options;
 }
@@ -120,7 +121,7 @@ py::object ConsistencyDict(const std::optional<FrameConsistency>& c) {
 py::object CalibrationDict(const std::optional<CalibrationPropagation>& c) {
   if (!c) return py::none();
   py::dict d;
-  d["mode"] = RotationModeName(c->mode);
+  d["rotation"] = RotationModeName(c->mode);  // as the JSON's key
   d["source"] = c->source;
   d["sigma_n"] = c->sigma_n;
   d["sigma_n_noise"] = c->sigma_n_noise;
@@ -138,7 +139,7 @@ py::object CalibrationDict(const std::optional<CalibrationPropagation>& c) {
   d["dn_drotation"] = ToNumpy(c->dn_drotation);
   d["dn_dtranslation"] = ToNumpy(c->dn_dtranslation);
   d["rotation_multiple_correlation"] = c->rotation_multiple_correlation;
-  d["rotation_sigma_inflation"] = c->rotation_sigma_inflation;
+  d["sigma_inflation_if_free"] = c->rotation_sigma_inflation;
   d["rotation_covariance"] = ToNumpy(c->rotation_covariance);
   d["rotation_correlation_with_n"] = ToNumpy(c->rotation_correlation_with_n);
   return std::move(d);
@@ -470,7 +471,7 @@ runs.
       "default_refinement_options",
       []() {
         RefinementOptions options;
-        return OptionValues(RefinementFields(&options));
+        return OptionValues(RefinementOptionFields(&options));
       },
       "The keyword options of the estimators with their default values.");
 

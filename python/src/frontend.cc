@@ -12,7 +12,6 @@
 #include "rcm/frontend/stereo_front_end.h"
 
 namespace rcm::python {
-namespace {
 
 // StereoFrontEndOptions from keywords, named after the C++ fields, nested
 // structs flattened with their prefix (clahe_clip_limit = clahe.clip_limit).
@@ -65,6 +64,8 @@ StereoFrontEndOptions FrontEndOptionsFrom(const py::dict& kwargs,
   ThrowIfError(o.Check());
   return o;
 }
+
+namespace {
 
 // Match runs without the GIL and keeps state between frames: `mutex`
 // serializes calls from several Python threads.

@@ -18,7 +18,9 @@ PYBIND11_MODULE(_rcm, module) {
   rcm::python::BindVirtualPinhole(module);
   rcm::python::BindCorrespondences(module);
   rcm::python::BindEstimators(module);
+  rcm::python::BindEstimate(module);
   rcm::python::BindFrontEnd(module);
+  rcm::python::BindSequence(module);
   rcm::python::BindSimulation(module);
   rcm::python::BindCalibration(module);
 }

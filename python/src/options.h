@@ -11,6 +11,11 @@
 #include <string>
 #include <vector>
 
+namespace rcm {
+struct RefinementOptions;
+struct StereoFrontEndOptions;
+}  // namespace rcm
+
 namespace rcm::python {
 
 // One keyword: its name and how to store a Python value of it.
@@ -34,6 +39,14 @@ OptionField DoubleOption(const std::string& name, double* field,
 void ApplyOptions(const pybind11::dict& kwargs,
                   const std::vector<OptionField>& fields,
                   const std::string& function);
+// The keywords of RefinementOptions, named as its fields (estimators.cc).
+std::vector<OptionField> RefinementOptionFields(RefinementOptions* options);
+
+// StereoFrontEndOptions from keywords, nested fields flattened with their
+// prefix (frontend.cc); Check()ed.
+StereoFrontEndOptions FrontEndOptionsFrom(const pybind11::dict& kwargs,
+                                          const std::string& function);
+
 // {name: current value} of the fields.
 pybind11::dict OptionValues(const std::vector<OptionField>& fields);
 

@@ -96,3 +96,51 @@ def test_same_n_to_seventeen_digits(tmp_path):
                                      rcm.read_correspondences(csv_path))
     assert abs(py.n - cpp["n"]) <= 1e-12
     assert py.sigma_n == pytest.approx(cpp["sigma_n"], rel=1e-12)
+
+
+def same_value(py, cpp, where):
+    """py and cpp equal: numbers to 1e-12 relative, containers key by key."""
+    if isinstance(py, dict):
+        assert isinstance(cpp, dict) and set(py) == set(cpp), where
+        for key in py:
+            same_value(py[key], cpp[key], where + "." + key)
+    elif isinstance(py, list):
+        assert isinstance(cpp, list) and len(py) == len(cpp), where
+        for i, (a, b) in enumerate(zip(py, cpp)):
+            same_value(a, b, f"{where}[{i}]")
+    elif isinstance(py, float) or isinstance(cpp, float):
+        assert py == pytest.approx(cpp, rel=1e-12, abs=1e-15), where
+    else:
+        assert py == cpp, where
+
+
+@pytest.mark.parametrize("estimator", ["refine", "online", "window",
+                                       "closed-form"])
+def test_estimate_json_keys_mean_the_same(tmp_path, estimator):
+    # One estimate type and one JSON writer: rcm.Estimate.to_dict() and
+    # `rcm estimate --json` on the same matches with the same options have
+    # the same keys with the same values; the CLI adds only what it knows
+    # of its run (the rig file, the input, the medium).
+    rig = rcm.reference_rig("alphasense-unrectified")
+    rig_path = tmp_path / "rig.yaml"
+    rig.write(rig_path)
+    exact = rcm.sample_correspondences(rig, n=1.34, num_frames=4,
+                                       per_frame=200, seed=41)
+    csv_path = tmp_path / "m.csv"
+    rcm.write_correspondences(csv_path, rcm.add_pixel_noise(exact, 0.5,
+                                                            seed=42))
+    cpp = run_estimate(rig_path, csv_path, "--estimator", estimator,
+                       "--window", "3")
+    py = rcm.estimate_refractive_index(
+        rcm.read_stereo_rig(rig_path), rcm.read_correspondences(csv_path),
+        estimator=estimator, window_frames=3, detect_systematic=True)
+    as_dict = py.to_dict()
+    assert set(cpp) - set(as_dict) == {"medium", "rig", "matches"}
+    for key, value in as_dict.items():
+        same_value(value, cpp[key], key)
+    assert abs(py.n - cpp["n"]) <= 1e-12
+    # The attributes are the keys.
+    assert py.sigma_n == as_dict["sigma_n"]
+    assert py.warnings == as_dict["warnings"]
+    assert py.calibration == as_dict["calibration"]
+    assert py.estimator == estimator

@@ -404,6 +404,12 @@ class RcmRosNode {
       last_n_ = index.n;
       last_sigma_ = index.sigma_n;
       SetState(true, "estimating");
+      // The library's warnings (a stale calibration, ...), each throttled
+      // by its own cause: the words before its first ':' or '('.
+      for (const std::string& warning : frame.warnings) {
+        warnings_.Warn(warning.substr(0, warning.find_first_of(":(")),
+                       "rcm_ros_node: " + warning);
+      }
     } else {
       // No estimate is never a number: valid false, n NaN, the reason.
       ++num_no_estimate_;

@@ -7,6 +7,7 @@
 #include <string>
 #include <utility>
 
+#include "rcm/estimation/estimate_warnings.h"
 #include "rcm/frontend/image_preprocessing.h"
 #include "rcm/util/number_format.h"
 
@@ -44,16 +45,16 @@ double Contrast(const cv::Mat& image) {
 
 }  // namespace
 
-const std::vector<StereoCorrespondence>& SpreadSubset(
-    const std::vector<StereoCorrespondence>& all, int cap,
-    std::vector<StereoCorrespondence>* subset) {
-  const size_t size = all.size();
-  if (cap <= 0 || size <= static_cast<size_t>(cap)) return all;
-  const size_t count = static_cast<size_t>(cap);
-  subset->clear();
-  subset->reserve(count);
-  for (size_t k = 0; k < count; ++k) subset->push_back(all[k * size / count]);
-  return *subset;
+SequenceEstimatorOptions LiveSequenceOptions(
+    const LivePipelineOptions& options) {
+  SequenceEstimatorOptions sequence;
+  sequence.front_end = options.front_end;
+  sequence.estimation.estimator = EstimatorKind::kWindow;
+  sequence.estimation.refinement = options.refinement;
+  sequence.window = options.window;
+  sequence.window_matches = options.max_matches;
+  sequence.keep_frames = false;
+  return sequence;
 }
 
 RefinementOptions LivePipelineOptions::DefaultRefinement() {
@@ -108,13 +109,9 @@ Status LivePipelineOptions::Check() const {
 StatusOr<std::unique_ptr<LivePipeline>> LivePipeline::Create(
     const StereoRig& rig, const LivePipelineOptions& options) {
   RCM_RETURN_IF_ERROR(options.Check());
-  StatusOr<StereoFrontEnd> front_end =
-      StereoFrontEnd::Create(rig, options.front_end);
-  if (!front_end.ok()) return front_end.status();
-  StatusOr<SlidingWindowRefractiveIndexEstimator> estimator =
-      SlidingWindowRefractiveIndexEstimator::Create(rig, options.refinement,
-                                                    options.window);
-  if (!estimator.ok()) return estimator.status();
+  StatusOr<std::unique_ptr<SequenceEstimator>> sequence =
+      SequenceEstimator::Create(rig, LiveSequenceOptions(options));
+  if (!sequence.ok()) return sequence.status();
   StatusOr<VirtualPinholeRig> maps =
       VirtualPinholeRig::Create(rig, options.initial_n, options.correction);
   if (!maps.ok()) {
@@ -122,19 +119,17 @@ StatusOr<std::unique_ptr<LivePipeline>> LivePipeline::Create(
                                      FormatDouble(options.initial_n));
   }
   return std::unique_ptr<LivePipeline>(new LivePipeline(
-      rig, options, std::move(*front_end), std::move(*estimator),
+      rig, options, std::move(*sequence),
       std::make_shared<const VirtualPinholeRig>(std::move(*maps))));
 }
 
 LivePipeline::LivePipeline(const StereoRig& rig,
                            const LivePipelineOptions& options,
-                           StereoFrontEnd front_end,
-                           SlidingWindowRefractiveIndexEstimator estimator,
+                           std::unique_ptr<SequenceEstimator> sequence,
                            std::shared_ptr<const VirtualPinholeRig> maps)
     : rig_(rig),
       options_(options),
-      front_end_(std::move(front_end)),
-      estimator_(std::move(estimator)),
+      sequence_(std::move(sequence)),
       maps_(std::move(maps)) {}
 
 LivePipeline::~LivePipeline() {
@@ -178,12 +173,9 @@ Status LivePipeline::Reset(std::optional<double> n) {
   if (n && !(*n >= 1.0 && *n <= 2.0)) {
     return Status::Error("reset: n must be in [1, 2], not " + FormatDouble(*n));
   }
-  StatusOr<SlidingWindowRefractiveIndexEstimator> estimator =
-      SlidingWindowRefractiveIndexEstimator::Create(rig_, options_.refinement,
-                                                    options_.window);
-  if (!estimator.ok()) return estimator.status();
-  estimator_ = std::move(*estimator);
-  guide_.reset();
+  // A new window and no guide; the front end keeps following the
+  // rotation it follows.
+  RCM_RETURN_IF_ERROR(sequence_->Restart(sequence_->matching_rotation()));
   if (n && std::abs(*n - maps_->n()) > 0.0) {
     CollectBuild(/*wait=*/true);
     StartBuild(*n);
@@ -218,36 +210,26 @@ StatusOr<LiveFrame> LivePipeline::Process(const cv::Mat& left,
     return valid;
   }
 
-  // 2. Matches.
+  // 2-3. Matches and the window (the sequence engine).
   LiveFrame out;
   out.stamp = stamp;
   const auto match_start = std::chrono::steady_clock::now();
-  StatusOr<StereoMatches> matched =
-      front_end_.Match(left, right, next_frame_, stamp, guide_);
-  if (!matched.ok()) {
+  StatusOr<SequencePair> pair =
+      sequence_->AddPair(left, right, next_frame_, stamp);
+  if (!pair.ok()) {
     ++num_refused_;
-    return matched.status();
+    return pair.status();
   }
-  out.match_ms = Milliseconds(match_start);
+  out.estimate_ms = pair->estimate_ms;
+  out.match_ms = Milliseconds(match_start) - pair->estimate_ms;
   out.frame = next_frame_++;
-  out.num_matches = static_cast<int64_t>(matched->matches.size());
-
-  // 3. The window.
-  const auto estimate_start = std::chrono::steady_clock::now();
-  const std::vector<StereoCorrespondence>& matches =
-      SpreadSubset(matched->matches, options_.max_matches, &subset_);
-  out.num_estimated = static_cast<int64_t>(matches.size());
-  SlidingWindowRefractiveIndexEstimator::WindowUpdate update =
-      estimator_.AddFrame(out.frame, matches);
-  out.estimate_ms = Milliseconds(estimate_start);
-  if (update.frame_estimate.ok()) {
-    guide_ =
-        NextPairGuide(update.frame_estimate->n, update.frame_estimate->sigma_n);
-  } else {
-    guide_.reset();
+  out.num_matches = static_cast<int64_t>(pair->matches.size());
+  out.num_estimated = pair->num_estimated;
+  out.estimate = std::move(pair->window);
+  out.medium_switch = pair->medium_switch;
+  if (out.estimate.ok()) {
+    out.warnings = EstimateWarnings(EstimateFromPooled(rig_, *out.estimate));
   }
-  out.estimate = std::move(update.window);
-  out.medium_switch = update.medium_switch;
   out.held = hold_;
 
   // 4. The maps, then the corrected pair.

@@ -8,14 +8,16 @@
 //      frame: the gray standard deviation of either image below
 //      min_contrast). A refused pair is an error (one line), changes
 //      nothing and produces nothing;
-//   2. the front end (stereo_front_end.h) matches it, guided by the last
-//      pair's own estimate n_f +- max(6 sigma_f, 0.01) (as `rcm estimate`
-//      on images), or over the prior search range when there is none;
-//   3. the sliding-window estimator (sliding_window_estimator.h) takes the
-//      matches: the window's n and total sigma_n, and whether this pair
-//      confirmed a change of medium. No estimate (too few matches, n not
-//      observable, n pinned at the upper bound of [1, 2], which a stale
-//      calibration gives) is the estimate's error, never a number;
+//   2. the sequence engine (sequence_estimator.h, the pair loop `rcm
+//      estimate`, `rcm demo` and Python run too) matches it, guided by the
+//      last pair's own estimate n_f +- max(6 sigma_f, 0.01) or over the
+//      prior search range when there is none, and following cam1's
+//      self-calibrated turn; its sliding window (sliding_window_estimator.h)
+//      takes the matches: the window's n and total sigma_n, and whether
+//      this pair confirmed a change of medium. No estimate (too few
+//      matches, n not observable, n pinned at the upper bound of [1, 2],
+//      which a stale calibration gives) is the estimate's error, never a
+//      number;
 //   4. both images are remapped to the corrected pinhole pair
 //      (virtual_pinhole_rig.h) with the maps of n_maps.
 //
@@ -58,11 +60,13 @@
 #include <memory>
 #include <opencv2/core.hpp>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "rcm/estimation/refinement_options.h"
 #include "rcm/estimation/sliding_window_estimator.h"
 #include "rcm/frontend/stereo_front_end.h"
+#include "rcm/live/sequence_estimator.h"
 #include "rcm/stereo/stereo_rig.h"
 #include "rcm/stereo/virtual_pinhole_rig.h"
 #include "rcm/util/status.h"
@@ -114,6 +118,10 @@ struct LiveFrame {
       Status::Error("no estimate");
   // This pair confirmed a change of medium (the window restarted).
   std::optional<MediumSwitch> medium_switch;
+  // What the window's estimate says of the calibration and the data, one
+  // line each (estimate_warnings.h: a stale calibration, n and cam1's
+  // rotation hardly separable, ...), as `rcm estimate` prints them.
+  std::vector<std::string> warnings;
   bool held = false;
   // The corrected pair and its rig: the maps' n, and whether the maps
   // changed at this pair.
@@ -127,14 +135,6 @@ struct LiveFrame {
   double estimate_ms = 0.0;
   double remap_ms = 0.0;
 };
-
-// The matches the window takes of `all` (LivePipelineOptions::max_matches,
-// `cap`): all of them when cap is 0 or not below their number, else every
-// (size / cap)-th, which keeps the front end's spread over the image; the
-// subset is written into `subset` (its capacity reused).
-const std::vector<StereoCorrespondence>& SpreadSubset(
-    const std::vector<StereoCorrespondence>& all, int cap,
-    std::vector<StereoCorrespondence>* subset);
 
 class LivePipeline {
  public:
@@ -172,8 +172,7 @@ class LivePipeline {
 
  private:
   LivePipeline(const StereoRig& rig, const LivePipelineOptions& options,
-               StereoFrontEnd front_end,
-               SlidingWindowRefractiveIndexEstimator estimator,
+               std::unique_ptr<SequenceEstimator> sequence,
                std::shared_ptr<const VirtualPinholeRig> maps);
   // Puts a finished build in use; true when the maps changed.
   bool CollectBuild(bool wait);
@@ -181,20 +180,23 @@ class LivePipeline {
 
   StereoRig rig_;
   LivePipelineOptions options_;
-  StereoFrontEnd front_end_;
-  SlidingWindowRefractiveIndexEstimator estimator_;
+  std::unique_ptr<SequenceEstimator> sequence_;
   std::shared_ptr<const VirtualPinholeRig> maps_;
   std::future<StatusOr<VirtualPinholeRig>> pending_;
   double pending_n_ = 0.0;
-  std::optional<RefractiveIndexInterval> guide_;
   bool hold_ = false;
   int64_t next_frame_ = 0;
   int64_t num_refused_ = 0;
   int64_t num_failed_builds_ = 0;
   cv::Mat left_corrected_;
   cv::Mat right_corrected_;
-  std::vector<StereoCorrespondence> subset_;  // reused: no allocation
 };
+
+// The sequence engine's options of a live pipeline's: its front end,
+// refinement and window, the window estimate as the estimate, no frames
+// kept.
+SequenceEstimatorOptions LiveSequenceOptions(
+    const LivePipelineOptions& options);
 
 }  // namespace rcm
 
