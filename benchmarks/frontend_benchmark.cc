@@ -69,12 +69,25 @@
 //     straightforward                  4.1 pairs/s n_error +3.8e-3  (sigma_n
 //                                      2.2e-3, 1659 matches per pair)
 //   default / straightforward: 8.4x (7.3x-8.6x over runs).
+//   BM_EndToEnd_Engine         the sequence engine as `rcm estimate` runs it
+//                              (the rig with the default drift priors, the
+//                              field test on), window_matches 100/200/400:
+//                              0.94/0.88/0.92 s for the 10 pairs (2026-12-05)
+//   BM_EndToEnd_RcmProcess     the whole `rcm estimate` process on the PNG
+//                              folders: 1.25 s, 3.0x one straightforward run
+//                              of the same benchmark (docs/numbers.md)
 //
 // Run e.g.
 //   build/bin/frontend_benchmark
 //   build/bin/frontend_benchmark --benchmark_filter=EndToEnd
 #include <benchmark/benchmark.h>
+#include <unistd.h>
 
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <future>
 #include <memory>
 #include <opencv2/features2d.hpp>
@@ -91,6 +104,9 @@
 #include "rcm/frontend/locus_band.h"
 #include "rcm/frontend/stereo_front_end.h"
 #include "rcm/frontend/subpixel_refinement.h"
+#include "rcm/io/camchain.h"
+#include "rcm/io/stereo_rig_file.h"
+#include "rcm/live/sequence_estimator.h"
 #include "rcm/sim/reference_rigs.h"
 #include "rcm/sim/sequence_simulator.h"
 
@@ -572,6 +588,126 @@ void BM_EndToEnd_Straightforward(benchmark::State& state) {
   ReportEndToEnd(state, result);
 }
 BENCHMARK(BM_EndToEnd_Straightforward)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3)
+    ->UseRealTime();
+
+// The sequence engine (rcm/live/sequence_estimator.h) on the 10 pairs as
+// `rcm estimate` runs it on images: each pair decoded (both PNGs at once)
+// and added, the final estimate solved once. The rig as `rcm` reads a
+// camchain without a sidecar: the default drift priors, so that the window
+// self-calibrates cam1's rotation and the focal scales.
+RunResult RunEnginePipeline(int window_matches) {
+  const Sequence& data = Data();
+  RunResult result;
+  const StereoRig rig = WithDefaultCalibrationUncertainty(data.rig).value();
+  SequenceEstimatorOptions options;
+  options.estimation.refinement.detect_systematic = true;  // rcm estimate's
+  options.window_matches = window_matches;
+  std::unique_ptr<SequenceEstimator> sequence =
+      SequenceEstimator::Create(rig, options).value();
+  for (int i = 0; i < kPairs; ++i) {
+    const EncodedPair& pair = data.pairs[i];
+    std::future<cv::Mat> left =
+        std::async(std::launch::async, [&pair] { return Decode(pair.left); });
+    const cv::Mat right = Decode(pair.right);
+    StatusOr<SequencePair> added =
+        sequence->AddPair(left.get(), right, i, i / kFrameRate);
+    if (!added.ok()) {
+      result.error = added.status().message();
+      return result;
+    }
+    result.matches += static_cast<int64_t>(added->matches.size());
+    result.reacquired += added->reacquired ? 1 : 0;
+  }
+  const StatusOr<RefractiveIndexEstimate> estimate = sequence->Estimate();
+  if (!estimate.ok()) {
+    result.error = estimate.status().message();
+    return result;
+  }
+  result.n = estimate->n;
+  result.sigma_n = estimate->sigma_n;
+  return result;
+}
+
+void BM_EndToEnd_Engine(benchmark::State& state) {
+  Data();
+  RunResult result;
+  for (auto _ : state) {
+    result = RunEnginePipeline(static_cast<int>(state.range(0)));
+  }
+  ReportEndToEnd(state, result);
+}
+BENCHMARK(BM_EndToEnd_Engine)
+    ->ArgName("window_matches")
+    ->Arg(100)
+    ->Arg(200)
+    ->Arg(400)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3)
+    ->UseRealTime();
+
+// The whole `rcm estimate --calib camchain.yaml --left L --right R --json`
+// process (the executable next to this benchmark) on the 10 pairs written
+// as PNG folders, wall time per run, and its ratio to one run of the
+// straightforward pipeline measured in the same benchmark
+// (x_straightforward: how many times as fast the whole process is).
+void BM_EndToEnd_RcmProcess(benchmark::State& state) {
+  const Sequence& data = Data();
+  const std::filesystem::path self =
+      std::filesystem::read_symlink("/proc/self/exe");
+  const std::filesystem::path rcm = self.parent_path() / "rcm";
+  if (!std::filesystem::exists(rcm)) {
+    state.SkipWithError("the rcm executable is not next to the benchmark");
+    return;
+  }
+  const std::filesystem::path folder =
+      std::filesystem::temp_directory_path() /
+      ("rcm_process_benchmark_" + std::to_string(getpid()));
+  std::filesystem::create_directories(folder / "left");
+  std::filesystem::create_directories(folder / "right");
+  for (int i = 0; i < kPairs; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "%06d.png", i);
+    std::ofstream(folder / "left" / name, std::ios::binary)
+        .write(reinterpret_cast<const char*>(data.pairs[i].left.data()),
+               data.pairs[i].left.size());
+    std::ofstream(folder / "right" / name, std::ios::binary)
+        .write(reinterpret_cast<const char*>(data.pairs[i].right.data()),
+               data.pairs[i].right.size());
+  }
+  const std::string camchain = (folder / "camchain.yaml").string();
+  CHECK(WriteCamchain(camchain, CamchainFromStereoRig(data.rig)).ok());
+  const std::string command =
+      rcm.string() + " estimate --calib " + camchain + " --left " +
+      (folder / "left").string() + " --right " + (folder / "right").string() +
+      " --json > " + (folder / "estimate.json").string() + " 2> /dev/null";
+  double seconds = 0.0;
+  int failures = 0;
+  for (auto _ : state) {
+    const auto start = std::chrono::steady_clock::now();
+    failures += std::system(command.c_str()) != 0 ? 1 : 0;
+    seconds +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+            .count();
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const RunResult straightforward = RunStraightforwardPipeline();
+  const double straightforward_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count();
+  std::filesystem::remove_all(folder);
+  if (failures > 0 || !straightforward.error.empty()) {
+    state.SkipWithError("rcm estimate or the straightforward pipeline failed");
+    return;
+  }
+  const double per_run = seconds / static_cast<double>(state.iterations());
+  state.counters["pairs_per_second"] = kPairs / per_run;
+  state.counters["straightforward_pairs_per_second"] =
+      kPairs / straightforward_seconds;
+  state.counters["x_straightforward"] = straightforward_seconds / per_run;
+}
+BENCHMARK(BM_EndToEnd_RcmProcess)
     ->Unit(benchmark::kMillisecond)
     ->Iterations(3)
     ->UseRealTime();

@@ -111,6 +111,13 @@ release_only=(
   # [UnderwaterModelSelection.ExactAirGapChoosesAGap]: the selection on
   # exact corners, with the bow
   'UnderwaterModelSelection.ExactBowedBoardChoosesTheBow'
+  # [LivePipeline.*, EstimateImagesCli.*, DemoCli.*, SequenceEstimator.
+  # RefusesBadPairsAndOptions]: the sequence engine on rendered pairs (the
+  # sanitized tests run it through the live pipeline, rcm estimate and the
+  # demo)
+  'SequenceEstimator.TheLivePipelineRunsIt'
+  'SequenceEstimator.FollowsATurnedCam1AndSaysTheCalibrationIsStale'
+  'SequenceEstimator.EstimatesOverTheCurrentMedium'
 )
 
 budgeted=(

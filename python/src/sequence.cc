@@ -177,7 +177,7 @@ keep_frames=False keeps no matches (estimate() is then the window's).
       .def(py::init(&MakeSequence), py::arg("rig"), py::kw_only(),
            py::arg("estimator") = "refine", py::arg("front_end") = py::dict(),
            py::arg("refinement") = py::dict(), py::arg("window_frames") = 20,
-           py::arg("change_threshold") = 5.0, py::arg("window_matches") = 400,
+           py::arg("change_threshold") = 5.0, py::arg("window_matches") = 200,
            py::arg("follow_rotation_px") = 0.5, py::arg("keep_frames") = true)
       .def("add_pair", &AddPair, py::arg("left"), py::arg("right"),
            py::arg("frame"), py::arg("timestamp") = py::none(),

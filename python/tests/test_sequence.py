@@ -80,7 +80,7 @@ def test_per_pair_results(rendered):
         d = pair.to_dict()
         assert d["n"] == pytest.approx(1.34, abs=0.02)
         assert d["window_n"] is not None and not d["medium_switch"]
-        assert d["num_estimated"] <= 400
+        assert d["num_estimated"] <= 200
     estimate = sequence.estimate()
     assert estimate.estimator == "window"
     assert estimate.per_frame["n"].shape == (FRAMES,)

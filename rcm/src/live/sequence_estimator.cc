@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <utility>
 
 #include "rcm/estimation/estimate_warnings.h"
@@ -238,21 +239,37 @@ StatusOr<SequenceRun> EstimateSequence(const StereoRig& rig,
     run = SequenceRun();
     run.passes = pass;
     const auto start = std::chrono::steady_clock::now();
-    for (size_t i = 0; i < pairs; ++i) {
+    // The next pair is decoded on another thread while this one is matched
+    // and estimated (one read at a time: the source is read in order, never
+    // by two threads at once).
+    struct Read {
+      StatusOr<StereoImagePair> images = Status::Error("not read");
+      double ms = 0.0;
+    };
+    const auto read = [source](size_t i) {
       const auto read_start = std::chrono::steady_clock::now();
-      StatusOr<StereoImagePair> images = source->ReadPair(i);
-      if (!images.ok()) return images.status();
-      run.read_ms += SequenceMilliseconds(read_start);
+      Read result{source->ReadPair(i), 0.0};
+      result.ms = SequenceMilliseconds(read_start);
+      return result;
+    };
+    std::future<Read> next;
+    if (pairs > 0) next = std::async(std::launch::async, read, size_t{0});
+    for (size_t i = 0; i < pairs; ++i) {
+      Read current = next.get();
+      if (!current.images.ok()) return current.images.status();
+      if (i + 1 < pairs) next = std::async(std::launch::async, read, i + 1);
+      run.read_ms += current.ms;
+      const StereoImagePair& images = *current.images;
       StatusOr<SequencePair> pair = sequence.AddPair(
-          images->left, images->right, images->frame, images->timestamp);
+          images.left, images.right, images.frame, images.timestamp);
       if (!pair.ok()) {
-        return pair.status().WithContext(images->left_name + " and " +
-                                         images->right_name);
+        return pair.status().WithContext(images.left_name + " and " +
+                                         images.right_name);
       }
       AddTimings(pair->timings, &run.timings);
       run.estimate_ms += pair->estimate_ms;
       run.reacquired += pair->reacquired ? 1 : 0;
-      if (progress) progress(pass, i + 1, pairs, *images, *pair);
+      if (progress) progress(pass, i + 1, pairs, images, *pair);
     }
     run.seconds = SequenceMilliseconds(start) / 1000.0;
     run.estimate = sequence.Estimate();

@@ -68,9 +68,11 @@ struct SequenceEstimatorOptions {
   SlidingWindowOptions window;
   // Matches of a pair the window takes at most (SpreadSubset); >= 0, 0
   // takes all. The window's update costs ~60 us of CPU per match with the
-  // default drift priors (live_pipeline.h), so 400 keeps a pair's guide and
-  // change test at ~25 ms; the final estimate takes every match.
-  int window_matches = 400;
+  // default drift priors (live_pipeline.h), so 200 keeps a pair's guide and
+  // change test at ~12 ms (frontend_benchmark's BM_EndToEnd_Engine: 200 and
+  // 400 give final estimates 4e-6 apart, sigma_n 1.3e-3); the final
+  // estimate takes every match.
+  int window_matches = 200;
   // Pixels at the focal length by which cam1's self-calibrated rotation
   // must move before the front end follows it; > 0 (infinity: never).
   // Half the band's ~1 px half-width.
@@ -172,8 +174,9 @@ const std::vector<StereoCorrespondence>& SpreadSubset(
     const std::vector<StereoCorrespondence>& all, int cap,
     std::vector<StereoCorrespondence>* subset);
 
-// An offline run over a source: every pair once per pass, the passes of
-// re-matching (above), and the final estimate.
+// An offline run over a source: every pair once per pass (the next pair
+// decoded on a second thread while the current one is matched), the passes
+// of re-matching (above), and the final estimate.
 struct SequenceRun {
   StatusOr<RefractiveIndexEstimate> estimate = Status::Error("not run");
   std::vector<FrameMatches> frames;  // of the last pass
