@@ -118,6 +118,25 @@ release_only=(
   'SequenceEstimator.TheLivePipelineRunsIt'
   'SequenceEstimator.FollowsATurnedCam1AndSaysTheCalibrationIsStale'
   'SequenceEstimator.EstimatesOverTheCurrentMedium'
+  # The heaviest CLI runs under the sanitizers (13-32 s each there, measured
+  # on build-sanitize/ of 319e96a), each beside a sanitized test of the
+  # same code:
+  # [CalibrateCli.FoldersToCamchainAndReport]: corners out and back in, a
+  # byte-for-byte equality; mrcal-style names; a board in one image only
+  'CalibrateCli.CornersOutThenCornersGivesTheSameCamchain'
+  'CalibrateCli.CornersOfMrcalStyleNamesPairByTheirNumber'
+  'CalibrateCli.BoardInOneImageOnlyIsNamedAndUsedForThatCamera'
+  # [the bad-input table's calibrate rows, CalibrateCli.FoldersToCamchain...]:
+  # detection over every image that finds nothing, an unreadable image
+  'CalibrateCli.NoTargetAnywhere'
+  'CalibrateCli.UnreadableImageSkipsItsPairOnly'
+  # [EstimateImagesCli.FoldersGiveNAndThePictures, SimulateCli.*,
+  # LivePipeline.*, DemoCli.UnwritableFolderIsOneLineError]: the demo's
+  # renders, pair loop and pictures
+  'DemoCli.EstimatesNFromTheImagesAndWritesThePictures'
+  # [BagStereoSource.*, EstimateImagesCli.FoldersGiveNAndThePictures,
+  # EstimateImagesCli.BagWithoutTheTopicsIsOneLine]: a bag against folders
+  'EstimateImagesCli.BagGivesTheSameNAsTheFolders'
 )
 
 budgeted=(

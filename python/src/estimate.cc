@@ -70,8 +70,8 @@ RefractiveIndexEstimate Estimate(const py::object& rig_object,
                     "' (available: refine, online, window, closed-form)");
   }
   options.estimator = *kind;
-  ApplyOptions(kwargs, RefinementOptionFields(&options.refinement),
-               "estimate_refractive_index");
+  ApplyRefinementOptions(kwargs, &options.refinement,
+                         "estimate_refractive_index");
   options.window.window_frames = window_frames;
   options.window.change_threshold = change_threshold;
   options.window.confirm_frames =

@@ -90,6 +90,12 @@ std::vector<OptionField> RefinementOptionFields(RefinementOptions* o) {
           IntOption("num_threads", &o->num_threads)};
 }
 
+void ApplyRefinementOptions(const py::dict& kwargs, RefinementOptions* options,
+                            const std::string& function) {
+  ApplyOptionsWithBase(kwargs, options, &RefinementOptionFields,
+                       "rcm.RefinementOptions", function);
+}
+
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -97,7 +103,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 RefinementOptions RefinementOptionsFrom(const py::dict& kwargs,
                                         const std::string& function) {
   RefinementOptions options;
-  ApplyOptions(kwargs, RefinementOptionFields(&options), function);
+  ApplyRefinementOptions(kwargs, &options, function);
   ThrowIfError(options.Check());
   return options;
 }
@@ -379,6 +385,52 @@ const char* DecisionName(SlidingWindowRefractiveIndexEstimator::Decision d) {
 }  // namespace
 
 void BindEstimators(py::module_& module) {
+  // rcm.RefinementOptions: the C++ struct with its defaults, one property
+  // per field (the keywords' names), documented from refinement_options.h.
+  const std::vector<std::pair<const char*, const char*>> field_docs = {
+      {"loss",
+       "Loss of the robust stage: 'cauchy' (default), 'huber', 'none'."},
+      {"n_prior",
+       "A prior on n (thin ports): None (default), 'fresh', 'sea', "
+       "'N:SIGMA' or (n, sigma)."},
+      {"loss_scale_px",
+       "Scale of the robust loss, pixels of distance from the locus; > 0 "
+       "(1.0)."},
+      {"inlier_threshold_px",
+       "Inliers of the final least squares lie within this many pixels of "
+       "their locus; > 0, inf keeps all (2.0)."},
+      {"num_scan_points",
+       "Points of the scan of [1, 2] that seeds n; >= 3 (51)."},
+      {"min_inliers", "Fewest inliers accepted; >= 2 (10)."},
+      {"max_crlb_per_px",
+       "Refuse data whose Cramer-Rao bound of n at 1 px exceeds this (0.1): "
+       "data that cannot tell water from air."},
+      {"refine_rotation",
+       "Estimate a rotation of cam1 without a prior (False)."},
+      {"self_calibrate_rotation",
+       "Estimate cam1's rotation with n under the calibration's drift prior "
+       "(True)."},
+      {"self_calibrate_focal",
+       "Estimate each camera's focal scale with n under the focal drift "
+       "prior (True)."},
+      {"systematic_px",
+       "The matches' systematic error floor, pixels per coefficient of a "
+       "smooth field, carried into sigma_n (0.0; the image front end's is "
+       "rcm.FRONT_END_SYSTEMATIC_PX)."},
+      {"detect_systematic",
+       "Test the residuals for a smooth field and widen sigma_n by it "
+       "(False; rcm estimate turns it on)."},
+      {"max_num_iterations", "Solver iterations per stage; >= 1 (100)."},
+      {"num_threads", "Threads for the residuals; >= 1 (2)."}};
+  BindOptionsClass<RefinementOptions>(module, "RefinementOptions", R"doc(
+The estimators' options (C++ RefinementOptions, refinement_options.h), with
+the C++ defaults: RefinementOptions(loss='huber', ...). Every estimator
+takes one as options=..., or its fields as keywords; check() raises
+ValueError with the library's message for a value Check() refuses;
+to_dict() gives the keywords.
+)doc",
+                                      &RefinementOptionFields, field_docs);
+
   py::class_<RefinementSummary>(module, "RefinementResult", R"doc(
 The result of refine_refractive_index (C++ RefinementSummary).
 
@@ -440,6 +492,39 @@ None).
                              [](const RefinementSummary& s) {
                                return ConsistencyDict(s.consistency);
                              })
+      .def(
+          "to_dict",
+          [](const py::object& self) {
+            // Every attribute above, under its name.
+            py::dict d;
+            for (const char* name : {"n",
+                                     "sigma_n",
+                                     "sigma_n_noise",
+                                     "sigma_n_calibration",
+                                     "sigma_n_systematic",
+                                     "crlb",
+                                     "sigma_px",
+                                     "n_closed_form",
+                                     "n_seed",
+                                     "n_robust",
+                                     "robust_cost",
+                                     "cost",
+                                     "num_inliers",
+                                     "num_correspondences",
+                                     "num_invalid",
+                                     "num_iterations",
+                                     "inlier_indices",
+                                     "rotation",
+                                     "focal",
+                                     "calibration",
+                                     "consistency"}) {
+              d[name] = self.attr(name);
+            }
+            return d;
+          },
+          "The attributes as a dict (the C++ struct's fields, radians; "
+          "for the report's keys use rcm.estimate_refractive_index's "
+          "rcm.Estimate).")
       .def("__repr__", &SummaryRepr);
 
   module.def("refine_refractive_index", &Refine, py::arg("rig"),

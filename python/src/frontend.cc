@@ -13,53 +13,58 @@
 
 namespace rcm::python {
 
-// StereoFrontEndOptions from keywords, named after the C++ fields, nested
-// structs flattened with their prefix (clahe_clip_limit = clahe.clip_limit).
-StereoFrontEndOptions FrontEndOptionsFrom(const py::dict& kwargs,
-                                          const std::string& function) {
-  StereoFrontEndOptions o;
-  std::vector<OptionField> fields = {
+// The keywords of StereoFrontEndOptions, named after the C++ fields,
+// nested structs flattened with their prefix (clahe_clip_limit =
+// clahe.clip_limit).
+std::vector<OptionField> FrontEndOptionFields(StereoFrontEndOptions* o) {
+  return {
       {"features",
-       [&](const py::handle& value) {
+       [o](const py::handle& value) {
          const std::string name = py::str(value).cast<std::string>();
          const std::optional<FeatureType> type = FeatureTypeFromName(name);
          if (!py::isinstance<py::str>(value) || !type) {
            ThrowValueError("unknown features '" + name +
                            "' (available: orb, sift, akaze)");
          }
-         o.features.type = *type;
+         o->features.type = *type;
        },
-       [&] { return py::object(py::str(FeatureTypeName(o.features.type))); }},
-      IntOption("max_features", &o.features.max_features),
-      IntOption("fast_threshold", &o.features.fast_threshold),
-      BoolOption("clahe", &o.clahe.enabled),
-      DoubleOption("clahe_clip_limit", &o.clahe.clip_limit),
-      IntOption("clahe_tiles", &o.clahe.tiles),
-      DoubleOption("tolerance_px", &o.band.tolerance_px),
-      DoubleOption("min_distance", &o.band.min_distance),
-      DoubleOption("ratio", &o.matching.ratio),
-      BoolOption("cross_check", &o.matching.cross_check),
-      IntOption("max_hamming_distance", &o.matching.max_hamming_distance),
-      BoolOption("subpixel", &o.subpixel.enabled),
-      IntOption("subpixel_window", &o.subpixel.window),
-      DoubleOption("subpixel_max_shift_px", &o.subpixel.max_shift_px),
+       [o] { return py::object(py::str(FeatureTypeName(o->features.type))); }},
+      IntOption("max_features", &o->features.max_features),
+      IntOption("fast_threshold", &o->features.fast_threshold),
+      BoolOption("clahe", &o->clahe.enabled),
+      DoubleOption("clahe_clip_limit", &o->clahe.clip_limit),
+      IntOption("clahe_tiles", &o->clahe.tiles),
+      DoubleOption("tolerance_px", &o->band.tolerance_px),
+      DoubleOption("min_distance", &o->band.min_distance),
+      DoubleOption("ratio", &o->matching.ratio),
+      BoolOption("cross_check", &o->matching.cross_check),
+      IntOption("max_hamming_distance", &o->matching.max_hamming_distance),
+      BoolOption("subpixel", &o->subpixel.enabled),
+      IntOption("subpixel_window", &o->subpixel.window),
+      DoubleOption("subpixel_max_shift_px", &o->subpixel.max_shift_px),
       {"search_range",
-       [&](const py::handle& value) {
+       [o](const py::handle& value) {
          const std::vector<double> range =
              VectorFromPython(value, "search_range");
          if (range.size() != 2) {
            ThrowValueError("search_range must be (min, max)");
          }
-         o.search_range = {range[0], range[1]};
+         o->search_range = {range[0], range[1]};
        },
-       [&] {
+       [o] {
          return py::object(
-             py::make_tuple(o.search_range.min, o.search_range.max));
+             py::make_tuple(o->search_range.min, o->search_range.max));
        }},
-      DoubleOption("reacquire_fraction", &o.reacquire_fraction),
-      IntOption("num_threads", &o.num_threads),
+      DoubleOption("reacquire_fraction", &o->reacquire_fraction),
+      IntOption("num_threads", &o->num_threads),
   };
-  ApplyOptions(kwargs, fields, function);
+}
+
+StereoFrontEndOptions FrontEndOptionsFrom(const py::dict& kwargs,
+                                          const std::string& function) {
+  StereoFrontEndOptions o;
+  ApplyOptionsWithBase(kwargs, &o, FrontEndOptionFields, "rcm.FrontEndOptions",
+                       function);
   o.matching.num_threads = o.num_threads;
   ThrowIfError(o.Check());
   return o;
@@ -121,6 +126,38 @@ known), reacquire_fraction=0.5, num_threads=2.
 }  // namespace
 
 void BindFrontEnd(py::module_& module) {
+  BindOptionsClass<StereoFrontEndOptions>(
+      module, "FrontEndOptions",
+      "The image front end's options (C++ StereoFrontEndOptions, "
+      "stereo_front_end.h; nested fields flattened with their prefix), with "
+      "the C++ defaults. rcm.StereoFrontEnd, rcm.match_stereo and "
+      "rcm.SequenceEstimator take one as options=... (front_end=... for the "
+      "sequence), or its fields as keywords.",
+      &FrontEndOptionFields,
+      {{"features",
+        "Keypoints and descriptors: 'orb' (default), 'sift', 'akaze'."},
+       {"max_features", "Keypoints per image (2000)."},
+       {"fast_threshold", "ORB's FAST threshold (20)."},
+       {"clahe", "Equalize contrast (CLAHE) before detection (False)."},
+       {"clahe_clip_limit", "CLAHE's clip limit (2.0)."},
+       {"clahe_tiles", "CLAHE's tiles per side (8)."},
+       {"tolerance_px",
+        "Half width of the refractive epipolar band, pixels (2.0)."},
+       {"min_distance", "Nearest depth the band covers, metres (0.2)."},
+       {"ratio",
+        "Lowe's ratio among a keypoint's candidates in the band (0.8)."},
+       {"cross_check", "Keep mutual best matches only (True)."},
+       {"max_hamming_distance", "ORB: largest descriptor distance (64)."},
+       {"subpixel", "Refine the right pixels to subpixel (True)."},
+       {"subpixel_window", "Subpixel window, pixels (11)."},
+       {"subpixel_max_shift_px", "Largest subpixel shift, pixels (2.0)."},
+       {"search_range",
+        "The n interval (min, max) the band covers before anything is known "
+        "((1.0, 1.6))."},
+       {"reacquire_fraction",
+        "A guided pair keeping less than this fraction of the prior band's "
+        "matches is matched again in it (0.5)."},
+       {"num_threads", "Threads (2)."}});
   // C++ kFrontEndSystematicPx: the systematic error floor of this front
   // end's matches (pixels), for refine_refractive_index(systematic_px=...)
   // on its matches, as `rcm estimate` does on images.

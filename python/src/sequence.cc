@@ -57,8 +57,8 @@ py::dict PairDict(const SequencePair& p) {
 }
 
 Sequence MakeSequence(const py::object& rig_object,
-                      const std::string& estimator, const py::dict& front_end,
-                      const py::dict& refinement, int window_frames,
+                      const std::string& estimator, const py::object& front_end,
+                      const py::object& refinement, int window_frames,
                       double change_threshold, int window_matches,
                       double follow_rotation_px, bool keep_frames) {
   const StereoRig rig = RigFromPython(rig_object);
@@ -69,10 +69,28 @@ Sequence MakeSequence(const py::object& rig_object,
                     "' (available: refine, online, window, closed-form)");
   }
   options.estimation.estimator = *kind;
-  options.front_end = FrontEndOptionsFrom(front_end, "SequenceEstimator");
-  ApplyOptions(refinement,
-               RefinementOptionFields(&options.estimation.refinement),
-               "SequenceEstimator's refinement");
+  if (py::isinstance<StereoFrontEndOptions>(front_end)) {
+    options.front_end = front_end.cast<StereoFrontEndOptions>();
+    options.front_end.matching.num_threads = options.front_end.num_threads;
+    ThrowIfError(options.front_end.Check());
+  } else if (py::isinstance<py::dict>(front_end)) {
+    options.front_end =
+        FrontEndOptionsFrom(front_end.cast<py::dict>(), "SequenceEstimator");
+  } else {
+    ThrowTypeError(
+        "front_end must be an rcm.FrontEndOptions or a dict of its keywords");
+  }
+  if (py::isinstance<RefinementOptions>(refinement)) {
+    options.estimation.refinement = refinement.cast<RefinementOptions>();
+  } else if (py::isinstance<py::dict>(refinement)) {
+    ApplyRefinementOptions(refinement.cast<py::dict>(),
+                           &options.estimation.refinement,
+                           "SequenceEstimator's refinement");
+  } else {
+    ThrowTypeError(
+        "refinement must be an rcm.RefinementOptions or a dict of its "
+        "keywords");
+  }
   options.window.window_frames = window_frames;
   options.window.change_threshold = change_threshold;
   options.window.confirm_frames =
@@ -131,16 +149,20 @@ rotation of cam1); estimate_ms, match_ms. to_dict() gives all but matches.
       .def_property_readonly(
           "matches",
           [](const PairResult& r) { return Correspondences{r.pair.matches}; })
-      .def_property_readonly(
-          "n", [](const PairResult& r) { return PairDict(r.pair)["n"]; })
-      .def_property_readonly(
-          "sigma_n",
-          [](const PairResult& r) { return PairDict(r.pair)["sigma_n"]; })
-      .def_property_readonly(
-          "window_n",
-          [](const PairResult& r) { return PairDict(r.pair)["window_n"]; })
+      .def_property_readonly("n",
+                             [](const PairResult& r) -> py::object {
+                               return PairDict(r.pair)["n"];
+                             })
+      .def_property_readonly("sigma_n",
+                             [](const PairResult& r) -> py::object {
+                               return PairDict(r.pair)["sigma_n"];
+                             })
+      .def_property_readonly("window_n",
+                             [](const PairResult& r) -> py::object {
+                               return PairDict(r.pair)["window_n"];
+                             })
       .def_property_readonly("window_sigma_n",
-                             [](const PairResult& r) {
+                             [](const PairResult& r) -> py::object {
                                return PairDict(r.pair)["window_sigma_n"];
                              })
       .def_property_readonly(
@@ -168,10 +190,11 @@ final estimate once (estimator: 'refine', 'online', 'window' or
 'closed-form') over the pairs since the last change of medium and returns
 an rcm.Estimate, the same as `rcm estimate --json`.
 
-rig: rcm.StereoRig or a reference rig name. front_end: a dict of
-rcm.StereoFrontEnd's keywords; refinement: a dict of
-refine_refractive_index's keywords (systematic_px defaults to
-rcm.FRONT_END_SYSTEMATIC_PX); window_frames, change_threshold: the window's;
+rig: rcm.StereoRig or a reference rig name. front_end: an
+rcm.FrontEndOptions or a dict of its keywords; refinement: an rcm.RefinementOptions or a
+dict of its keywords (systematic_px defaults to
+rcm.FRONT_END_SYSTEMATIC_PX; an rcm.RefinementOptions replaces the defaults
+whole); window_frames, change_threshold: the window's;
 keep_frames=False keeps no matches (estimate() is then the window's).
 )doc")
       .def(py::init(&MakeSequence), py::arg("rig"), py::kw_only(),

@@ -43,7 +43,8 @@ def realistic_rig():
 
 
 def thick_port():
-    """8 mm of air behind 6 mm of acrylic (the README's thick port)."""
+    """8 mm of air behind 6 mm of acrylic (the thick port of
+    docs/thick_ports.md)."""
     return rcm.FlatPort(air_gap=0.008, glass_thickness=0.006, glass_index=1.49)
 
 

@@ -76,7 +76,8 @@ def test_exact_with_a_thick_port(thick_rig):
     matches = sample(thick_rig, n)  # through the exact ports
     result = rcm.refine_refractive_index(thick_rig, matches)
     assert abs(result.n - n) < EXACT
-    # The thin-port model on the same matches is biased (README: -0.019).
+    # The thin-port model on the same matches is biased (docs/thick_ports.md:
+    # -0.019).
     thin = rcm.refine_refractive_index(
         rcm.reference_rig("alphasense-unrectified"), matches)
     assert thin.n < n - 0.005
@@ -393,3 +394,40 @@ def test_a_field_off_the_rigid_scene_widens_sigma(realistic_rig):
     assert found.calibration["systematic_detected_px"] > 0.05
     assert found.sigma_n_systematic > 3.0 * blind.sigma_n
     assert abs(found.n - n) < 3.0 * found.sigma_n
+
+
+def test_refinement_options_class(ideal_rig):
+    # rcm.RefinementOptions: the C++ struct with its defaults, its fields
+    # as properties, accepted as options= by every estimator.
+    options = rcm.RefinementOptions(loss="huber", inlier_threshold_px=1.5)
+    assert options.loss == "huber" and options.inlier_threshold_px == 1.5
+    options.min_inliers = 12
+    assert options.to_dict() == dict(rcm.default_refinement_options(),
+                                     loss="huber", inlier_threshold_px=1.5,
+                                     min_inliers=12)
+    assert "pixels" in rcm.RefinementOptions.loss_scale_px.__doc__
+    matches = rcm.add_pixel_noise(sample(ideal_rig, 1.34), 0.3, seed=8)
+    by_object = rcm.refine_refractive_index(ideal_rig, matches,
+                                            options=options)
+    by_keywords = rcm.refine_refractive_index(
+        ideal_rig, matches, loss="huber", inlier_threshold_px=1.5,
+        min_inliers=12)
+    assert by_object.n == by_keywords.n
+    # A keyword beside options= overrides its field.
+    assert rcm.refine_refractive_index(
+        ideal_rig, matches, options=options, loss="cauchy").n == \
+        rcm.refine_refractive_index(ideal_rig, matches,
+                                    inlier_threshold_px=1.5,
+                                    min_inliers=12).n
+    assert set(by_object.to_dict()) >= {"n", "sigma_n", "calibration"}
+    with pytest.raises(TypeError) as error:
+        rcm.RefinementOptions(no_such_option=1)
+    one_line(error)
+    bad = rcm.RefinementOptions(loss_scale_px=-1.0)
+    with pytest.raises(ValueError) as error:
+        bad.check()
+    one_line(error)
+    with pytest.raises(ValueError):
+        rcm.refine_refractive_index(ideal_rig, matches, options=bad)
+    with pytest.raises(TypeError):
+        rcm.refine_refractive_index(ideal_rig, matches, options={"loss": 1})

@@ -103,3 +103,63 @@ def test_bad_input_is_one_line(rendered):
     with pytest.raises(ValueError) as error:
         sequence.estimate()  # no pair yet
     one_line(error)
+
+
+def test_demo_runs_the_same_engine(tmp_path):
+    # `rcm demo` renders its dive and runs the sequence engine on it; the
+    # same renders (the simulator is deterministic) through
+    # rcm.SequenceEstimator with the demo's options give the same n.
+    import json
+    import subprocess
+    frames = 3
+    completed = subprocess.run(
+        [rcm_executable(), "demo", "--frames", str(frames), "--out",
+         str(tmp_path / "demo"), "--json"],
+        capture_output=True, text=True, timeout=300, check=False)
+    assert completed.returncode == 0, completed.stderr
+    demo = json.loads(completed.stdout)
+    # The demo's rig as rcm reads a camchain without a sidecar (the default
+    # drift prior), its simulation flags' defaults.
+    rig_path = tmp_path / "rig.yaml"
+    rcm.reference_rig("alphasense-rectified").write(rig_path)
+    simulator = rcm.SequenceSimulator(
+        rcm.reference_rig("alphasense-rectified"), n=1.333, frames=frames,
+        supersampling=2, image_noise=1.5, frame_rate=20.0, seed=1)
+    sequence = rcm.SequenceEstimator(rcm.read_stereo_rig(rig_path))
+    for i in range(frames):
+        frame = simulator.frame(i)
+        sequence.add_pair(frame["left"], frame["right"], i, frame["t"])
+    estimate = sequence.estimate()
+    assert abs(estimate.n - demo["n"]) <= 1e-12
+    assert abs(estimate.n - demo["estimate"]["n"]) <= 1e-12
+    for key, value in estimate.to_dict().items():
+        same_value(value, demo["estimate"][key], key)
+
+
+def test_options_classes(rendered):
+    # rcm.FrontEndOptions and rcm.RefinementOptions: the C++ structs with
+    # their defaults; an object and the same keywords as a dict are one.
+    _, _, frames = rendered
+    front_end = rcm.FrontEndOptions(max_features=1500)
+    assert front_end.max_features == 1500 and front_end.features == "orb"
+    assert front_end.to_dict()["search_range"] == (1.0, 1.6)
+    assert "band" in rcm.FrontEndOptions.tolerance_px.__doc__
+    refinement = rcm.RefinementOptions(
+        systematic_px=rcm.FRONT_END_SYSTEMATIC_PX)
+    by_objects = rcm.SequenceEstimator("alphasense-unrectified",
+                                       front_end=front_end,
+                                       refinement=refinement)
+    by_dicts = rcm.SequenceEstimator("alphasense-unrectified",
+                                     front_end={"max_features": 1500})
+    for i, frame in enumerate(frames[:2]):
+        a = by_objects.add_pair(frame["left"], frame["right"], i)
+        b = by_dicts.add_pair(frame["left"], frame["right"], i)
+        assert len(a.matches) == len(b.matches) and a.n == b.n
+    assert by_objects.estimate().n == by_dicts.estimate().n
+    with pytest.raises(TypeError) as error:
+        rcm.SequenceEstimator("alphasense-unrectified", front_end=3)
+    one_line(error)
+    bad = rcm.FrontEndOptions(ratio=2.0)
+    with pytest.raises(ValueError) as error:
+        bad.check()
+    one_line(error)

@@ -1,7 +1,7 @@
 // Air stereo calibration by bundle adjustment over planar-target views.
 //
 // Unknowns: the lens parameters of each camera (lens_models.h order,
-//   p_c = [fx, fy, cx, cy, d0, d1, d2, d3], radtan or equidistant), the
+//   p_c = [fx, fy, cx, cy, d...], any of the six lens models), the
 //   extrinsics cam1_from_cam0 = (R_10, t_10) and one pose
 //   cam0_from_target_v = (R_v, t_v) per view, and (estimate_board_warp)
 //   the board's warp w = [warp_x, warp_y] shared by all views. Target

@@ -130,8 +130,9 @@ struct RefinementSummary {
 
 // A rig with a thick port (StereoRig::HasThickPort, from a camchain's port
 // blocks) is refined with the thick-port model instead
-// (RefineRefractiveIndexThickPort with these options; no rotation
-// correction); a rig without ports, or with thin ones, exactly as above.
+// (RefineRefractiveIndexThickPort with these options: cam1's rotation
+// self-calibrated as for the thin port; the focal scales held); a rig
+// without ports, or with thin ones, exactly as above.
 // Fails with one line (and never returns a number) on invalid options,
 // fewer than options.min_inliers usable matches or inliers, data that do
 // not observe n (crlb at 1 px above options.max_crlb_per_px), or a

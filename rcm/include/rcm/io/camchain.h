@@ -9,9 +9,10 @@
 //     - [r20, r21, r22, t2]
 //     - [0.0, 0.0, 0.0, 1.0]
 //     cam_overlaps: [1]           # optional, indices of overlapping cameras
-//     camera_model: pinhole       # the only projection rcm supports
+//     camera_model: pinhole       # or ds (double sphere), eucm
 //     distortion_coeffs: [k1, k2, k3, k4]
-//     distortion_model: equidistant   # none | radtan | equidistant
+//     distortion_model: equidistant   # none | radtan | equidistant |
+//                                     # rational (none for ds, eucm)
 //     intrinsics: [fu, fv, pu, pv]    # fx, fy, cx, cy in pixels
 //     resolution: [720, 540]          # width, height
 //     rostopic: /cam0/image_raw       # optional
@@ -27,7 +28,10 @@
 //     ...                         # i.e. T_cn_cnm1 = camn_from_camnm1
 //
 // `distortion_coeffs` has as many entries as the model takes (4 for radtan
-// and equidistant); with `none` it is an empty list or absent. Keys rcm does
+// and equidistant, 8 for rational: OpenCV's k1, k2, p1, p2, k3, k4, k5,
+// k6); with `none` it is an empty list or absent. The unified models ds
+// and eucm put their two parameters (xi, alpha; alpha, beta) before fu, fv,
+// pu, pv in `intrinsics`, as Kalibr does. Keys rcm does
 // not know are ignored when reading (and therefore not written back).
 //
 // Reading never throws: every problem is reported as one line,

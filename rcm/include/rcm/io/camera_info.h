@@ -29,9 +29,10 @@
 //                         rcm's radtan model has no k3; an absent
 //                         distortion_model means plumb_bob, as in ROS;
 //   equidistant        -> rcm equidistant (k1..k4, OpenCV fisheye);
+//   rational_polynomial -> rcm rational (k1, k2, p1, p2, k3, k4, k5, k6);
 //   none, ""           -> pinhole; the coefficients must be absent, an
 //                         empty list or all zero.
-// Other ROS models (rational_polynomial, ...) are rejected. K must have zero
+// Other ROS models are rejected. K must have zero
 // skew and last row [0, 0, 1]; R must be a rotation.
 //
 // Errors are one line, "SOURCE[:LINE]: KEY: message", as for camchain.h.
