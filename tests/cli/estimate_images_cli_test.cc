@@ -105,6 +105,18 @@ TEST(EstimateImagesCli, EveryEstimatorRunsOnImages) {
                 std::string(estimator) == "closed-form" ? 0.1 : kNTolerance)
         << estimator;
   }
+  // A freely refined rotation (--refine-rotation) is the final estimate's;
+  // the sequence's window keeps its self-calibration.
+  const RunResult free_rotation =
+      Rcm({"estimate", "--calib", Dive() + "/camchain.yaml", "--left",
+           Dive() + "/left", "--right", Dive() + "/right", "--refine-rotation",
+           "--json"});
+  ASSERT_EQ(free_rotation.exit_code, 0) << free_rotation.err;
+  const nlohmann::json json = nlohmann::json::parse(free_rotation.out);
+  ASSERT_TRUE(json.contains("rotation")) << free_rotation.out;
+  EXPECT_FALSE(json["rotation"]["with_prior"].get<bool>());
+  EXPECT_LT(std::abs(json["n"].get<double>() - kNTrue),
+            std::max(kNTolerance, 5.0 * json["sigma_n"].get<double>()));
 }
 
 TEST(EstimateImagesCli, StrideKeepsFrameNumbers) {

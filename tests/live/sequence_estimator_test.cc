@@ -148,9 +148,14 @@ TEST(SequenceEstimator, RefusesBadPairsAndOptions) {
   options = SequenceEstimatorOptions();
   options.max_matching_passes = 0;
   EXPECT_FALSE(options.Check().ok());
+  // A freely refined rotation is the final estimate's; the window keeps
+  // its self-calibration.
   options = SequenceEstimatorOptions();
   options.estimation.refinement.refine_rotation = true;
-  EXPECT_FALSE(options.Check().ok());
+  EXPECT_TRUE(options.Check().ok());
+  EXPECT_FALSE(options.WindowRefinement().refine_rotation);
+  options.estimation.estimator = EstimatorKind::kWindow;
+  EXPECT_FALSE(options.Check().ok());  // refine_rotation: refine only
   EXPECT_TRUE(SequenceEstimatorOptions().Check().ok());
 }
 

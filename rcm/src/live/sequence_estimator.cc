@@ -45,14 +45,15 @@ EstimationOptions SequenceEstimatorOptions::DefaultEstimation() {
   return options;
 }
 
+RefinementOptions SequenceEstimatorOptions::WindowRefinement() const {
+  RefinementOptions window_refinement = estimation.refinement;
+  window_refinement.refine_rotation = false;  // the window self-calibrates
+  return window_refinement;
+}
+
 Status SequenceEstimatorOptions::Check() const {
   RCM_RETURN_IF_ERROR(front_end.Check().WithContext("front end"));
   RCM_RETURN_IF_ERROR(estimation.Check().WithContext("estimator"));
-  if (estimation.refinement.refine_rotation) {
-    return Status::Error(
-        "estimator: a sequence cannot refine the rotation without its prior "
-        "(the window self-calibrates it from the drift prior)");
-  }
   RCM_RETURN_IF_ERROR(window.Check().WithContext("window"));
   if (window_matches < 0) {
     return Status::Error("window matches must be >= 0, not " +
@@ -76,7 +77,7 @@ StatusOr<std::unique_ptr<SequenceEstimator>> SequenceEstimator::Create(
   if (!front_end.ok()) return front_end.status();
   StatusOr<SlidingWindowRefractiveIndexEstimator> window =
       SlidingWindowRefractiveIndexEstimator::Create(
-          rig, options.estimation.refinement, options.window);
+          rig, options.WindowRefinement(), options.window);
   if (!window.ok()) return window.status();
   return std::unique_ptr<SequenceEstimator>(new SequenceEstimator(
       rig, options, std::move(*front_end), std::move(*window)));
@@ -100,7 +101,7 @@ double SequenceEstimator::RotationPixels(const Eigen::Vector3d& a,
 Status SequenceEstimator::Restart(const Eigen::Vector3d& rotation) {
   StatusOr<SlidingWindowRefractiveIndexEstimator> window =
       SlidingWindowRefractiveIndexEstimator::Create(
-          rig_, options_.estimation.refinement, options_.window);
+          rig_, options_.WindowRefinement(), options_.window);
   if (!window.ok()) return window.status();
   StatusOr<StereoRig> turned = rig_.WithCam1Moved(rotation);
   if (!turned.ok()) return turned.status();

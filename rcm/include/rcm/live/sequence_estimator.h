@@ -84,6 +84,10 @@ struct SequenceEstimatorOptions {
   bool keep_frames = true;
 
   static EstimationOptions DefaultEstimation();
+  // The window's refinement: estimation.refinement without refine_rotation
+  // (the window self-calibrates cam1's rotation from its drift prior; a
+  // freely refined rotation is the final estimate's only).
+  RefinementOptions WindowRefinement() const;
   // Errors: the parts' Check(); window_matches < 0; follow_rotation_px not
   // > 0; max_matching_passes < 1.
   Status Check() const;
