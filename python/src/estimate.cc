@@ -28,9 +28,11 @@ py::dict EstimateDict(const RefractiveIndexEstimate& estimate) {
       .cast<py::dict>();
 }
 
-// One key of the JSON, so that the attribute and the key are one value.
+// One key of the JSON, so that the attribute and the key are one value;
+// None for a key the estimator leaves out.
 py::object Key(const RefractiveIndexEstimate& estimate, const char* key) {
-  return EstimateDict(estimate)[key];
+  const py::dict d = EstimateDict(estimate);
+  return d.contains(key) ? py::object(d[key]) : py::none();
 }
 
 py::dict PerFrameArrays(const RefractiveIndexEstimate& estimate) {
@@ -145,26 +147,11 @@ to_dict() gives the JSON object; to_json() its text.
       .def_property_readonly("consistency",
                              [](const E& e) { return Key(e, "consistency"); })
       .def_property_readonly("rotation",
-                             [](const E& e) {
-                               const py::dict d = EstimateDict(e);
-                               return d.contains("rotation")
-                                          ? py::object(d["rotation"])
-                                          : py::none();
-                             })
+                             [](const E& e) { return Key(e, "rotation"); })
       .def_property_readonly("focal_scale",
-                             [](const E& e) {
-                               const py::dict d = EstimateDict(e);
-                               return d.contains("focal_scale")
-                                          ? py::object(d["focal_scale"])
-                                          : py::none();
-                             })
+                             [](const E& e) { return Key(e, "focal_scale"); })
       .def_property_readonly("air_gap",
-                             [](const E& e) {
-                               const py::dict d = EstimateDict(e);
-                               return d.contains("air_gap")
-                                          ? py::object(d["air_gap"])
-                                          : py::none();
-                             })
+                             [](const E& e) { return Key(e, "air_gap"); })
       .def_readonly("warnings", &E::warnings)
       .def_property_readonly("per_frame", &PerFrameArrays)
       .def("to_dict", &EstimateDict,

@@ -31,8 +31,15 @@ struct PairResult {
   SequencePair pair;
 };
 
-py::object EstimateOrNone(double n, bool ok) {
-  return ok ? py::object(py::float_(n)) : py::none();
+// A field of the pair's own estimate or of the window's, None without one.
+py::object OwnField(const SequencePair& p, double PooledLocusEstimate::*field) {
+  return p.own.ok() ? py::object(py::float_((*p.own).*field)) : py::none();
+}
+
+py::object WindowField(const SequencePair& p,
+                       double PooledLocusEstimate::*field) {
+  return p.window.ok() ? py::object(py::float_((*p.window).*field))
+                       : py::none();
 }
 
 py::dict PairDict(const SequencePair& p) {
@@ -42,12 +49,10 @@ py::dict PairDict(const SequencePair& p) {
       p.timestamp ? py::object(py::float_(*p.timestamp)) : py::none();
   d["num_matches"] = p.matches.size();
   d["num_estimated"] = p.num_estimated;
-  d["n"] = EstimateOrNone(p.own.ok() ? p.own->n : NAN, p.own.ok());
-  d["sigma_n"] = EstimateOrNone(p.own.ok() ? p.own->sigma_n : NAN, p.own.ok());
-  d["window_n"] =
-      EstimateOrNone(p.window.ok() ? p.window->n : NAN, p.window.ok());
-  d["window_sigma_n"] =
-      EstimateOrNone(p.window.ok() ? p.window->sigma_n : NAN, p.window.ok());
+  d["n"] = OwnField(p, &PooledLocusEstimate::n);
+  d["sigma_n"] = OwnField(p, &PooledLocusEstimate::sigma_n);
+  d["window_n"] = WindowField(p, &PooledLocusEstimate::n);
+  d["window_sigma_n"] = WindowField(p, &PooledLocusEstimate::sigma_n);
   d["medium_switch"] = p.medium_switch.has_value();
   d["reacquired"] = p.reacquired;
   d["followed"] = p.followed;
@@ -150,20 +155,23 @@ rotation of cam1); estimate_ms, match_ms. to_dict() gives all but matches.
           "matches",
           [](const PairResult& r) { return Correspondences{r.pair.matches}; })
       .def_property_readonly("n",
-                             [](const PairResult& r) -> py::object {
-                               return PairDict(r.pair)["n"];
+                             [](const PairResult& r) {
+                               return OwnField(r.pair, &PooledLocusEstimate::n);
                              })
       .def_property_readonly("sigma_n",
-                             [](const PairResult& r) -> py::object {
-                               return PairDict(r.pair)["sigma_n"];
+                             [](const PairResult& r) {
+                               return OwnField(r.pair,
+                                               &PooledLocusEstimate::sigma_n);
                              })
       .def_property_readonly("window_n",
-                             [](const PairResult& r) -> py::object {
-                               return PairDict(r.pair)["window_n"];
+                             [](const PairResult& r) {
+                               return WindowField(r.pair,
+                                                  &PooledLocusEstimate::n);
                              })
       .def_property_readonly("window_sigma_n",
-                             [](const PairResult& r) -> py::object {
-                               return PairDict(r.pair)["window_sigma_n"];
+                             [](const PairResult& r) {
+                               return WindowField(
+                                   r.pair, &PooledLocusEstimate::sigma_n);
                              })
       .def_property_readonly(
           "medium_switch",
