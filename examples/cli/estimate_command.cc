@@ -183,7 +183,6 @@ int RunEstimate() {
     sequence_options.front_end = *cli->front_end;
     sequence_options.estimation = estimation;
     sequence_options.estimation.per_frame_estimates = false;
-    sequence_options.window = estimation.window;
     ImageRun image_run;
     image_run.source = (*source)->Describe();
     const size_t pairs = (*source)->NumPairs();

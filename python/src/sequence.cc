@@ -96,11 +96,11 @@ Sequence MakeSequence(const py::object& rig_object,
         "refinement must be an rcm.RefinementOptions or a dict of its "
         "keywords");
   }
-  options.window.window_frames = window_frames;
-  options.window.change_threshold = change_threshold;
-  options.window.confirm_frames =
-      std::min(options.window.confirm_frames, std::max(1, window_frames));
-  options.estimation.window = options.window;
+  SlidingWindowOptions& window = options.estimation.window;
+  window.window_frames = window_frames;
+  window.change_threshold = change_threshold;
+  window.confirm_frames =
+      std::min(window.confirm_frames, std::max(1, window_frames));
   options.window_matches = window_matches;
   options.follow_rotation_px = follow_rotation_px;
   options.keep_frames = keep_frames;

@@ -115,7 +115,7 @@ TEST(SequenceEstimator, EstimatesOverTheCurrentMedium) {
   std::unique_ptr<SequenceSimulator> simulator =
       Sequence({{1.0, 3}, {kWater, 4}});
   SequenceEstimatorOptions options;
-  options.window.window_frames = 3;
+  options.estimation.window.window_frames = 3;
   std::unique_ptr<SequenceEstimator> sequence =
       SequenceEstimator::Create(AlphasenseFrontRectifiedRig(), options).value();
   for (int i = 0; i < simulator->num_frames(); ++i) {

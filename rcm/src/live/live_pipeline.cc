@@ -51,7 +51,7 @@ SequenceEstimatorOptions LiveSequenceOptions(
   sequence.front_end = options.front_end;
   sequence.estimation.estimator = EstimatorKind::kWindow;
   sequence.estimation.refinement = options.refinement;
-  sequence.window = options.window;
+  sequence.estimation.window = options.window;
   sequence.window_matches = options.max_matches;
   sequence.keep_frames = false;
   return sequence;

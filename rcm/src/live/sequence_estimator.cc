@@ -54,7 +54,6 @@ RefinementOptions SequenceEstimatorOptions::WindowRefinement() const {
 Status SequenceEstimatorOptions::Check() const {
   RCM_RETURN_IF_ERROR(front_end.Check().WithContext("front end"));
   RCM_RETURN_IF_ERROR(estimation.Check().WithContext("estimator"));
-  RCM_RETURN_IF_ERROR(window.Check().WithContext("window"));
   if (window_matches < 0) {
     return Status::Error("window matches must be >= 0, not " +
                          std::to_string(window_matches));
@@ -77,7 +76,7 @@ StatusOr<std::unique_ptr<SequenceEstimator>> SequenceEstimator::Create(
   if (!front_end.ok()) return front_end.status();
   StatusOr<SlidingWindowRefractiveIndexEstimator> window =
       SlidingWindowRefractiveIndexEstimator::Create(
-          rig, options.WindowRefinement(), options.window);
+          rig, options.WindowRefinement(), options.estimation.window);
   if (!window.ok()) return window.status();
   return std::unique_ptr<SequenceEstimator>(new SequenceEstimator(
       rig, options, std::move(*front_end), std::move(*window)));
@@ -101,7 +100,7 @@ double SequenceEstimator::RotationPixels(const Eigen::Vector3d& a,
 Status SequenceEstimator::Restart(const Eigen::Vector3d& rotation) {
   StatusOr<SlidingWindowRefractiveIndexEstimator> window =
       SlidingWindowRefractiveIndexEstimator::Create(
-          rig_, options_.WindowRefinement(), options_.window);
+          rig_, options_.WindowRefinement(), options_.estimation.window);
   if (!window.ok()) return window.status();
   StatusOr<StereoRig> turned = rig_.WithCam1Moved(rotation);
   if (!turned.ok()) return turned.status();

@@ -63,9 +63,9 @@ struct SequenceEstimatorOptions {
   // the window uses too. systematic_px defaults to the front end's floor
   // (kFrontEndSystematicPx), as `rcm estimate` on images (which also turns
   // on detect_systematic).
+  // estimation.window is the sequence's window too (its length and change
+  // test), the one that guides the pairs and finds changes of medium.
   EstimationOptions estimation = DefaultEstimation();
-  // The window's length and change test.
-  SlidingWindowOptions window;
   // Matches of a pair the window takes at most (SpreadSubset); >= 0, 0
   // takes all. The window's update costs ~60 us of CPU per match with the
   // default drift priors (live_pipeline.h), so 200 keeps a pair's guide and
