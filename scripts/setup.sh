@@ -15,8 +15,8 @@ packages=(
   libgoogle-glog-dev   # CHECK macros for programmer errors
   libyaml-cpp-dev      # Kalibr camchain / ROS camera_info YAML
   nlohmann-json3-dev   # --json output
-  libopencv-dev        # images: PNG/JPEG I/O, remap, drawing plots, SIFT
-  zlib1g-dev libjpeg-dev  # silent integrity checks of PNG/JPEG data before decoding
+  libopencv-dev        # images: remap, drawing plots, SIFT, other image formats
+  libpng-dev libjpeg-dev zlib1g-dev  # PNG/JPEG I/O and their silent integrity checks
   libopencv-contrib-dev  # aruco: AprilTag 36h11 and ChArUco targets
   opencv-doc           # the real stereo chessboard images a calibration test uses
   libgtest-dev libgmock-dev  # tests

@@ -4,7 +4,6 @@
 #include <filesystem>
 #include <map>
 #include <memory>
-#include <opencv2/imgcodecs.hpp>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -13,6 +12,7 @@
 #include "number_list_flag.h"
 #include "rcm/calib/corners_file.h"
 #include "rcm/calib/target_detector.h"
+#include "rcm/io/image_file.h"
 
 DEFINE_string(corners, "",
               "calibrate from these corners (mrcal's corners.vnl format) "
@@ -103,8 +103,8 @@ std::optional<calib::ImageSize> SizeOfFirstReadable(
     for (const fs::path& path : {fs::path(name), corners_folder / name}) {
       std::error_code error;
       if (!fs::is_regular_file(path, error)) continue;
-      const cv::Mat image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
-      if (!image.empty()) return calib::ImageSize{image.cols, image.rows};
+      const StatusOr<cv::Mat> image = ReadImageAsStored(path.string());
+      if (image.ok()) return calib::ImageSize{image->cols, image->rows};
     }
   }
   return std::nullopt;

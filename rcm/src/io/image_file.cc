@@ -9,11 +9,11 @@
 // jpeglib.h uses FILE and size_t without declaring them: after <cstdio>.
 #include <jpeglib.h>
 
-#include <opencv2/imgcodecs.hpp>
 #include <utility>
 #include <vector>
 
 #include "rcm/io/atomic_file.h"
+#include "rcm/io/image_codec.h"
 
 namespace rcm {
 
@@ -29,15 +29,9 @@ Status WritePng(const cv::Mat& image, const std::string& path) {
                          "or 4 channels, got " +
                          cv::typeToString(image.type()));
   }
-  std::vector<uchar> encoded;
-  try {
-    if (!cv::imencode(".png", image, encoded)) {
-      return Status::Error(path + ": PNG encoding failed");
-    }
-  } catch (const cv::Exception& error) {
-    return Status::Error(path + ": PNG encoding failed: " + error.msg);
-  }
-  return WriteFileAtomically(path, std::string(encoded.begin(), encoded.end()));
+  StatusOr<std::string> encoded = EncodePng(image);
+  if (!encoded.ok()) return encoded.status().WithContext(path);
+  return WriteFileAtomically(path, *encoded);
 }
 
 namespace {
@@ -482,26 +476,13 @@ Status CheckJpeg(std::string_view bytes) {
   return Status::Ok();
 }
 
-StatusOr<cv::Mat> DecodeFile(const std::string& path, int flags) {
+StatusOr<cv::Mat> DecodeFile(const std::string& path, ImageReadMode mode) {
   StatusOr<std::string> contents = ReadFileToString(path);
   if (!contents.ok()) return contents.status();
   const std::string& bytes = *contents;
   RCM_RETURN_IF_ERROR(CheckImageFileStructure(bytes).WithContext(path));
-  cv::Mat image;
-  if (!bytes.empty()) {
-    try {
-      const cv::Mat buffer(1, static_cast<int>(bytes.size()), CV_8UC1,
-                           const_cast<char*>(bytes.data()));
-      image = cv::imdecode(buffer, flags);
-    } catch (const cv::Exception&) {
-      image = cv::Mat();
-    }
-  }
-  if (image.empty()) {
-    return Status::Error(
-        path +
-        ": not an image OpenCV can decode (corrupt or unsupported format)");
-  }
+  StatusOr<cv::Mat> image = DecodeImage(bytes, mode);
+  if (!image.ok()) return image.status().WithContext(path);
   return image;
 }
 
@@ -516,11 +497,12 @@ Status CheckImageFileStructure(std::string_view bytes) {
 }
 
 StatusOr<cv::Mat> ReadImage(const std::string& path, bool grayscale) {
-  return DecodeFile(path, grayscale ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR);
+  return DecodeFile(path,
+                    grayscale ? ImageReadMode::kGray : ImageReadMode::kColor);
 }
 
 StatusOr<cv::Mat> ReadImageAsStored(const std::string& path) {
-  return DecodeFile(path, cv::IMREAD_UNCHANGED);
+  return DecodeFile(path, ImageReadMode::kAsStored);
 }
 
 }  // namespace rcm

@@ -9,7 +9,6 @@
 #include <cstdint>
 #include <filesystem>
 #include <future>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <optional>
 #include <string_view>

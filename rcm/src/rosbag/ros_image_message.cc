@@ -9,11 +9,11 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <utility>
 #include <vector>
 
+#include "rcm/io/image_codec.h"
 #include "rcm/util/message_text.h"
 #include "rcm/util/number_format.h"
 
@@ -111,17 +111,16 @@ StatusOr<cv::Mat> DecodeImage(const sensor_msgs::Image& message) {
 StatusOr<cv::Mat> DecodeCompressedImage(
     const sensor_msgs::CompressedImage& message) {
   const std::string format = QuoteForMessage(message.format);
-  cv::Mat image;
-  try {
-    image = cv::imdecode(message.data, cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception&) {
-    image.release();
-  }
-  if (image.empty()) {
+  StatusOr<cv::Mat> decoded = DecodeImage(
+      std::string_view(reinterpret_cast<const char*>(message.data.data()),
+                       message.data.size()),
+      ImageReadMode::kAsStored);
+  if (!decoded.ok()) {
     return Status::Error("compressed image (format " + format + ", " +
                          std::to_string(message.data.size()) +
                          " bytes) is corrupt or not a format OpenCV decodes");
   }
+  cv::Mat image = *std::move(decoded);
   if (image.depth() != CV_8U ||
       (image.channels() != 1 && image.channels() != 3 &&
        image.channels() != 4)) {
@@ -168,14 +167,7 @@ Status EncodeImage(const cv::Mat& image, const std::string& encoding,
 
 Status EncodeCompressedImage(const cv::Mat& image, const std::string& format,
                              sensor_msgs::CompressedImage* message) {
-  std::string extension;
-  std::vector<int> parameters;
-  if (format == "png") {
-    extension = ".png";
-  } else if (format == "jpeg") {
-    extension = ".jpg";
-    parameters = {cv::IMWRITE_JPEG_QUALITY, 95};
-  } else {
+  if (format != "png" && format != "jpeg") {
     return Status::Error("unknown format " + QuoteForMessage(format) +
                          " (png or jpeg)");
   }
@@ -185,13 +177,13 @@ Status EncodeCompressedImage(const cv::Mat& image, const std::string& format,
   }
   const std::string encoding = image.channels() == 1 ? "mono8" : "bgr8";
   message->format = encoding + "; " + format + " compressed " + encoding;
-  try {
-    if (!cv::imencode(extension, image, message->data, parameters)) {
-      return Status::Error(format + " encoding failed");
-    }
-  } catch (const cv::Exception& error) {
-    return Status::Error(format + " encoding failed: " + OneLine(error));
+  StatusOr<std::string> encoded =
+      format == "png" ? EncodePng(image) : EncodeJpeg(image, /*quality=*/95);
+  if (!encoded.ok()) {
+    return Status::Error(format +
+                         " encoding failed: " + encoded.status().message());
   }
+  message->data.assign(encoded->begin(), encoded->end());
   return Status::Ok();
 }
 

@@ -43,7 +43,7 @@ std::string StampedName(const std::string& topic, double stamp_s);
 StatusOr<cv::Mat> DecodeImage(const sensor_msgs::Image& message);
 
 // The 8-bit, 1- or 3-channel (BGR) image of a sensor_msgs/CompressedImage
-// (whatever cv::imdecode reads; an alpha channel is dropped).
+// (what rcm::DecodeImage reads, image_codec.h; an alpha channel is dropped).
 StatusOr<cv::Mat> DecodeCompressedImage(
     const sensor_msgs::CompressedImage& message);
 
