@@ -56,6 +56,7 @@ std::vector<OptionField> FrontEndOptionFields(StereoFrontEndOptions* o) {
              py::make_tuple(o->search_range.min, o->search_range.max));
        }},
       DoubleOption("reacquire_fraction", &o->reacquire_fraction),
+      IntOption("max_refined_matches", &o->max_refined_matches),
       IntOption("num_threads", &o->num_threads),
   };
 }
@@ -120,7 +121,8 @@ tolerance_px=2.0 (half width of the locus band, pixels), min_distance=0.2,
 ratio=0.8 (Lowe's ratio), cross_check=True, max_hamming_distance=64,
 subpixel=True, subpixel_window=11 (pixels), subpixel_max_shift_px=2.0,
 search_range=(1.0, 1.6) (the n interval the band covers before anything is
-known), reacquire_fraction=0.5, num_threads=2.
+known), reacquire_fraction=0.5, max_refined_matches=0 (0: all),
+num_threads=2.
 )doc";
 
 }  // namespace
@@ -157,6 +159,9 @@ void BindFrontEnd(py::module_& module) {
        {"reacquire_fraction",
         "A guided pair keeping less than this fraction of the prior band's "
         "matches is matched again in it (0.5)."},
+       {"max_refined_matches",
+        "Descriptor matches refined to subpixel and returned at most, every "
+        "k-th; 0 refines all (0)."},
        {"num_threads", "Threads (2)."}});
   // C++ kFrontEndSystematicPx: the systematic error floor of this front
   // end's matches (pixels), for refine_refractive_index(systematic_px=...)

@@ -119,7 +119,12 @@ StatusOr<NodeOptions> ReadOptions(const ros::NodeHandle& nh) {
       Param(nh, "search_min", p.front_end.search_range.min);
   p.front_end.search_range.max =
       Param(nh, "search_max", p.front_end.search_range.max);
-  p.max_matches = Param(nh, "max_matches", p.max_matches);
+  // ~max_matches: the name of 0.2.0's parameter, still read.
+  if (nh.hasParam("max_matches") && !nh.hasParam("window_matches")) {
+    ROS_WARN("~max_matches is now ~window_matches; read as such");
+    p.window_matches = Param(nh, "max_matches", p.window_matches);
+  }
+  p.window_matches = Param(nh, "window_matches", p.window_matches);
   p.map_update_threshold =
       Param(nh, "map_update_threshold", p.map_update_threshold);
   p.initial_n = Param(nh, "initial_n", p.initial_n);

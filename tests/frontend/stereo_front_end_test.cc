@@ -259,10 +259,14 @@ TEST(StereoFrontEnd, ReacquiresWhenTheMediumChanges) {
   // With re-acquisition off the air frame stays in the water band with
   // fewer matches.
   options.reacquire_fraction = 0.0;
-  StereoFrontEnd without_reacquisition = StereoFrontEnd::Create(rig, options).value();
-  ASSERT_TRUE(without_reacquisition.Match(frames.water[0].left, frames.water[0].right).ok());
+  StereoFrontEnd without_reacquisition =
+      StereoFrontEnd::Create(rig, options).value();
+  ASSERT_TRUE(
+      without_reacquisition.Match(frames.water[0].left, frames.water[0].right)
+          .ok());
   const StereoMatches stuck =
-      without_reacquisition.Match(frames.air.left, frames.air.right, 2, frames.air.t, water)
+      without_reacquisition
+          .Match(frames.air.left, frames.air.right, 2, frames.air.t, water)
           .value();
   EXPECT_FALSE(stuck.reacquired);
   EXPECT_EQ(stuck.band.min, water.min);
@@ -341,6 +345,45 @@ TEST(StereoFrontEnd, SameMatchesOnOneAndTwoThreads) {
   }
 }
 
+// max_refined_matches: every k-th descriptor match is refined, each to
+// exactly the pixel the full run refines it to (refinement is per match),
+// and the rest are not.
+TEST(StereoFrontEnd, RefinesOnlyEveryKthMatchWhenCapped) {
+  const StereoRig rig = AlphasenseFrontUnrectifiedRig();
+  const SequenceFrame frame =
+      Simulator(rig, {MediaSegment{1.345, 1}})->Frame(0).value();
+  StereoFrontEndOptions capped_options;
+  capped_options.max_refined_matches = 150;
+  const StereoMatches all = StereoFrontEnd::Create(rig, StereoFrontEndOptions())
+                                .value()
+                                .Match(frame.left, frame.right)
+                                .value();
+  const StereoMatches capped = StereoFrontEnd::Create(rig, capped_options)
+                                   .value()
+                                   .Match(frame.left, frame.right)
+                                   .value();
+  ASSERT_GT(all.descriptor_matches, 600);
+  EXPECT_EQ(capped.descriptor_matches, all.descriptor_matches);
+  // Refinement and the band's check drop a few of the 150 (the full run
+  // keeps over 95 % of its matches).
+  ASSERT_LE(capped.matches.size(), 150u);
+  EXPECT_GE(capped.matches.size(), 140u);
+  EXPECT_GE(all.matches.size(), 0.95 * all.descriptor_matches);
+  size_t next = 0;  // both runs keep the matches' order
+  for (const StereoCorrespondence& match : capped.matches) {
+    while (next < all.matches.size() &&
+           all.matches[next].left_pixel != match.left_pixel) {
+      ++next;
+    }
+    ASSERT_LT(next, all.matches.size()) << "a match the full run has not";
+    EXPECT_EQ(all.matches[next].right_pixel, match.right_pixel);
+  }
+  // Spread over all of them, not the first 150: the last is the last
+  // descriptor match's k-th, within the last 1/150 (and a few dropped) of
+  // the full run's.
+  EXPECT_GT(next, all.matches.size() * 0.97);
+}
+
 TEST(StereoFrontEnd, RejectsImagesOfAnotherSizeThanTheCalibration) {
   StereoFrontEnd front_end =
       StereoFrontEnd::Create(AlphasenseFrontRectifiedRig(),
@@ -408,6 +451,10 @@ TEST(StereoFrontEnd, OptionsCheck) {
   options = StereoFrontEndOptions();
   options.num_threads = 0;
   EXPECT_EQ(options.Check().message(), "threads must be at least 1, got 0");
+  options = StereoFrontEndOptions();
+  options.max_refined_matches = -1;
+  EXPECT_EQ(options.Check().message(),
+            "max refined matches must be >= 0, got -1");
   options = StereoFrontEndOptions();
   options.search_range = RefractiveIndexInterval{0.9, 1.6};
   EXPECT_EQ(options.Check().message(),

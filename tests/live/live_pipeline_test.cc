@@ -5,11 +5,10 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <opencv2/imgproc.hpp>
 #include <string>
 #include <thread>
 #include <vector>
-
-#include <opencv2/imgproc.hpp>
 
 #include "rcm/live/latest_slot.h"
 #include "rcm/sim/reference_rigs.h"
@@ -79,8 +78,8 @@ TEST(LivePipeline, FollowsAirWaterAirAndItsMapsFollowN) {
   EXPECT_GE(switches[1], 22);
   EXPECT_LT(switches[1], 22 + kMaxSwitchDelayPairs);
   ASSERT_TRUE(water_n.has_value());
-  std::printf("water: n %.5f +- %.5f; %d map updates\n", *water_n,
-              *water_sigma, map_updates);
+  std::printf("water: n %.5f +- %.5f; %d map updates\n", *water_n, *water_sigma,
+              map_updates);
   EXPECT_LT(std::abs(*water_n - kWater), kMaxWaterError);
   EXPECT_LT(std::abs(*water_n - kWater), 3.0 * *water_sigma);
   EXPECT_GE(map_updates, 2);  // into the water and back
@@ -110,8 +109,9 @@ TEST(LivePipeline, RefusesBadPairsAndKeepsRunning) {
       {as_float, frame.right, ""},
       {cv::Mat(), frame.right, ""},
       {frame.left, small, ""},
-      {black, black, "a blank pair (gray standard deviation 0.00 < 2.00): "
-                     "a black, saturated or covered frame"},
+      {black, black,
+       "a blank pair (gray standard deviation 0.00 < 2.00): "
+       "a black, saturated or covered frame"},
       {frame.left, white, ""},
   };
   for (size_t c = 0; c < cases.size(); ++c) {
@@ -131,6 +131,9 @@ TEST(LivePipeline, RefusesBadPairsAndKeepsRunning) {
   ASSERT_TRUE(good.ok()) << good.status().message();
   EXPECT_EQ(good->frame, 0);
   EXPECT_GT(good->num_matches, 100);
+  // The front end refines only the matches the window takes.
+  EXPECT_LE(good->num_matches, LivePipelineOptions().window_matches);
+  EXPECT_EQ(good->num_estimated, good->num_matches);
 }
 
 // On hold the maps stay at their n while the estimate still runs; a reset
@@ -169,7 +172,13 @@ TEST(LivePipeline, HoldKeepsTheMapsAndResetMovesThem) {
 
 TEST(LivePipelineOptions, Check) {
   EXPECT_TRUE(LivePipelineOptions().Check().ok());
+  // The sequence engine's policy, the one `rcm estimate` runs.
+  EXPECT_EQ(LivePipelineOptions().window_matches,
+            SequenceEstimatorOptions().window_matches);
   LivePipelineOptions options;
+  options.window_matches = -1;
+  EXPECT_EQ(options.Check().message(), "window matches must be >= 0, not -1");
+  options = LivePipelineOptions();
   options.initial_n = 2.5;
   EXPECT_EQ(options.Check().message(), "initial n must be in [1, 2], not 2.5");
   options = LivePipelineOptions();
@@ -183,8 +192,8 @@ TEST(LivePipelineOptions, Check) {
   EXPECT_FALSE(options.Check().ok());
   options = LivePipelineOptions();
   options.window.window_frames = 0;
-  EXPECT_FALSE(LivePipeline::Create(AlphasenseFrontRectifiedRig(), options)
-                   .ok());
+  EXPECT_FALSE(
+      LivePipeline::Create(AlphasenseFrontRectifiedRig(), options).ok());
 }
 
 TEST(LatestSlot, TheLatestItemWinsAndDropsAreCounted) {

@@ -130,6 +130,19 @@ TEST(SequenceEstimator, EstimatesOverTheCurrentMedium) {
   EXPECT_LT(std::abs(estimate->n - kWater), 3.0 * estimate->sigma_n);
 }
 
+// Without kept frames only the window takes a pair's matches: the front end
+// refines only as many; with them, the final estimate takes every match.
+TEST(SequenceEstimatorOptions, FrontEndRefinesWhatTheMatchesAreFor) {
+  SequenceEstimatorOptions options;
+  EXPECT_EQ(options.FrontEnd().max_refined_matches, 0);
+  options.keep_frames = false;
+  EXPECT_EQ(options.FrontEnd().max_refined_matches, options.window_matches);
+  options.window_matches = 0;  // the window takes all
+  EXPECT_EQ(options.FrontEnd().max_refined_matches, 0);
+  options.front_end.max_refined_matches = 50;  // the caller's own cap
+  EXPECT_EQ(options.FrontEnd().max_refined_matches, 50);
+}
+
 TEST(SequenceEstimator, RefusesBadPairsAndOptions) {
   std::unique_ptr<SequenceEstimator> sequence =
       SequenceEstimator::Create(AlphasenseFrontRectifiedRig(),

@@ -63,6 +63,10 @@ Status StereoFrontEndOptions::Check() const {
   if (!(reacquire_fraction >= 0.0 && reacquire_fraction <= 1.0)) {
     return Status::Error("re-acquisition fraction must be in [0, 1]");
   }
+  if (max_refined_matches < 0) {
+    return Status::Error("max refined matches must be >= 0, got " +
+                         std::to_string(max_refined_matches));
+  }
   if (num_threads < 1) {
     return Status::Error("threads must be at least 1, got " +
                          std::to_string(num_threads));
@@ -104,14 +108,12 @@ StatusOr<StereoMatches> StereoFrontEnd::Match(
   FeatureDetector* detectors[2] = {&left_detector_, &right_detector_};
   ParallelFor(2, options_.num_threads, 1, [&](int64_t first, int64_t last) {
     for (int64_t side = first; side < last; ++side) {
-      sides[side] = DetectImage(*images[side], options_.clahe,
-                                detectors[side]);
+      sides[side] = DetectImage(*images[side], options_.clahe, detectors[side]);
     }
   });
   StereoMatches result;
   result.left_keypoints = static_cast<int>(sides[0].features.keypoints.size());
-  result.right_keypoints =
-      static_cast<int>(sides[1].features.keypoints.size());
+  result.right_keypoints = static_cast<int>(sides[1].features.keypoints.size());
   result.timings.preprocess_ms =
       std::max(sides[0].preprocess_ms, sides[1].preprocess_ms);
   result.timings.detect_ms = std::max(sides[0].detect_ms, sides[1].detect_ms);
@@ -156,11 +158,21 @@ StatusOr<StereoMatches> StereoFrontEnd::Match(
 
   // Stages 4-5.
   const Clock::time_point refine_start = Clock::now();
+  // The matches refined: all, or every k-th (SpreadSubset's rule).
+  std::vector<KeypointMatch>& descriptor_matches = matched->matches;
+  const size_t size = descriptor_matches.size();
+  const size_t cap = static_cast<size_t>(options_.max_refined_matches);
+  if (cap > 0 && size > cap) {
+    for (size_t k = 0; k < cap; ++k) {
+      descriptor_matches[k] = descriptor_matches[k * size / cap];
+    }
+    descriptor_matches.resize(cap);
+  }
   std::vector<cv::Point2f> left_points;
   std::vector<cv::Point2f> right_points;
-  left_points.reserve(matched->matches.size());
-  right_points.reserve(matched->matches.size());
-  for (const KeypointMatch& match : matched->matches) {
+  left_points.reserve(descriptor_matches.size());
+  right_points.reserve(descriptor_matches.size());
+  for (const KeypointMatch& match : descriptor_matches) {
     left_points.push_back(sides[0].features.keypoints[match.left].pt);
     right_points.push_back(sides[1].features.keypoints[match.right].pt);
   }
@@ -178,8 +190,7 @@ StatusOr<StereoMatches> StereoFrontEnd::Match(
     correspondence.right_pixel =
         Eigen::Vector2d(right_points[i].x, right_points[i].y);
     // The left pixel is the keypoint's: its key is the one matched with.
-    const LocusKey& left_key =
-        matched->left_keys[matched->matches[i].left];
+    const LocusKey& left_key = matched->left_keys[descriptor_matches[i].left];
     if (!band.Contains(left_key, band.RightKey(correspondence.right_pixel))) {
       continue;
     }

@@ -52,7 +52,7 @@ SequenceEstimatorOptions LiveSequenceOptions(
   sequence.estimation.estimator = EstimatorKind::kWindow;
   sequence.estimation.refinement = options.refinement;
   sequence.estimation.window = options.window;
-  sequence.window_matches = options.max_matches;
+  sequence.window_matches = options.window_matches;
   sequence.keep_frames = false;
   return sequence;
 }
@@ -95,9 +95,9 @@ Status LivePipelineOptions::Check() const {
         "the map update threshold must be positive and finite, not " +
         FormatDouble(map_update_threshold));
   }
-  if (max_matches < 0) {
-    return Status::Error("max matches must be >= 0, not " +
-                         std::to_string(max_matches));
+  if (window_matches < 0) {
+    return Status::Error("window matches must be >= 0, not " +
+                         std::to_string(window_matches));
   }
   if (!(min_contrast >= 0.0) || !std::isfinite(min_contrast)) {
     return Status::Error("min contrast must be >= 0 and finite, not " +

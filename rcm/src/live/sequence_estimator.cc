@@ -51,6 +51,14 @@ RefinementOptions SequenceEstimatorOptions::WindowRefinement() const {
   return window_refinement;
 }
 
+StereoFrontEndOptions SequenceEstimatorOptions::FrontEnd() const {
+  StereoFrontEndOptions options = front_end;
+  if (!keep_frames && options.max_refined_matches == 0) {
+    options.max_refined_matches = window_matches;
+  }
+  return options;
+}
+
 Status SequenceEstimatorOptions::Check() const {
   RCM_RETURN_IF_ERROR(front_end.Check().WithContext("front end"));
   RCM_RETURN_IF_ERROR(estimation.Check().WithContext("estimator"));
@@ -72,7 +80,7 @@ StatusOr<std::unique_ptr<SequenceEstimator>> SequenceEstimator::Create(
     const StereoRig& rig, const SequenceEstimatorOptions& options) {
   RCM_RETURN_IF_ERROR(options.Check());
   StatusOr<StereoFrontEnd> front_end =
-      StereoFrontEnd::Create(rig, options.front_end);
+      StereoFrontEnd::Create(rig, options.FrontEnd());
   if (!front_end.ok()) return front_end.status();
   StatusOr<SlidingWindowRefractiveIndexEstimator> window =
       SlidingWindowRefractiveIndexEstimator::Create(
@@ -105,7 +113,7 @@ Status SequenceEstimator::Restart(const Eigen::Vector3d& rotation) {
   StatusOr<StereoRig> turned = rig_.WithCam1Moved(rotation);
   if (!turned.ok()) return turned.status();
   StatusOr<StereoFrontEnd> front_end =
-      StereoFrontEnd::Create(*turned, options_.front_end);
+      StereoFrontEnd::Create(*turned, options_.FrontEnd());
   if (!front_end.ok()) return front_end.status();
   window_ = std::move(*window);
   front_end_ = std::move(*front_end);
@@ -163,7 +171,7 @@ StatusOr<SequencePair> SequenceEstimator::AddPair(
     StatusOr<StereoRig> turned = rig_.WithCam1Moved(*pair.window->rotation);
     if (turned.ok()) {
       StatusOr<StereoFrontEnd> front_end =
-          StereoFrontEnd::Create(*turned, options_.front_end);
+          StereoFrontEnd::Create(*turned, options_.FrontEnd());
       if (front_end.ok()) {
         front_end_ = std::move(*front_end);
         followed_ = *pair.window->rotation;

@@ -6,6 +6,7 @@
 //   3. match        descriptors within the refractive
 //                   epipolar band of an n interval   (guided_matcher.h)
 //   4. refine       right pixels to subpixel         (subpixel_refinement.h)
+//                   (at most max_refined_matches of them)
 //   5. verify       refined pairs still in the band  (locus_band.h)
 //
 // Stages 1-2 (and the band keys) run on the two images at once. The band
@@ -67,6 +68,14 @@ struct StereoFrontEndOptions {
   // frame matched with search_range is matched again with it; in [0, 1]
   // (0 never re-acquires).
   double reacquire_fraction = 0.5;
+  // Descriptor matches refined (stages 4-5) and returned at most: every
+  // k-th in the order they were matched, as SpreadSubset
+  // (sequence_estimator.h) takes them; >= 0, 0 refines all. Refinement is
+  // most of a pair's front end (~26 us per match of 720x540 on one core),
+  // so a caller that uses only so many matches of a pair (the live
+  // pipeline's window, SequenceEstimatorOptions::window_matches) refines
+  // only those.
+  int max_refined_matches = 0;
   // Threads; >= 1. 2 runs the two images' stages 1-2 at once.
   int num_threads = 2;
 

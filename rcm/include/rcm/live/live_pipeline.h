@@ -32,17 +32,18 @@
 // about a pair's whole period at 20 Hz, hence the worker.
 //
 // Cost per 720x540 pair (live_benchmark, this project's 2-core machine):
-// the window's update of all ~1200 matches and both remaps take 72 ms of
-// CPU for a rig read as `rcm` reads a camchain without a sidecar (the
-// default drift and focal drift priors: each pair's refinement estimates
-// cam1's rotation and both focal scales with n, and its normal equations,
-// taken at the window's rotation, carry the lenses' columns), 18-20 ms for a
-// rig without them; the front end's matching adds ~31-38 ms (on both cores).
-// With all matches a pair therefore takes ~100 ms of wall time: about 10 pairs
-// a second, the rest dropped whole by the caller (latest_slot.h). max_matches
-// 400 takes the estimation to 27 ms, for 20 Hz. The map threshold's default,
-// 1e-3, moves the corrected images' focal length by 0.1 %, below what a metric
-// depth of 1 % needs.
+// a whole pair (checks, front end, window, remaps) takes 40-50 ms of CPU
+// and 32-33 ms of wall time (BM_LivePipelinePair; 129-136 ms of CPU when
+// the window took, and the front end refined, all ~1200 matches). Of it
+// the window's update of its 200 matches and both remaps take 17 ms of CPU
+// for a rig read as `rcm` reads a camchain without a sidecar (the default
+// drift and focal drift priors: each pair's refinement estimates cam1's
+// rotation and both focal scales with n, and its normal equations, taken
+// at the window's rotation, carry the lenses' columns); 89 ms with every
+// match. At 20 Hz a pair has 50 ms; the caller drops whole the pairs that
+// come while one is processed (latest_slot.h). The map threshold's
+// default, 1e-3, moves the corrected images' focal length by 0.1 %, below
+// what a metric depth of 1 % needs.
 //
 // Hold (SetHold): the maps stay at their n and no build starts; the
 // estimation keeps running and is reported. Reset(n): a new window and no
@@ -89,14 +90,15 @@ struct LivePipelineOptions {
   double map_update_threshold = 1e-3;
   // Matches of a pair the window takes at most, every k-th of the front
   // end's (which come in image order, so the subset keeps their spread);
-  // >= 0, 0 takes all. The window's update costs ~60 us of CPU per match
-  // with the default priors (the frame's refinement with cam1's rotation
-  // and the focal scales, the lenses' columns of its normal equations, the
-  // locus cost function's 577 nodes; ~12 us without priors): the ~1200
-  // matches a 720x540 pair gives take ~72 ms, and the cap bounds a richer
-  // scene's up to the front end's 2000 features. 400 fits the 25 ms that
-  // half a core at 20 Hz allows.
-  int max_matches = 1500;
+  // >= 0, 0 takes all. The sequence engine's own default
+  // (SequenceEstimatorOptions::window_matches, the one policy `rcm
+  // estimate` and Python run too): 200. The window's update costs ~60 us of
+  // CPU per match with the default priors (the frame's refinement with
+  // cam1's rotation and the focal scales, the lenses' columns of its normal
+  // equations, the locus cost function's 577 nodes; ~12 us without
+  // priors), so 200 keep it at ~12 ms where the ~1200 matches of a 720x540
+  // pair took ~72 ms.
+  int window_matches = SequenceEstimatorOptions().window_matches;
   // A gray standard deviation below this (either image) refuses the pair
   // as blank; >= 0 (0 accepts every pair). 2 gray levels: a lit scene has
   // tens, a covered or black frame its sensor noise.
@@ -112,7 +114,7 @@ struct LiveFrame {
   int64_t frame = 0;        // 0, 1, ... in the order of Process calls accepted
   double stamp = 0.0;       // the caller's, unchanged
   int64_t num_matches = 0;  // the front end's
-  int64_t num_estimated = 0;  // of them, the window's (max_matches)
+  int64_t num_estimated = 0;  // of them, the window's (window_matches)
   // The window estimate after this pair, or why there is none.
   StatusOr<SlidingWindowRefractiveIndexEstimator::Estimate> estimate =
       Status::Error("no estimate");

@@ -21,7 +21,8 @@
 //      the rig turned by it (a rig that turned since its calibration would
 //      otherwise lose, and bias, the matches the turn moves out of the
 //      band);
-//   4. with keep_frames, the matches are kept for Estimate().
+//   4. with keep_frames, the matches are kept for Estimate(); without, the
+//      front end refines only the matches the window takes (FrontEnd()).
 //
 // Estimate() solves the final estimate once (estimate_refractive_index.h),
 // with options.estimation, over the kept frames since the window's last
@@ -88,6 +89,12 @@ struct SequenceEstimatorOptions {
   // (the window self-calibrates cam1's rotation from its drift prior; a
   // freely refined rotation is the final estimate's only).
   RefinementOptions WindowRefinement() const;
+  // The front end's options: front_end, and without keep_frames (nothing
+  // but the window takes the matches) at most window_matches of a pair
+  // refined (StereoFrontEndOptions::max_refined_matches, unless front_end
+  // sets it), the same subset the window would take of them all, without
+  // refining the rest.
+  StereoFrontEndOptions FrontEnd() const;
   // Errors: the parts' Check(); window_matches < 0; follow_rotation_px not
   // > 0; max_matching_passes < 1.
   Status Check() const;
