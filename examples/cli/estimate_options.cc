@@ -201,10 +201,8 @@ StatusOr<EstimateCliOptions> EstimateOptionsFromFlags() {
   EstimationOptions& estimation = cli.estimation;
   estimation.estimator = *estimator;
   estimation.estimate_air_gap = FLAGS_estimate_air_gap;
-  estimation.window.window_frames = FLAGS_window;
+  estimation.window.SetWindowFrames(FLAGS_window);
   estimation.window.change_threshold = FLAGS_change_threshold;
-  estimation.window.confirm_frames =
-      std::min(estimation.window.confirm_frames, std::max(1, FLAGS_window));
   if (const Status status = estimation.window.Check(); !status.ok()) {
     return status.WithContext("--window/--change-threshold");
   }

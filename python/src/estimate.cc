@@ -74,10 +74,8 @@ RefractiveIndexEstimate Estimate(const py::object& rig_object,
   options.estimator = *kind;
   ApplyRefinementOptions(kwargs, &options.refinement,
                          "estimate_refractive_index");
-  options.window.window_frames = window_frames;
+  options.window.SetWindowFrames(window_frames);
   options.window.change_threshold = change_threshold;
-  options.window.confirm_frames =
-      std::min(options.window.confirm_frames, std::max(1, window_frames));
   options.closed_form.eta = mask_eta;
   options.estimate_air_gap = estimate_air_gap;
   options.per_frame_estimates = per_frame_estimates;

@@ -97,10 +97,8 @@ Sequence MakeSequence(const py::object& rig_object,
         "keywords");
   }
   SlidingWindowOptions& window = options.estimation.window;
-  window.window_frames = window_frames;
+  window.SetWindowFrames(window_frames);
   window.change_threshold = change_threshold;
-  window.confirm_frames =
-      std::min(window.confirm_frames, std::max(1, window_frames));
   options.window_matches = window_matches;
   options.follow_rotation_px = follow_rotation_px;
   options.keep_frames = keep_frames;

@@ -108,7 +108,7 @@ StatusOr<NodeOptions> ReadOptions(const ros::NodeHandle& nh) {
         "air");
   }
   LivePipelineOptions& p = options.pipeline;
-  p.window.window_frames = Param(nh, "window", p.window.window_frames);
+  p.window.SetWindowFrames(Param(nh, "window", p.window.window_frames));
   p.window.change_threshold =
       Param(nh, "change_threshold", p.window.change_threshold);
   p.window.confirm_frames =

@@ -19,18 +19,6 @@ namespace {
 // enough to carry that to n.
 constexpr double kExactTolerance = 1e-9;
 
-// `frames` frames of `per_frame` exact correspondences at depths 0.6-6 m.
-std::vector<StereoCorrespondence> Sequence(const StereoRig& rig, double n,
-                                           int frames, int per_frame,
-                                           uint64_t seed) {
-  StereoSamplerOptions options;
-  options.n = n;
-  options.num_frames = frames;
-  options.per_frame = per_frame;
-  options.seed = seed;
-  return SampleStereoCorrespondences(rig, options).value();
-}
-
 // The rig with cam1 rotated about its own center by `angle_axis`.
 StereoRig RotateCam1(const StereoRig& rig, const Eigen::Vector3d& angle_axis) {
   Eigen::Matrix3d delta;
@@ -52,7 +40,7 @@ TEST(BatchRefinement, ExactOnEveryRigAndIndex) {
   for (const StereoRig& rig : rigs) {
     for (const double n : {1.0, 1.2, 1.333, 1.6}) {
       const StatusOr<RefinementSummary> summary = RefineRefractiveIndex(
-          rig, Sequence(rig, n, 2, 150, 3), RefinementOptions());
+          rig, test::ExactSequence(rig, n, 2, 150, 3), RefinementOptions());
       ASSERT_TRUE(summary.ok()) << summary.status().message();
       EXPECT_NEAR(summary->n, n, kExactTolerance);
       EXPECT_EQ(summary->inliers.size(), 300u);
@@ -125,7 +113,7 @@ TEST(BatchRefinement, MonteCarloEfficientWithHonestSigma) {
   double sum_error = 0.0;
   for (int trial = 0; trial < kTrials; ++trial) {
     const std::vector<StereoCorrespondence> exact =
-        Sequence(rig, kTrueN, 5, 200, 1000 + trial);
+        test::ExactSequence(rig, kTrueN, 5, 200, 1000 + trial);
     std::vector<StereoCorrespondence> data = exact;
     AddPixelNoise(kSigmaPx, 2000 + trial, &data);
     const StatusOr<RefinementSummary> summary =
@@ -157,7 +145,7 @@ TEST(BatchRefinement, NoisyWithinFourCramerRaoBounds) {
   const StereoRig rig = test::IdealRig(test::EurocRadtanCamera(),
                                        test::EurocRadtanCamera(), 0.12);
   const std::vector<StereoCorrespondence> exact =
-      Sequence(rig, kTrueN, 4, 250, 31);
+      test::ExactSequence(rig, kTrueN, 4, 250, 31);
   std::vector<StereoCorrespondence> data = exact;
   AddPixelNoise(kSigmaPx, 32, &data);
   const RefinementSummary summary =
@@ -186,7 +174,7 @@ TEST(BatchRefinement, AirAtTheLowerBoundEndsThereInFewIterations) {
   int on_bound = 0;
   for (int trial = 0; trial < kTrials; ++trial) {
     std::vector<StereoCorrespondence> data =
-        Sequence(rig, 1.0, 4, 300, 500 + trial);
+        test::ExactSequence(rig, 1.0, 4, 300, 500 + trial);
     AddPixelNoise(0.3, 600 + trial, &data);
     const StatusOr<RefinementSummary> summary =
         RefineRefractiveIndex(rig, data, RefinementOptions());
@@ -211,7 +199,8 @@ TEST(BatchRefinement, RotationCorrectionIdentifiableOverWideField) {
   const StereoRig truth = test::AlphasenseRealisticRig();
   const Eigen::Vector3d calibration_error(0.002, -0.0025, 0.0015);
   const StereoRig calibrated = RotateCam1(truth, calibration_error);
-  std::vector<StereoCorrespondence> data = Sequence(truth, kTrueN, 10, 300, 41);
+  std::vector<StereoCorrespondence> data =
+      test::ExactSequence(truth, kTrueN, 10, 300, 41);
   AddPixelNoise(0.5, 42, &data);
 
   const RefinementSummary n_only =
@@ -257,7 +246,7 @@ TEST(BatchRefinement, RotationCorrectionNotIdentifiableInNarrowField) {
   const StereoRig rig = test::AlphasenseRealisticRig();
   std::vector<StereoCorrespondence> central;
   for (const StereoCorrespondence& match :
-       Sequence(rig, kTrueN, 1, 40000, 51)) {
+       test::ExactSequence(rig, kTrueN, 1, 40000, 51)) {
     if ((match.left_pixel - Eigen::Vector2d(360.5, 271.0)).norm() < 60.0) {
       central.push_back(match);
     }

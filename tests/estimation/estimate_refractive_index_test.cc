@@ -11,7 +11,6 @@
 #include "rcm/estimation/estimate_json.h"
 #include "rcm/estimation/estimate_warnings.h"
 #include "rcm/io/stereo_rig_file.h"
-#include "rcm/sim/stereo_sampler.h"
 #include "support/test_rigs.h"
 
 namespace rcm {
@@ -25,17 +24,6 @@ constexpr double kExactTolerance = 1e-9;
 constexpr double kSameRunTolerance = 1e-12;
 constexpr double kWaterN = 1.34;
 
-std::vector<StereoCorrespondence> Sequence(const StereoRig& rig, double n,
-                                           int frames, int per_frame,
-                                           uint64_t seed) {
-  StereoSamplerOptions options;
-  options.n = n;
-  options.num_frames = frames;
-  options.per_frame = per_frame;
-  options.seed = seed;
-  return SampleStereoCorrespondences(rig, options).value();
-}
-
 EstimationOptions Options(EstimatorKind kind) {
   EstimationOptions options;
   options.estimator = kind;
@@ -46,7 +34,7 @@ EstimationOptions Options(EstimatorKind kind) {
 TEST(EstimateRefractiveIndex, RefineIsTheBatchRefinement) {
   const StereoRig rig = test::AlphasenseRealisticRig();
   const std::vector<StereoCorrespondence> matches =
-      Sequence(rig, kWaterN, 3, 200, 7);
+      test::ExactSequence(rig, kWaterN, 3, 200, 7);
   const StatusOr<RefractiveIndexEstimate> estimate = EstimateRefractiveIndex(
       rig, SplitFrames(matches), Options(EstimatorKind::kRefine));
   ASSERT_TRUE(estimate.ok()) << estimate.status().message();
@@ -68,7 +56,7 @@ TEST(EstimateRefractiveIndex, EveryEstimatorExactOnNoiseFreeFrames) {
   // The ideal rectified rig, where the closed form (eq. 14) is exact too.
   const StereoRig rig = test::AlphasenseIdealRig();
   const std::vector<FrameMatches> frames =
-      SplitFrames(Sequence(rig, kWaterN, 4, 150, 11));
+      SplitFrames(test::ExactSequence(rig, kWaterN, 4, 150, 11));
   for (const EstimatorKind kind :
        {EstimatorKind::kRefine, EstimatorKind::kOnline, EstimatorKind::kWindow,
         EstimatorKind::kClosedForm}) {
@@ -114,7 +102,7 @@ TEST(EstimateRefractiveIndex, RefineOnlyOptionsRefusedElsewhere) {
 TEST(EstimateRefractiveIndex, ClosedFormOffARectifiedRigSaysSo) {
   const StereoRig rig = test::AlphasenseRealisticRig();
   const StatusOr<RefractiveIndexEstimate> estimate = EstimateRefractiveIndex(
-      rig, SplitFrames(Sequence(rig, kWaterN, 2, 200, 3)),
+      rig, SplitFrames(test::ExactSequence(rig, kWaterN, 2, 200, 3)),
       Options(EstimatorKind::kClosedForm));
   ASSERT_TRUE(estimate.ok()) << estimate.status().message();
   ASSERT_EQ(estimate->warnings.size(), 1u);
@@ -140,15 +128,15 @@ TEST(EstimateWarnings, StaleCalibrationIsNamed) {
     return false;
   };
   const RefractiveIndexEstimate fresh =
-      EstimateRefractiveIndex(rig,
-                              SplitFrames(Sequence(rig, kWaterN, 3, 200, 5)),
-                              Options(EstimatorKind::kRefine))
+      EstimateRefractiveIndex(
+          rig, SplitFrames(test::ExactSequence(rig, kWaterN, 3, 200, 5)),
+          Options(EstimatorKind::kRefine))
           .value();
   EXPECT_FALSE(stale(fresh));
   const RefractiveIndexEstimate moved =
-      EstimateRefractiveIndex(rig,
-                              SplitFrames(Sequence(turned, kWaterN, 3, 200, 5)),
-                              Options(EstimatorKind::kRefine))
+      EstimateRefractiveIndex(
+          rig, SplitFrames(test::ExactSequence(turned, kWaterN, 3, 200, 5)),
+          Options(EstimatorKind::kRefine))
           .value();
   ASSERT_TRUE(moved.rotation.has_value());
   EXPECT_TRUE(stale(moved)) << moved.warnings.size() << " warnings";
@@ -160,9 +148,9 @@ TEST(EstimateJson, KeysAreTheFieldsAndMeanTheSame) {
                             test::AlphasenseRealisticRig(), RigFileOptions())
                             .value();
   const RefractiveIndexEstimate estimate =
-      EstimateRefractiveIndex(rig,
-                              SplitFrames(Sequence(rig, kWaterN, 3, 200, 9)),
-                              Options(EstimatorKind::kRefine))
+      EstimateRefractiveIndex(
+          rig, SplitFrames(test::ExactSequence(rig, kWaterN, 3, 200, 9)),
+          Options(EstimatorKind::kRefine))
           .value();
   const nlohmann::json json = nlohmann::json::parse(EstimateJson(estimate));
   // Numbers round-trip exactly (17 significant digits).

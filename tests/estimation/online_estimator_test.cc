@@ -33,18 +33,6 @@ constexpr double kExactTolerance = 1e-9;
 // sqrt(C / (N - 1)) has a floor of ~1e-8 px (measured 4e-9 - 8e-9).
 constexpr double kExactSigmaPx = 1e-7;
 
-// Frames 0 .. frames-1 of per_frame matches in water of index n.
-std::vector<StereoCorrespondence> Sequence(const StereoRig& rig, double n,
-                                           int frames, int per_frame,
-                                           uint64_t seed) {
-  StereoSamplerOptions options;
-  options.n = n;
-  options.num_frames = frames;
-  options.per_frame = per_frame;
-  options.seed = seed;
-  return SampleStereoCorrespondences(rig, options).value();
-}
-
 // The matches split by frame, in frame order, with each match's index in
 // the whole sequence.
 struct Frames {
@@ -121,7 +109,8 @@ TEST(OnlineEstimator, MatchesBatchOnCleanData) {
   // No robust stage and no threshold: both estimators fit plain least
   // squares to every match, so they must agree whatever the noise.
   const StereoRig rig = test::AlphasenseRealisticRig();
-  std::vector<StereoCorrespondence> sequence = Sequence(rig, 1.333, 6, 200, 1);
+  std::vector<StereoCorrespondence> sequence =
+      test::ExactSequence(rig, 1.333, 6, 200, 1);
   AddPixelNoise(0.5, 2, &sequence);
   RefinementOptions options;
   options.loss = RobustLoss::kNone;
@@ -151,7 +140,8 @@ TEST(OnlineEstimator, MatchesBatchWithOutliers) {
   // per-frame inlier classification picks the batch's inliers, and then
   // the two stage-2 problems are identical.
   const StereoRig rig = test::AlphasenseRealisticRig();
-  std::vector<StereoCorrespondence> sequence = Sequence(rig, 1.333, 5, 200, 3);
+  std::vector<StereoCorrespondence> sequence =
+      test::ExactSequence(rig, 1.333, 5, 200, 3);
   AddPixelNoise(0.5, 4, &sequence);
   AddOutliers(rig, 0.2, 5, &sequence);
   const RefinementOptions options;
@@ -177,7 +167,8 @@ TEST(OnlineEstimator, MatchesBatchWithOutliers) {
 
 TEST(OnlineEstimator, FrameEstimateIsTheBatchOfThatFrame) {
   const StereoRig rig = test::AlphasenseRealisticRig();
-  std::vector<StereoCorrespondence> sequence = Sequence(rig, 1.333, 3, 200, 6);
+  std::vector<StereoCorrespondence> sequence =
+      test::ExactSequence(rig, 1.333, 3, 200, 6);
   AddPixelNoise(0.5, 7, &sequence);
   AddOutliers(rig, 0.2, 8, &sequence);
   const Frames frames = SplitByFrame(sequence);
@@ -218,7 +209,7 @@ TEST(OnlineEstimator, FrameEstimateWithCalibrationIsTheBatchOfThatFrame) {
                                 CalibrationUncertainty::DefaultDriftPrior())
                             .value();
   std::vector<StereoCorrespondence> sequence =
-      Sequence(truth, 1.333, 3, 200, 16);
+      test::ExactSequence(truth, 1.333, 3, 200, 16);
   AddPixelNoise(0.3, 17, &sequence);
   const Frames frames = SplitByFrame(sequence);
   RefinementOptions options;
@@ -253,8 +244,9 @@ TEST(OnlineEstimator, ExactOnEveryRigAndIndex) {
                        test::WideEquidistantCamera())}) {
     for (const double n : {1.0, 1.2, 1.333, 1.6}) {
       std::vector<int64_t> inliers;
-      const OnlineRefractiveIndexEstimator online = RunOnline(
-          rig, Sequence(rig, n, 3, 100, 9), RefinementOptions(), &inliers);
+      const OnlineRefractiveIndexEstimator online =
+          RunOnline(rig, test::ExactSequence(rig, n, 3, 100, 9),
+                    RefinementOptions(), &inliers);
       const OnlineRefractiveIndexEstimator::Estimate estimate =
           online.Current().value();
       EXPECT_NEAR(estimate.n, n, kExactTolerance);
@@ -330,7 +322,7 @@ TEST(OnlineEstimator, MemoryStaysConstantOverThousandFrames) {
   // trivially the same).
   const StereoRig rig = test::AlphasenseRealisticRig();
   std::vector<StereoCorrespondence> sequence =
-      Sequence(rig, 1.333, 1000, 20, 10);
+      test::ExactSequence(rig, 1.333, 1000, 20, 10);
   AddPixelNoise(0.5, 11, &sequence);
   RefinementOptions options;
   options.loss = RobustLoss::kNone;

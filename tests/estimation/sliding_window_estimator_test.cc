@@ -230,6 +230,23 @@ TEST(SlidingWindowEstimator, NoEstimateBeforeAnyFrame) {
       << estimator.Current().status().message();
 }
 
+// A window of one frame confirms a change at its first frame; a longer one
+// keeps confirm_frames; a window below one frame is Check()'s to refuse.
+TEST(SlidingWindowOptions, SetWindowFramesKeepsConfirmFramesWithinIt) {
+  SlidingWindowOptions options;
+  options.SetWindowFrames(1);
+  EXPECT_EQ(options.window_frames, 1);
+  EXPECT_EQ(options.confirm_frames, 1);
+  EXPECT_TRUE(options.Check().ok());
+  options = SlidingWindowOptions();
+  options.SetWindowFrames(5);
+  EXPECT_EQ(options.window_frames, 5);
+  EXPECT_EQ(options.confirm_frames, SlidingWindowOptions().confirm_frames);
+  options.SetWindowFrames(0);
+  EXPECT_EQ(options.confirm_frames, 1);
+  EXPECT_FALSE(options.Check().ok());
+}
+
 TEST(SlidingWindowOptions, CheckRejectsInvalidValues) {
   EXPECT_TRUE(SlidingWindowOptions().Check().ok());
   SlidingWindowOptions options;

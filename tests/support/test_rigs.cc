@@ -63,10 +63,10 @@ Camera EucmCamera() {
 }
 
 std::vector<Camera> AllTestCameras() {
-  return {PinholeCamera(),         EurocRadtanCamera(), AlphasenseCam0(),
-          AlphasenseCam1(),        WideEquidistantCamera(),
-          RationalCamera(),        DoubleSphereCamera(),
-          EucmCamera()};
+  return {PinholeCamera(),         EurocRadtanCamera(),
+          AlphasenseCam0(),        AlphasenseCam1(),
+          WideEquidistantCamera(), RationalCamera(),
+          DoubleSphereCamera(),    EucmCamera()};
 }
 
 StereoRig IdealRig(const Camera& left, const Camera& right, double baseline) {
@@ -80,14 +80,14 @@ StereoRig AlphasenseIdealRig() { return AlphasenseFrontRectifiedRig(); }
 StereoRig AlphasenseRealisticRig() { return AlphasenseFrontUnrectifiedRig(); }
 
 StereoRig NarrowRadtanRig() {
-  const Camera left = Camera::Create(LensModelId::kRadTan, 640, 480,
-                                     {500.0, 500.0, 322.0, 238.0},
-                                     {-0.12, 0.05, 1e-4, -2e-4})
-                          .value();
-  const Camera right = Camera::Create(LensModelId::kRadTan, 640, 480,
-                                      {503.0, 502.0, 317.0, 243.0},
-                                      {-0.11, 0.04, -1e-4, 1e-4})
-                           .value();
+  const Camera left =
+      Camera::Create(LensModelId::kRadTan, 640, 480,
+                     {500.0, 500.0, 322.0, 238.0}, {-0.12, 0.05, 1e-4, -2e-4})
+          .value();
+  const Camera right =
+      Camera::Create(LensModelId::kRadTan, 640, 480,
+                     {503.0, 502.0, 317.0, 243.0}, {-0.11, 0.04, -1e-4, 1e-4})
+          .value();
   const double toe_in = 2.5 * M_PI / 180.0;
   Rigid3d right_from_left;
   right_from_left.rotation =
@@ -102,6 +102,17 @@ std::vector<StereoCorrespondence> ExactMatches(const StereoRig& rig, double n,
   StereoSamplerOptions options;
   options.n = n;
   options.per_frame = count;
+  options.seed = seed;
+  return SampleStereoCorrespondences(rig, options).value();
+}
+
+std::vector<StereoCorrespondence> ExactSequence(const StereoRig& rig, double n,
+                                                int frames, int per_frame,
+                                                uint64_t seed) {
+  StereoSamplerOptions options;
+  options.n = n;
+  options.num_frames = frames;
+  options.per_frame = per_frame;
   options.seed = seed;
   return SampleStereoCorrespondences(rig, options).value();
 }

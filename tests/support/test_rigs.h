@@ -58,6 +58,11 @@ StereoRig NarrowRadtanRig();
 // depths 0.6-6 m (rcm/sim/stereo_sampler.h).
 std::vector<StereoCorrespondence> ExactMatches(const StereoRig& rig, double n,
                                                int count, uint64_t seed = 1);
+// `frames` frames 0 .. frames-1 of `per_frame` exact correspondences each,
+// the same way (a sequence for the multi-frame estimators).
+std::vector<StereoCorrespondence> ExactSequence(const StereoRig& rig, double n,
+                                                int frames, int per_frame,
+                                                uint64_t seed);
 // ExactMatches with Gaussian pixel noise of sigma_px (seed + 100), prepared
 // for the estimators (prepared_correspondence.h; the unusable dropped).
 std::vector<PreparedCorrespondence> NoisyPreparedMatches(const StereoRig& rig,

@@ -1,5 +1,6 @@
 #include "rcm/estimation/sliding_window_estimator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -19,6 +20,11 @@ double ChangeStatistic(double n_a, double sigma_a, double n_b, double sigma_b) {
 }
 
 }  // namespace
+
+void SlidingWindowOptions::SetWindowFrames(int frames) {
+  window_frames = frames;
+  confirm_frames = std::min(confirm_frames, std::max(1, frames));
+}
 
 Status SlidingWindowOptions::Check() const {
   std::ostringstream error;

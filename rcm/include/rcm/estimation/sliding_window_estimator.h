@@ -92,6 +92,11 @@ struct SlidingWindowOptions {
   // switch; >= 1, at most window_frames.
   int confirm_frames = 2;
 
+  // Sets window_frames to `frames` and lowers confirm_frames to it when it
+  // was larger (a window of one frame confirms a change at its first
+  // frame); frames < 1 is left to Check(). The one place that rule lives:
+  // `rcm estimate --window`, Python's window_frames= and the node use it.
+  void SetWindowFrames(int frames);
   Status Check() const;
 };
 
