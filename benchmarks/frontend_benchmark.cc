@@ -74,8 +74,9 @@
 //                              field test on), window_matches 100/200/400:
 //                              0.94/0.88/0.92 s for the 10 pairs (2026-12-05)
 //   BM_EndToEnd_RcmProcess     the whole `rcm estimate` process on the PNG
-//                              folders: 1.25 s, 3.0x one straightforward run
-//                              of the same benchmark (docs/numbers.md)
+//                              folders: 1.06-1.15 s, 3.7-5.5x one
+//                              straightforward run of the same benchmark
+//                              over three runs (docs/numbers.md)
 //
 // Run e.g.
 //   build/bin/frontend_benchmark

@@ -97,7 +97,8 @@ struct LivePipelineOptions {
   // cam1's rotation and the focal scales, the lenses' columns of its normal
   // equations, the locus cost function's 577 nodes; ~12 us without
   // priors), so 200 keep it at ~12 ms where the ~1200 matches of a 720x540
-  // pair took ~72 ms.
+  // pair took ~72 ms. The front end refines only those
+  // (SequenceEstimatorOptions::FrontEnd()).
   int window_matches = SequenceEstimatorOptions().window_matches;
   // A gray standard deviation below this (either image) refuses the pair
   // as blank; >= 0 (0 accepts every pair). 2 gray levels: a lit scene has
