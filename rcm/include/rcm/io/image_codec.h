@@ -12,7 +12,7 @@
 // WebP, ...), a JPEG with an Exif block read as gray or color (OpenCV turns
 // it upright by its orientation tag), a CMYK JPEG and a JPEG without its
 // Huffman tables (motion JPEG) go to cv::imdecode, loaded on first use
-// (dlopen) from the OpenCV rcm was built with.
+// (dlopen, by the soname of the OpenCV rcm was built with).
 #ifndef RCM_IO_IMAGE_CODEC_H_
 #define RCM_IO_IMAGE_CODEC_H_
 
