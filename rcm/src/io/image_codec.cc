@@ -15,11 +15,12 @@
 #include <mutex>
 #include <vector>
 
+#include "image_bytes.h"
+
 namespace rcm {
 namespace {
 
-constexpr std::string_view kPngSignature("\x89PNG\r\n\x1a\n", 8);
-constexpr std::string_view kJpegStart("\xff\xd8\xff", 3);
+using image_bytes::BigEndian32;
 
 Status NotDecodable() {
   return Status::Error(
@@ -119,13 +120,9 @@ void ReadPngBytes(png_structp png, png_bytep out, png_size_t size) {
 // Whether a PNG's chunks before its image data hold an eXIf chunk, whose
 // orientation OpenCV may apply.
 bool PngHasExif(std::string_view bytes) {
-  size_t at = kPngSignature.size();
+  size_t at = image_bytes::kPngSignature.size();
   while (bytes.size() - at >= 8) {
-    const auto byte = [&bytes](size_t i) {
-      return static_cast<uint32_t>(static_cast<uint8_t>(bytes[i]));
-    };
-    const uint64_t length =
-        byte(at) << 24 | byte(at + 1) << 16 | byte(at + 2) << 8 | byte(at + 3);
+    const uint64_t length = BigEndian32(bytes, at);
     const std::string_view type = bytes.substr(at + 4, 4);
     if (type == "eXIf") return true;
     if (type == "IDAT" || type == "IEND") return false;
@@ -391,13 +388,13 @@ bool WriteJpegPixels(const cv::Mat& image, int quality, unsigned char** data,
 
 StatusOr<cv::Mat> DecodeImage(std::string_view bytes, ImageReadMode mode) {
   if (bytes.empty()) return NotDecodable();
-  if (bytes.substr(0, kPngSignature.size()) == kPngSignature) {
+  if (image_bytes::IsPng(bytes)) {
     if (PngHasExif(bytes) && mode != ImageReadMode::kAsStored) {
       return DecodeWithOpenCv(bytes, mode);
     }
     return DecodePng(bytes, mode);
   }
-  if (bytes.substr(0, kJpegStart.size()) == kJpegStart) {
+  if (image_bytes::IsJpeg(bytes)) {
     return DecodeJpeg(bytes, mode);
   }
   return DecodeWithOpenCv(bytes, mode);

@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "image_bytes.h"
 #include "rcm/io/atomic_file.h"
 #include "rcm/io/image_codec.h"
 
@@ -36,23 +37,15 @@ Status WritePng(const cv::Mat& image, const std::string& path) {
 
 namespace {
 
-constexpr std::string_view kPngSignature("\x89PNG\r\n\x1a\n", 8);
-constexpr std::string_view kJpegStart("\xff\xd8\xff", 3);
+using image_bytes::BigEndian32;
+using image_bytes::Byte;
+using image_bytes::kPngSignature;
 
 // OpenCV refuses to decode images of more pixels (CV_IO_MAX_IMAGE_PIXELS,
 // imgcodecs/src/loadsave.cpp) before it reads their pixel data; the checks
 // of the pixel data below leave such images to it rather than inflate or
 // decode gigabytes first.
 constexpr uint64_t kOpenCvMaxPixels = uint64_t{1} << 30;
-
-uint8_t Byte(std::string_view bytes, size_t at) {
-  return static_cast<uint8_t>(bytes[at]);
-}
-
-uint32_t BigEndian32(std::string_view bytes, size_t at) {
-  return uint32_t{Byte(bytes, at)} << 24 | uint32_t{Byte(bytes, at + 1)} << 16 |
-         uint32_t{Byte(bytes, at + 2)} << 8 | uint32_t{Byte(bytes, at + 3)};
-}
 
 const Bytef* ZlibBytes(std::string_view bytes) {
   return reinterpret_cast<const Bytef*>(bytes.data());
@@ -489,10 +482,8 @@ StatusOr<cv::Mat> DecodeFile(const std::string& path, ImageReadMode mode) {
 }  // namespace
 
 Status CheckImageFileStructure(std::string_view bytes) {
-  if (bytes.substr(0, kPngSignature.size()) == kPngSignature) {
-    return CheckPng(bytes);
-  }
-  if (bytes.substr(0, kJpegStart.size()) == kJpegStart) return CheckJpeg(bytes);
+  if (image_bytes::IsPng(bytes)) return CheckPng(bytes);
+  if (image_bytes::IsJpeg(bytes)) return CheckJpeg(bytes);
   return Status::Ok();
 }
 
