@@ -7,7 +7,7 @@
 
 #include "support/test_rigs.h"
 
-namespace rcm::calib {
+namespace rcm::calib::board_reprojection_error_test {
 namespace {
 
 // A board corner 0.8 m in front of the rig, a little off axis.
@@ -122,4 +122,4 @@ TEST(BoardReprojectionError, AutodiffMatchesCentralDifferences) {
 }
 
 }  // namespace
-}  // namespace rcm::calib
+}  // namespace rcm::calib::board_reprojection_error_test

@@ -20,7 +20,7 @@
 #include "support/sample_moments.h"
 #include "support/test_rigs.h"
 
-namespace rcm::calib {
+namespace rcm::calib::board_warp_test {
 namespace {
 
 using test::BoardPoses;
@@ -388,4 +388,4 @@ TEST(BoardWarpOnRenders, BowRecoveredAndFocalLengthsUnbiased) {
 }
 
 }  // namespace
-}  // namespace rcm::calib
+}  // namespace rcm::calib::board_warp_test

@@ -9,7 +9,7 @@
 #include "rcm/geometry/calibration_uncertainty.h"
 #include "support/test_rigs.h"
 
-namespace rcm::calib {
+namespace rcm::calib::calibration_covariance_test {
 namespace {
 
 // A fixed positive definite n x n matrix (entries of a sine table), scaled.
@@ -43,7 +43,7 @@ UnderwaterCovariance FitCovariance(const Eigen::MatrixXd& geometry) {
 // mean(d) (trace(C^-1 J) = sum d); a spread below the covariance widens
 // nothing; no leave-out, nothing.
 TEST(UnderwaterCalibrationCovariance, LeaveOutScaleIsTheWhitenedMeanSpread) {
-  UnderwaterCalibration result(test::AlphasenseRealisticRig());
+  UnderwaterCalibration result(rcm::test::AlphasenseRealisticRig());
   const Eigen::MatrixXd geometry = FixedCovariance(11, 0.4, 1e-6);
   result.covariance = FitCovariance(geometry);
   EXPECT_EQ(GeometryLeaveOutScale(result), 1.0);
@@ -70,7 +70,7 @@ TEST(UnderwaterCalibrationCovariance, LeaveOutScaleIsTheWhitenedMeanSpread) {
 // Cov(h | lenses) = 2.25 G0 (to rounding), the response to the lenses K
 // unchanged, the joint positive semi-definite, the ports in their block.
 TEST(UnderwaterCalibrationCovariance, WidensOnlyWhatTheWaterViewsMeasured) {
-  const StereoRig rig = test::AlphasenseRealisticRig();
+  const StereoRig rig = rcm::test::AlphasenseRealisticRig();
   const int p = rig.left().num_params();
   ASSERT_EQ(rig.right().num_params(), p);
   CalibrationUncertainty air;
@@ -154,4 +154,4 @@ TEST(UnderwaterCalibrationCovariance, WidensOnlyWhatTheWaterViewsMeasured) {
 }
 
 }  // namespace
-}  // namespace rcm::calib
+}  // namespace rcm::calib::calibration_covariance_test

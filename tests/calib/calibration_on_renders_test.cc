@@ -19,7 +19,7 @@
 #include "support/projection_error.h"
 #include "support/test_rigs.h"
 
-namespace rcm::calib {
+namespace rcm::calib::calibration_on_renders_test {
 namespace {
 
 constexpr double kMaxFocalError = 1e-3;  // relative
@@ -169,4 +169,4 @@ TEST(CalibrationOnRenders, ChessboardEucmRecoversTheTruth) {
 }
 
 }  // namespace
-}  // namespace rcm::calib
+}  // namespace rcm::calib::calibration_on_renders_test

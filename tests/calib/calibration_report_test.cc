@@ -20,7 +20,7 @@
 #include "support/temp_file.h"
 #include "support/test_rigs.h"
 
-namespace rcm::calib {
+namespace rcm::calib::calibration_report_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -75,7 +75,7 @@ TEST(ProjectionUncertainty, JacobianMatchesCentralDifferences) {
   // parameter; the rational, ds and eucm models are not linear in theirs,
   // but their truncation error, ~h^2 f'' ~ 1e-12 * 1000 px, is smaller.
   constexpr double kTolerance = 1e-6;
-  for (const Camera& camera : test::AllTestCameras()) {
+  for (const Camera& camera : rcm::test::AllTestCameras()) {
     for (const Eigen::Vector2d& normalized :
          {Eigen::Vector2d(0.0, 0.0), Eigen::Vector2d(0.3, -0.2),
           Eigen::Vector2d(-0.6, 0.45)}) {
@@ -133,7 +133,7 @@ TEST(ProjectionUncertainty, RadTanK1MatchesHandComputation) {
   // s^2 a a^T with the one nonzero eigenvalue s^2 |a|^2. Relative round-off
   // of the unprojection and a few products.
   constexpr double kRelativeTolerance = 1e-10;
-  const Camera camera = test::EurocRadtanCamera();
+  const Camera camera = rcm::test::EurocRadtanCamera();
   const double s_k1 = 0.003;
   const CameraCalibration calibration =
       Calibrated(camera, DiagonalCovariance({0, 0, 0, 0, s_k1}));
@@ -153,7 +153,7 @@ TEST(ProjectionUncertainty, RadTanK1MatchesHandComputation) {
 TEST(ProjectionUncertainty, ZeroForZeroCovarianceAndLinearInSigma) {
   // sigma(k^2 C) = k sigma(C) up to the round-off of one sqrt.
   constexpr double kRelativeTolerance = 1e-12;
-  const Camera camera = test::AlphasenseCam0();
+  const Camera camera = rcm::test::AlphasenseCam0();
   const CameraCalibration zero =
       Calibrated(camera, Eigen::Matrix<double, 8, 8>::Zero());
   Eigen::Matrix<double, 8, 8> a;
@@ -183,7 +183,7 @@ TEST(ProjectionUncertainty, NaNWhereThePixelHasNoRay) {
   // The equidistant lens maps rays up to 90 degrees off axis into a disc;
   // a pixel far outside it has no ray.
   const CameraCalibration calibration =
-      Calibrated(test::AlphasenseCam0(), DiagonalCovariance({1, 1, 1, 1}));
+      Calibrated(rcm::test::AlphasenseCam0(), DiagonalCovariance({1, 1, 1, 1}));
   EXPECT_TRUE(std::isnan(ProjectionUncertainty(calibration, {1e5, 1e5})));
   EXPECT_FALSE(ProjectionCovariance(calibration, {1e5, 1e5}).has_value());
   EXPECT_TRUE(std::isfinite(ProjectionUncertainty(calibration, {0.0, 0.0})));
@@ -231,7 +231,7 @@ StereoCalibration EmptyCalibration(int num_views, const Camera& camera,
 // to 0.1 px: the uncertainty stays below 0.13 px.
 StereoCalibration GoodCalibration(int num_views = 10) {
   StereoCalibration calibration =
-      EmptyCalibration(num_views, test::PinholeCamera(), 0.1);
+      EmptyCalibration(num_views, rcm::test::PinholeCamera(), 0.1);
   for (int v = 0; v < num_views; ++v) {
     for (int c = 0; c < 2; ++c) {
       for (int row = 0; row < 6; ++row) {
@@ -253,7 +253,7 @@ TEST(CalibrationReport, StatisticsOfAHandBuiltCalibration) {
   // Three views over a 400x200 image and a 4x2 grid (cells of 100x100);
   // view 1 has no pose.
   StereoCalibration calibration =
-      EmptyCalibration(3, test::PinholeCamera(), 0.1);
+      EmptyCalibration(3, rcm::test::PinholeCamera(), 0.1);
   calibration.cam0_from_target[1] = std::nullopt;
   // cam0, view 0: cells (0, 0) [twice, once on the image's corner] and
   // (3, 1) [on the far corner, clamped into the last cell].
@@ -596,7 +596,8 @@ struct Synthetic {
 };
 
 Synthetic RealisticCalibration() {
-  const Camera cameras[2] = {test::AlphasenseCam0(), test::AlphasenseCam1()};
+  const Camera cameras[2] = {rcm::test::AlphasenseCam0(),
+                             rcm::test::AlphasenseCam1()};
   Synthetic synthetic(cameras[0], cameras[1]);
   for (int c = 0; c < 2; ++c) {
     synthetic.sizes[c] = {cameras[c].width(), cameras[c].height()};
@@ -699,8 +700,9 @@ TEST(CalibrationReport, WritesEveryFile) {
                 [](const CornerResidual& corner) { return !corner.inlier; })));
   // RCM_CALIB_REPORT_DIR keeps the pictures for a person to look at.
   const char* keep = std::getenv("RCM_CALIB_REPORT_DIR");
-  const std::string directory =
-      keep != nullptr ? std::string(keep) : test::TempFilePath("report/sub");
+  const std::string directory = keep != nullptr
+                                    ? std::string(keep)
+                                    : rcm::test::TempFilePath("report/sub");
   const Status status = WriteCalibrationReport(
       directory, report, synthetic.calibration, synthetic.views,
       synthetic.sizes[0], synthetic.sizes[1]);
@@ -729,7 +731,7 @@ TEST(CalibrationReport, WritesEveryFile) {
   int rows = 0;
   while (std::getline(lines, line)) ++rows;
   EXPECT_EQ(rows, 18);
-  if (keep == nullptr) fs::remove_all(test::TempFilePath("report"));
+  if (keep == nullptr) fs::remove_all(rcm::test::TempFilePath("report"));
 }
 
 TEST(CalibrationReport, PerViewCsvRows) {
@@ -757,7 +759,8 @@ TEST(CalibrationReport, WriteFailsWithOneLineForAnUnwritableFolder) {
   const StereoCalibration calibration = GoodCalibration(1);
   const CalibrationReport report =
       SummarizeCalibration(calibration, NamedViews(1), kVga, kVga);
-  const std::string file = test::WriteTempFile("plain.txt", "not a folder");
+  const std::string file =
+      rcm::test::WriteTempFile("plain.txt", "not a folder");
   const Status status = WriteCalibrationReport(
       file + "/report", report, calibration, NamedViews(1), kVga, kVga);
   ASSERT_FALSE(status.ok());
@@ -768,4 +771,4 @@ TEST(CalibrationReport, WriteFailsWithOneLineForAnUnwritableFolder) {
 }
 
 }  // namespace
-}  // namespace rcm::calib
+}  // namespace rcm::calib::calibration_report_test

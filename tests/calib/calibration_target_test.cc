@@ -9,7 +9,7 @@
 
 #include "support/temp_file.h"
 
-namespace rcm::calib {
+namespace rcm::calib::calibration_target_test {
 namespace {
 
 constexpr double kExact = 1e-15;
@@ -89,7 +89,7 @@ TEST(CalibrationTarget, ParsesUnquotedTypeAndIgnoresUnknownKeys) {
 
 TEST(CalibrationTarget, ReadsFile) {
   const std::string path =
-      test::WriteTempFile("aprilgrid.yaml", kKalibrAprilGrid);
+      rcm::test::WriteTempFile("aprilgrid.yaml", kKalibrAprilGrid);
   const StatusOr<CalibrationTarget> target = ReadCalibrationTarget(path);
   std::remove(path.c_str());
   ASSERT_TRUE(target.ok()) << target.status().message();
@@ -98,7 +98,7 @@ TEST(CalibrationTarget, ReadsFile) {
 }
 
 TEST(CalibrationTarget, ReadMissingFileReportsPath) {
-  const std::string path = test::TempFilePath("missing.yaml");
+  const std::string path = rcm::test::TempFilePath("missing.yaml");
   const StatusOr<CalibrationTarget> target = ReadCalibrationTarget(path);
   ASSERT_FALSE(target.ok());
   EXPECT_EQ(target.status().message().rfind(path + ": cannot open: ", 0), 0u)
@@ -526,4 +526,4 @@ TEST(CalibrationTarget, ErrorLengthOutOfRange) {
 }
 
 }  // namespace
-}  // namespace rcm::calib
+}  // namespace rcm::calib::calibration_target_test

@@ -8,7 +8,7 @@
 
 #include "support/temp_file.h"
 
-namespace rcm::calib {
+namespace rcm::calib::corners_file_test {
 namespace {
 
 using ::testing::HasSubstr;
@@ -76,7 +76,7 @@ TEST(CornersFile, RoundTripKeepsEveryPixelBitForBit) {
 }
 
 TEST(CornersFile, WritesAndReadsAFile) {
-  const std::string path = test::TempFilePath("corners_file_write.vnl");
+  const std::string path = rcm::test::TempFilePath("corners_file_write.vnl");
   ASSERT_TRUE(WriteCornersFile(path, {{"a.png", Observation({0, 1, 2, 3, 4, 5})}},
                                kPoints)
                   .ok());
@@ -161,7 +161,7 @@ TEST(CornersFile, FileWithoutDataRowsIsOneLine) {
 
 TEST(CornersFile, MissingFileIsOneLine) {
   const StatusOr<std::vector<CornersFileImage>> read =
-      ReadCornersFile(test::TempFilePath("no_such_corners.vnl"), kPoints);
+      ReadCornersFile(rcm::test::TempFilePath("no_such_corners.vnl"), kPoints);
   ASSERT_FALSE(read.ok());
   EXPECT_THAT(OneLine(read.status()), HasSubstr("no_such_corners.vnl"));
 }
@@ -183,4 +183,4 @@ TEST(CornersFile, NamesAndObservationsThatCannotBeWrittenAreRefused) {
 }
 
 }  // namespace
-}  // namespace rcm::calib
+}  // namespace rcm::calib::corners_file_test

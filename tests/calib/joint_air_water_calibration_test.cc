@@ -13,7 +13,7 @@
 #include "rcm/calib/underwater_calibration.h"
 #include "support/sample_moments.h"
 
-namespace rcm::calib {
+namespace rcm::calib::joint_air_water_calibration_test {
 namespace {
 
 using test::BoardPoses;
@@ -296,4 +296,4 @@ TEST(JointAirWaterCalibration, NoAirViewIsAnError) {
 }
 
 }  // namespace
-}  // namespace rcm::calib
+}  // namespace rcm::calib::joint_air_water_calibration_test

@@ -16,7 +16,7 @@
 #include "rcm/calib/stereo_calibration.h"
 #include "support/test_rigs.h"
 
-namespace rcm::calib {
+namespace rcm::calib::projection_uncertainty_test {
 namespace {
 
 using test::BoardPoses;
@@ -241,4 +241,4 @@ TEST(MeanFramesProjection, MonteCarloSpreadIsThePredictedOne) {
 }
 
 }  // namespace
-}  // namespace rcm::calib
+}  // namespace rcm::calib::projection_uncertainty_test

@@ -18,7 +18,7 @@
 #include "rcm/calib/target_detector.h"
 #include "support/test_rigs.h"
 
-namespace rcm::calib {
+namespace rcm::calib::stereo_calibration_opencv_sample_test {
 namespace {
 
 constexpr char kDataDir[] = "/usr/share/doc/opencv-doc/examples/data/";
@@ -331,4 +331,4 @@ TEST(CrossValidation, NeedsTwoFolds) {
 }
 
 }  // namespace
-}  // namespace rcm::calib
+}  // namespace rcm::calib::stereo_calibration_opencv_sample_test

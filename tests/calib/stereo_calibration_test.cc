@@ -16,7 +16,7 @@
 #include "support/projection_error.h"
 #include "support/test_rigs.h"
 
-namespace rcm::calib {
+namespace rcm::calib::stereo_calibration_test {
 namespace {
 
 using test::BoardPoses;
@@ -442,4 +442,4 @@ TEST(StereoCalibrationOptions, Check) {
 }
 
 }  // namespace
-}  // namespace rcm::calib
+}  // namespace rcm::calib::stereo_calibration_test

@@ -19,7 +19,7 @@
 #include "rcm/sim/reference_rigs.h"
 #include "rcm/stereo/stereo_rig.h"
 
-namespace rcm::calib {
+namespace rcm::calib::target_detector_test {
 namespace {
 
 // Detected corners against the renderer's ground truth, on 4x4
@@ -390,4 +390,4 @@ TEST(TargetDetectorOptions, Check) {
 }
 
 }  // namespace
-}  // namespace rcm::calib
+}  // namespace rcm::calib::target_detector_test

@@ -10,7 +10,7 @@
 
 #include "rcm/calib/calibration_target.h"
 
-namespace rcm::calib {
+namespace rcm::calib::target_image_test {
 namespace {
 
 // A target point maps to a pixel edge crossing: both texture coordinates
@@ -206,4 +206,4 @@ TEST(TargetImage, PixelsPerMetreIsRoundedToWholeSquares) {
 }
 
 }  // namespace
-}  // namespace rcm::calib
+}  // namespace rcm::calib::target_image_test

@@ -14,7 +14,7 @@
 #include "rcm/calib/target_image.h"
 #include "rcm/sim/reference_rigs.h"
 
-namespace rcm::calib {
+namespace rcm::calib::target_renderer_test {
 namespace {
 
 // ProjectTargetPoints against Camera::ProjectNormalized: the same
@@ -236,4 +236,4 @@ TEST(TargetRenderOptions, Check) {
 }
 
 }  // namespace
-}  // namespace rcm::calib
+}  // namespace rcm::calib::target_renderer_test

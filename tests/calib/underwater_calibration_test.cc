@@ -18,7 +18,7 @@
 #include "rcm/sim/reference_rigs.h"
 #include "support/sample_moments.h"
 
-namespace rcm::calib {
+namespace rcm::calib::underwater_calibration_test {
 namespace {
 
 using test::BoardPoses;
@@ -756,4 +756,4 @@ TEST(UnderwaterCalibrationOptions, Check) {
 }
 
 }  // namespace
-}  // namespace rcm::calib
+}  // namespace rcm::calib::underwater_calibration_test

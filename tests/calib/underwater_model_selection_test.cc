@@ -20,7 +20,7 @@
 #include "support/sample_moments.h"
 #include "support/test_budget.h"
 
-namespace rcm::calib {
+namespace rcm::calib::underwater_model_selection_test {
 namespace {
 
 using test::BoardPoses;
@@ -527,9 +527,9 @@ TEST(UnderwaterCalibration, PortsInTheSidecarKeepTargetFreeSigmaHonest) {
 }
 
 }  // namespace
-}  // namespace rcm::calib
+}  // namespace rcm::calib::underwater_model_selection_test
 
-namespace rcm::calib {
+namespace rcm::calib::underwater_model_selection_test {
 namespace {
 
 // The errors a real dive has that one fixed model leaves out, drawn per
@@ -675,4 +675,4 @@ TEST(UnderwaterModelSelection, MonteCarloHonestUnderEachModelError) {
 }
 
 }  // namespace
-}  // namespace rcm::calib
+}  // namespace rcm::calib::underwater_model_selection_test

@@ -7,7 +7,7 @@
 
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::camera_test {
 namespace {
 
 TEST(Camera, CreatesValidCamera) {
@@ -212,4 +212,4 @@ TEST(Camera, LensInvertibleAtDetectsFold) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::camera_test

@@ -16,7 +16,7 @@
 #include "rcm/camera/thick_port_refraction.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::flat_port_test {
 namespace {
 
 // Thin port against the paper's closed-form model: the two share no code
@@ -335,11 +335,11 @@ TEST(FlatPortCamera, RejectsInvalidPortOrIndex) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::flat_port_test
 
 // --- ThickPortRefraction: the templated back-trace.
 
-namespace rcm {
+namespace rcm::flat_port_test {
 namespace {
 
 // The templated back-trace against ExactFlatPort's: the same physics
@@ -449,11 +449,11 @@ TEST(ThickPortRefraction, JetDerivativesMatchCentralDifferences) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::flat_port_test
 
 // --- FlatPortProjection: the templated forward projection.
 
-namespace rcm {
+namespace rcm::flat_port_test {
 namespace {
 
 // The templated projection against ExactFlatPort's (another unknown, the
@@ -672,4 +672,4 @@ TEST(FlatPortProjection, JetDerivativesMatchFiniteDifferences) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::flat_port_test

@@ -15,7 +15,7 @@
 
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::lens_models_test {
 namespace {
 
 // Pixel round trips: undistortion converges to a residual of 1e-14 in
@@ -611,4 +611,4 @@ TEST(LensModels, FoldsOfTheNewModels) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::lens_models_test

@@ -8,7 +8,7 @@
 
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::refractive_camera_test {
 namespace {
 
 // Pixel round trips go through the iterative undistortion (1e-14 residual
@@ -189,11 +189,11 @@ TEST(RefractiveCamera, VirtualPinholeBeyondCriticalAngleHasNoSource) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::refractive_camera_test
 
 // --- A thick port made central at a reference depth (CreateWithPort).
 
-namespace rcm {
+namespace rcm::refractive_camera_test {
 namespace {
 
 FlatPort HousingPort() {
@@ -370,4 +370,4 @@ TEST(RefractiveCameraWithPort, RejectsReferenceDepthInsideTheHousing) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::refractive_camera_test

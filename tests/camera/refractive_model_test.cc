@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-namespace rcm {
+namespace rcm::refractive_model_test {
 namespace {
 
 // Closed-form expressions of O(1) quantities: agreement to a few ulp.
@@ -182,4 +182,4 @@ TEST(FlatPortRefraction, RadialFactorDerivativeFiniteOnAxis) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::refractive_model_test

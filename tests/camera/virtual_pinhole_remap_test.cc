@@ -11,7 +11,7 @@
 
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::virtual_pinhole_remap_test {
 namespace {
 
 RefractiveCamera Refractive(const Camera& camera, double n) {
@@ -478,4 +478,4 @@ TEST(VirtualPinholeRemap, RejectsBadInput) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::virtual_pinhole_remap_test

@@ -31,7 +31,7 @@
 #include "rcm/rosbag/bag_image_writer.h"
 #endif
 
-namespace rcm {
+namespace rcm::bad_input_table_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -1396,4 +1396,4 @@ INSTANTIATE_TEST_SUITE_P(
     });
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::bad_input_table_test

@@ -25,7 +25,7 @@
 #include "rcm/rosbag/bag_image_writer.h"
 #endif
 
-namespace rcm {
+namespace rcm::calibrate_cli_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -587,4 +587,4 @@ TEST(CalibrateCli, HelpListsTheTargetFlags) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::calibrate_cli_test

@@ -21,7 +21,7 @@
 #include "support/temp_file.h"
 #include "support/test_budget.h"
 
-namespace rcm {
+namespace rcm::calibrate_underwater_cli_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -612,4 +612,4 @@ TEST(UnderwaterCli, FlagsThatNeedUnderwater) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::calibrate_underwater_cli_test

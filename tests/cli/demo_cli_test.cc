@@ -9,7 +9,7 @@
 #include "rcm/io/image_file.h"
 #include "support/temp_file.h"
 
-namespace rcm {
+namespace rcm::demo_cli_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -75,4 +75,4 @@ TEST(DemoCli, UnwritableFolderIsOneLineError) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::demo_cli_test

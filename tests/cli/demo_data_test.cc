@@ -8,7 +8,7 @@
 #include "rcm/io/camchain.h"
 #include "support/temp_file.h"
 
-namespace rcm {
+namespace rcm::demo_data_test {
 namespace {
 
 TEST(DemoData, RegeneratesByteForByte) {
@@ -35,4 +35,4 @@ TEST(DemoData, RigFileIsWhatKalibrWouldWrite) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::demo_data_test

@@ -17,7 +17,7 @@
 #include "rcm/version.h"
 #include "support/temp_file.h"
 
-namespace rcm {
+namespace rcm::estimate_cli_test {
 namespace {
 
 using test::IsOneLine;
@@ -670,9 +670,9 @@ TEST(EstimateCli, WarnsOnUnrectifiedRig) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::estimate_cli_test
 
-namespace rcm {
+namespace rcm::estimate_cli_test {
 namespace {
 
 // A camchain whose cameras have port blocks (8 mm of air, 6 mm of glass)
@@ -718,9 +718,9 @@ TEST(EstimateCli, PortBlocksSelectTheThickPortModel) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::estimate_cli_test
 
-namespace rcm {
+namespace rcm::estimate_cli_test {
 namespace {
 
 // rcm simulate writes a thick port as port blocks; rcm estimate then models
@@ -759,4 +759,4 @@ TEST(EstimateCli, SimulatedThickPortAndItsAirGap) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::estimate_cli_test

@@ -19,7 +19,7 @@
 #include "rcm/rosbag/bag_image_writer.h"
 #endif
 
-namespace rcm {
+namespace rcm::estimate_images_cli_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -236,4 +236,4 @@ TEST(EstimateImagesCli, BagWithoutTheTopicsIsOneLine) {
 #endif  // RCM_HAVE_ROSBAG
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::estimate_images_cli_test

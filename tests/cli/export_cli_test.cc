@@ -14,7 +14,7 @@
 #include "rcm/io/image_file.h"
 #include "support/temp_file.h"
 
-namespace rcm {
+namespace rcm::export_cli_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -224,9 +224,9 @@ TEST(CompareCli, SameCalibrationGivesUnitIndex) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::export_cli_test
 
-namespace rcm {
+namespace rcm::export_cli_test {
 namespace {
 
 // The dataset rig with port blocks (8 mm of air, 6 mm of glass).
@@ -274,4 +274,4 @@ TEST(ExportCli, RejectsAReferenceDepthInsideTheHousing) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::export_cli_test

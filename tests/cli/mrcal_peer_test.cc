@@ -33,7 +33,7 @@
 #include "rcm/io/camchain.h"
 #include "support/temp_file.h"
 
-namespace rcm {
+namespace rcm::mrcal_peer_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -303,4 +303,4 @@ TEST(MrcalPeer, MrcalsDefaultsGiveTheSameFocalLengthsAndBowl) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::mrcal_peer_test

@@ -19,7 +19,7 @@
 #include "rcm/sim/reference_rigs.h"
 #include "support/temp_file.h"
 
-namespace rcm {
+namespace rcm::simulate_cli_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -465,4 +465,4 @@ TEST(SimulateCli, HelpListsTheFlags) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::simulate_cli_test

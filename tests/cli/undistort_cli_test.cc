@@ -22,7 +22,7 @@
 #include "rcm/rosbag/bag_stereo_source.h"
 #endif
 
-namespace rcm {
+namespace rcm::undistort_cli_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -429,9 +429,9 @@ TEST(UndistortCli, BagGivesACorrectedBagAndItsCamchain) {
 #endif  // RCM_HAVE_ROSBAG
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::undistort_cli_test
 
-namespace rcm {
+namespace rcm::undistort_cli_test {
 namespace {
 
 // Port blocks in the rig: the corrected images are made for the reference
@@ -467,4 +467,4 @@ TEST(UndistortCli, ThickPortIsCorrectedAtTheReferenceDepth) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::undistort_cli_test

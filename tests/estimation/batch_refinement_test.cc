@@ -11,7 +11,7 @@
 #include "rcm/sim/stereo_sampler.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::batch_refinement_test {
 namespace {
 
 // Exact correspondences have residuals below 1e-12 px (see
@@ -360,4 +360,4 @@ TEST(BatchRefinement, InvalidOptionsAreRejected) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::batch_refinement_test

@@ -7,7 +7,7 @@
 
 #include "rcm/estimation/refinement_options.h"
 
-namespace rcm {
+namespace rcm::bounded_index_solve_test {
 namespace {
 
 // The solves below are linear least squares: their minima are exact to
@@ -149,4 +149,4 @@ TEST(BoundedIndexSolve, ConstantIndexIsNotTouched) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::bounded_index_solve_test

@@ -15,7 +15,7 @@
 #include "support/reader_inputs.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::calibration_comparison_test {
 namespace {
 
 using ::testing::HasSubstr;
@@ -291,4 +291,4 @@ TEST(RefractedProjectionError, FalsePastTotalInternalReflection) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::calibration_comparison_test

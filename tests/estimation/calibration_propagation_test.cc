@@ -21,7 +21,7 @@
 #include "support/test_budget.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::calibration_propagation_test {
 namespace {
 
 constexpr double kDegree = M_PI / 180.0;
@@ -1048,4 +1048,4 @@ TEST(CalibrationPropagation, ChiSquaredUpperTailMatchesTables) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::calibration_propagation_test

@@ -11,7 +11,7 @@
 #include "rcm/stereo/observability.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::closed_form_test {
 namespace {
 
 // Exact data: the undistortion leaves 1e-14 in normalized coordinates and
@@ -130,4 +130,4 @@ TEST(ClosedForm, NoisyMatchesSpreadAsFirstOrderSigma) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::closed_form_test

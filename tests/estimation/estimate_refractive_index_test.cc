@@ -13,7 +13,7 @@
 #include "rcm/io/stereo_rig_file.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::estimate_refractive_index_test {
 namespace {
 
 // Exact data: residuals below 1e-12 px at the true n
@@ -199,4 +199,4 @@ TEST(EstimatePerFrameCsv, OneRowPerFrame) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::estimate_refractive_index_test

@@ -13,7 +13,7 @@
 #include "rcm/stereo/epipolar.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::generalized_epipolar_error_test {
 namespace {
 
 // The housing: 8 mm of air, 6 mm of acrylic.
@@ -125,4 +125,4 @@ TEST(GeneralizedEpipolarError, JacobianMatchesCentralDifferences) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::generalized_epipolar_error_test

@@ -15,7 +15,7 @@
 #include "rcm/stereo/epipolar.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::locus_cost_function_test {
 namespace {
 
 // The interpolation error bound of the header, 6e-13 relative to the
@@ -307,4 +307,4 @@ TEST(LocusCostFunction, EmptyIsZero) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::locus_cost_function_test

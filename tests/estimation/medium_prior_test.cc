@@ -13,7 +13,7 @@
 #include "support/test_budget.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::medium_prior_test {
 namespace {
 
 constexpr double kDegree = M_PI / 180.0;
@@ -186,4 +186,4 @@ TEST(MediumDrift, MonteCarloTurnSigmaIsHonestOnANarrowRig) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::medium_prior_test

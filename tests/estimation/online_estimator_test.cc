@@ -15,7 +15,7 @@
 #include "rcm/sim/stereo_sampler.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::online_estimator_test {
 namespace {
 
 // The bar for online == batch on the same data. Both solve the
@@ -365,4 +365,4 @@ TEST(OnlineEstimator, CreateRejectsInvalidOptions) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::online_estimator_test

@@ -10,7 +10,7 @@
 #include "rcm/stereo/observability.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::paper_online_estimator_test {
 namespace {
 
 // See closed_form_test.cc: exact data give every n_i to < 1e-9, and the
@@ -213,4 +213,4 @@ TEST(PaperOnlineEstimatorOptions, CheckRejectsInvalidEta) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::paper_online_estimator_test

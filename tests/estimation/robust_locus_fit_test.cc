@@ -9,7 +9,7 @@
 #include "rcm/stereo/epipolar.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::robust_locus_fit_test {
 namespace {
 
 std::vector<PreparedCorrespondence> Prepare(
@@ -189,4 +189,4 @@ TEST(RobustLocusFit, InliersAreCloseToTheLocusAndInFront) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::robust_locus_fit_test

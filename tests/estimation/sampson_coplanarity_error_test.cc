@@ -13,7 +13,7 @@
 #include "rcm/stereo/epipolar.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::sampson_coplanarity_error_test {
 namespace {
 
 // Exact correspondences come from the model's forward map with round trips
@@ -204,9 +204,9 @@ TEST(SampsonCoplanarityError, CeresJacobianMatchesCentralDifferences) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::sampson_coplanarity_error_test
 
-namespace rcm {
+namespace rcm::sampson_coplanarity_error_test {
 namespace {
 
 // PrepareCorrespondenceSide is PrepareCorrespondence's half for one
@@ -282,4 +282,4 @@ TEST(PreparedCorrespondence, FocalStepRigsMadeOnceGiveTheSameDerivatives) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::sampson_coplanarity_error_test

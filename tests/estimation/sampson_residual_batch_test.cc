@@ -16,7 +16,7 @@
 #include "rcm/stereo/epipolar.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::sampson_residual_batch_test {
 namespace {
 
 using Jet = ceres::Jet<double, 1>;
@@ -128,4 +128,4 @@ TEST(SampsonResidualBatch, EmptyAndUndefinedMatches) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::sampson_residual_batch_test

@@ -11,7 +11,7 @@
 #include "rcm/sim/stereo_sampler.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::sliding_window_estimator_test {
 namespace {
 
 using Estimator = SlidingWindowRefractiveIndexEstimator;
@@ -279,4 +279,4 @@ TEST(SlidingWindowOptions, CheckRejectsInvalidValues) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::sliding_window_estimator_test

@@ -11,7 +11,7 @@
 #include "support/reader_inputs.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::thick_port_refinement_test {
 namespace {
 
 FlatPort Port(double air_gap, double glass_thickness) {
@@ -210,9 +210,9 @@ TEST(ThickPortRefinement, RejectsRotationCorrectionAndBadPorts) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::thick_port_refinement_test
 
-namespace rcm {
+namespace rcm::thick_port_refinement_test {
 namespace {
 
 // A rig that carries thick ports (from a camchain's port blocks) is refined
@@ -316,4 +316,4 @@ TEST(StereoRigPorts, WithPortsRejectsInvalidPorts) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::thick_port_refinement_test

@@ -17,7 +17,7 @@
 // acceptance figures at n = 1.333, and the contract's edge cases; there is
 // no noisy or Monte-Carlo case to run.
 
-namespace rcm {
+namespace rcm::water_side_model_fit_test {
 namespace {
 
 using ::testing::HasSubstr;
@@ -217,4 +217,4 @@ TEST(WaterSideProjectionError, JacobianMatchesCentralDifferences) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::water_side_model_fit_test

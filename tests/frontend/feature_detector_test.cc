@@ -7,7 +7,7 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
-namespace rcm {
+namespace rcm::feature_detector_test {
 namespace {
 
 // Random blobs of random gray levels on gray, slightly blurred: corners
@@ -211,4 +211,4 @@ TEST(FeatureDetector, LowerFastThresholdFindsWeakerCorners) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::feature_detector_test

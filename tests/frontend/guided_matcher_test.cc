@@ -12,7 +12,7 @@
 #include "rcm/camera/refractive_camera.h"
 #include "rcm/sim/reference_rigs.h"
 
-namespace rcm {
+namespace rcm::guided_matcher_test {
 namespace {
 
 constexpr double kWater = 1.333;
@@ -519,4 +519,4 @@ TEST(GuidedMatcher, OptionsCheck) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::guided_matcher_test

@@ -6,7 +6,7 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
-namespace rcm {
+namespace rcm::image_preprocessing_test {
 namespace {
 
 // Random blobs of random gray levels in [low, high] on a background of
@@ -167,4 +167,4 @@ TEST(ClaheOptions, Check) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::image_preprocessing_test

@@ -13,7 +13,7 @@
 #include "rcm/camera/refractive_camera.h"
 #include "rcm/sim/reference_rigs.h"
 
-namespace rcm {
+namespace rcm::locus_band_test {
 namespace {
 
 // A scene point (left camera frame) and its exact pixels in both cameras.
@@ -464,4 +464,4 @@ TEST(LocusBand, CreateRejectsInvalidOptionsAndIntervals) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::locus_band_test

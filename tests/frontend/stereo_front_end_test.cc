@@ -14,7 +14,7 @@
 #include "rcm/sim/reference_rigs.h"
 #include "rcm/sim/sequence_simulator.h"
 
-namespace rcm {
+namespace rcm::stereo_front_end_test {
 namespace {
 
 // The acceptance bound on |n - n_true| over 10 pairs.
@@ -479,4 +479,4 @@ TEST(StereoFrontEnd, OptionsCheck) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::stereo_front_end_test

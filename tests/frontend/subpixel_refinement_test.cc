@@ -9,7 +9,7 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
-namespace rcm {
+namespace rcm::subpixel_refinement_test {
 namespace {
 
 // Random blobs of random gray levels on gray, slightly blurred: texture
@@ -366,4 +366,4 @@ TEST(SubpixelRefinement, OptionsCheck) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::subpixel_refinement_test

@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-namespace rcm {
+namespace rcm::calibration_uncertainty_test {
 namespace {
 
 using ::testing::HasSubstr;
@@ -208,4 +208,4 @@ TEST(CalibrationUncertainty, PortsJoinTheJointCovariance) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::calibration_uncertainty_test

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <limits>
 
-namespace rcm {
+namespace rcm::rigid3d_test {
 namespace {
 
 Rigid3d SomeTransform() {
@@ -85,4 +85,4 @@ TEST(Rigid3d, RotationAngle) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::rigid3d_test

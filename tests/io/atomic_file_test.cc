@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <string>
 
-namespace rcm {
+namespace rcm::atomic_file_test {
 namespace {
 
 std::string TempPath(const std::string& name) {
@@ -70,4 +70,4 @@ TEST(AtomicFile, ReadDirectory) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::atomic_file_test

@@ -12,7 +12,7 @@
 #include "support/temp_file.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::calibration_covariance_file_test {
 namespace {
 
 using ::testing::HasSubstr;
@@ -431,4 +431,4 @@ TEST(CalibrationCovarianceFile, ReadStereoRigAttachesTheSidecar) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::calibration_covariance_file_test

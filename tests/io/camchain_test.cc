@@ -15,7 +15,7 @@
 #include "support/temp_file.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::camchain_test {
 namespace {
 
 using ::testing::HasSubstr;
@@ -976,9 +976,9 @@ TEST(Camchain, ReadPrefixesErrorsWithThePath) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::camchain_test
 
-namespace rcm {
+namespace rcm::camchain_test {
 namespace {
 
 TEST(CamchainCameraIndex, ReadsCanonicalNamesOnly) {
@@ -1007,9 +1007,9 @@ TEST(Camchain, FromStereoRigReadsBackAsTheSameRig) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::camchain_test
 
-namespace rcm {
+namespace rcm::camchain_test {
 namespace {
 
 TEST(Camchain, PortBlocksBecomeTheRigsPorts) {
@@ -1037,4 +1037,4 @@ TEST(Camchain, PortBlocksBecomeTheRigsPorts) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::camchain_test

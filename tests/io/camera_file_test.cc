@@ -11,7 +11,7 @@
 #include "support/temp_file.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::camera_file_test {
 namespace {
 
 using ::testing::HasSubstr;
@@ -76,4 +76,4 @@ TEST(CameraFile, ReportsMissingEmptyAndUnrecognisedFiles) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::camera_file_test

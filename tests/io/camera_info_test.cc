@@ -16,7 +16,7 @@
 #include "support/temp_file.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::camera_info_test {
 namespace {
 
 using ::testing::HasSubstr;
@@ -670,4 +670,4 @@ TEST(CameraInfo, WriteToUnwritableDirectoryFailsAndLeavesNothing) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::camera_info_test

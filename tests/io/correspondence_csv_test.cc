@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-namespace rcm {
+namespace rcm::correspondence_csv_test {
 namespace {
 
 uint64_t Bits(double value) {
@@ -404,4 +404,4 @@ TEST(CorrespondenceCsv, ErrorMessageHasNoControlCharacters) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::correspondence_csv_test

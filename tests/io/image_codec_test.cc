@@ -5,10 +5,11 @@
 
 #include <cstdint>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
 
-namespace rcm {
+namespace rcm::image_codec_test {
 namespace {
 
 // The modes and the imread flags they stand for.
@@ -280,4 +281,4 @@ TEST(ImageCodec, UndecodableBytesAreAnErrorAndPrintNothing) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::image_codec_test

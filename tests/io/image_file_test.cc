@@ -14,7 +14,7 @@
 
 #include "support/temp_file.h"
 
-namespace rcm {
+namespace rcm::image_file_test {
 namespace {
 
 cv::Mat TestImage(int type) {
@@ -687,4 +687,4 @@ TEST(ImageFileStructure, ReadsWhatOpenCvWritesSilently) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::image_file_test

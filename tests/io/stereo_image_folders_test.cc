@@ -13,7 +13,7 @@
 #include "rcm/io/image_file.h"
 #include "support/temp_file.h"
 
-namespace rcm {
+namespace rcm::stereo_image_folders_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -685,4 +685,4 @@ TEST(StereoImageFolders, RefusesATimeRangeOutsideTheSequence) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::stereo_image_folders_test

@@ -7,7 +7,7 @@
 #include <limits>
 #include <vector>
 
-namespace rcm {
+namespace rcm::stereo_image_source_test {
 namespace {
 
 using ::testing::ElementsAre;
@@ -169,4 +169,4 @@ TEST(SelectFrames, RejectsAnInvalidSelectionAndNoPairs) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::stereo_image_source_test

@@ -13,7 +13,7 @@
 #include "support/temp_file.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::stereo_rig_file_test {
 namespace {
 
 using ::testing::HasSubstr;
@@ -296,4 +296,4 @@ TEST(StereoRigFile, ReportsCameraInfoErrorsWithPath) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::stereo_rig_file_test

@@ -14,7 +14,7 @@
 #include "rcm/sim/reference_rigs.h"
 #include "rcm/sim/sequence_simulator.h"
 
-namespace rcm {
+namespace rcm::live_pipeline_test {
 namespace {
 
 // A rendered sequence through air -> water -> air (one ray per pixel, as
@@ -237,4 +237,4 @@ TEST(LatestSlot, AFloodDropsWholeItemsAndNeverQueues) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::live_pipeline_test

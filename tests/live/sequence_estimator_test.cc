@@ -12,7 +12,7 @@
 #include "rcm/sim/reference_rigs.h"
 #include "rcm/sim/sequence_simulator.h"
 
-namespace rcm {
+namespace rcm::sequence_estimator_test {
 namespace {
 
 constexpr double kWater = 1.333;
@@ -173,4 +173,4 @@ TEST(SequenceEstimator, RefusesBadPairsAndOptions) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::sequence_estimator_test

@@ -7,7 +7,7 @@
 #include <random>
 #include <vector>
 
-namespace rcm {
+namespace rcm::line_plot_test {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -304,4 +304,4 @@ TEST(LinePlot, LegendDoesNotHideData) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::line_plot_test

@@ -29,7 +29,7 @@
 #include "support/temp_file.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::bag_image_rewriter_test {
 namespace {
 
 using ::testing::ElementsAre;
@@ -787,4 +787,4 @@ TEST(BagImageWriter, CameraInfoNeedsATopicAndAStamp) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::bag_image_rewriter_test

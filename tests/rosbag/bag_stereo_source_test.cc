@@ -19,7 +19,7 @@
 #include "rcm/rosbag/bag_image_writer.h"
 #include "support/temp_file.h"
 
-namespace rcm {
+namespace rcm::bag_stereo_source_test {
 namespace {
 
 using ::testing::HasSubstr;
@@ -825,4 +825,4 @@ TEST(BagImageWriter, CreateInMissingDirectoryFails) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::bag_stereo_source_test

@@ -12,7 +12,7 @@
 #include "rcm/sim/reference_rigs.h"
 #include "rcm/sim/sequence_simulator.h"
 
-namespace rcm {
+namespace rcm::board_motion_test {
 namespace {
 
 constexpr double kDegree = M_PI / 180.0;
@@ -220,4 +220,4 @@ TEST(PlanBoardFrames, ABoardTooLargeForTheViewIsRecordedAsNotVisible) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::board_motion_test

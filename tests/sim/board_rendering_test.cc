@@ -23,7 +23,7 @@
 #include "rcm/sim/trajectory.h"
 #include "sim/test_pool.h"
 
-namespace rcm {
+namespace rcm::board_rendering_test {
 namespace {
 
 constexpr double kWaterIndex = 1.34;
@@ -341,4 +341,4 @@ TEST(BoardRendering, PixelsAreTheExactPixelIntegral) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::board_rendering_test

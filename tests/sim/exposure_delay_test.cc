@@ -10,7 +10,7 @@
 #include "rcm/sim/stereo_sampler.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::exposure_delay_test {
 namespace {
 
 constexpr double kDegree = M_PI / 180.0;
@@ -140,4 +140,4 @@ TEST(ExposureDelay, SamplerMovesTheRightPixelsByTheFramesMotion) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::exposure_delay_test

@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-namespace rcm {
+namespace rcm::media_schedule_test {
 namespace {
 
 TEST(MediaSchedule, ParsesNamesAndIndices) {
@@ -41,4 +41,4 @@ TEST(MediaSchedule, RejectsWaterIndexOutsideRange) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::media_schedule_test

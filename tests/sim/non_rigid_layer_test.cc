@@ -9,7 +9,7 @@
 #include "rcm/sim/stereo_sampler.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::non_rigid_layer_test {
 namespace {
 
 using ::testing::HasSubstr;
@@ -126,4 +126,4 @@ TEST(NonRigidLayer, MovesTheBandsRightPixelsByTheFramesOffset) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::non_rigid_layer_test

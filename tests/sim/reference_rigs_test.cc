@@ -6,7 +6,7 @@
 
 #include "rcm/camera/flat_port_camera.h"
 
-namespace rcm {
+namespace rcm::reference_rigs_test {
 namespace {
 
 constexpr double kDegree = M_PI / 180.0;
@@ -74,4 +74,4 @@ TEST(ReferenceRigs, NarrowFieldToeInMakesTheAxesMeet) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::reference_rigs_test

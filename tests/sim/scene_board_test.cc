@@ -12,7 +12,7 @@
 #include "rcm/calib/target_image.h"
 #include "rcm/sim/scene_intersection.h"
 
-namespace rcm {
+namespace rcm::scene_board_test {
 namespace {
 
 SceneBoard Board(int cols, int rows, double square) {
@@ -311,4 +311,4 @@ TEST(SceneIntersection, TheBoardOccludesTheTankOnlyInFrontOfIt) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::scene_board_test

@@ -11,7 +11,7 @@
 #include "rcm/sim/reference_rigs.h"
 #include "rcm/sim/scene_intersection.h"
 
-namespace rcm {
+namespace rcm::sequence_simulator_test {
 namespace {
 
 // Poses and matches only, no images: fast.
@@ -489,4 +489,4 @@ TEST(SequenceSimulator, SameSeedSameFramesWithABoard) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::sequence_simulator_test

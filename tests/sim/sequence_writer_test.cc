@@ -13,7 +13,7 @@
 #include "rcm/sim/reference_rigs.h"
 #include "support/temp_file.h"
 
-namespace rcm {
+namespace rcm::sequence_writer_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -155,4 +155,4 @@ TEST(SequenceWriter, WritesTheBoardAndTheCalibrationNotTheDrift) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::sequence_writer_test

@@ -12,7 +12,7 @@
 #include "rcm/sim/trajectory.h"
 #include "sim/test_pool.h"
 
-namespace rcm {
+namespace rcm::stereo_renderer_test {
 namespace {
 
 // Rendered DN are rounded: within 0.5 of the exact value, plus float
@@ -441,4 +441,4 @@ TEST(StereoRenderer, ABoardOnlyChangesThePixelsThatSeeIt) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::stereo_renderer_test

@@ -11,7 +11,7 @@
 #include "rcm/camera/flat_port_camera.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::stereo_sampler_test {
 namespace {
 
 TEST(StereoSampler, SamplesRequestedFramesInsideBothImages) {
@@ -252,4 +252,4 @@ TEST(FlatPortSampler, RejectsBadMediaAndPorts) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::stereo_sampler_test

@@ -6,7 +6,7 @@
 #include <random>
 #include <vector>
 
-namespace rcm {
+namespace rcm::tank_scene_test {
 namespace {
 
 // Hits are computed in closed form from one division per axis: a few ulps
@@ -293,4 +293,4 @@ TEST(TankScene, AnisotropicShadeHeadOnIsTheIsotropicOne) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::tank_scene_test

@@ -12,7 +12,7 @@
 
 #include "rcm/sim/reference_rigs.h"
 
-namespace rcm {
+namespace rcm::thin_port_bias_test {
 namespace {
 
 FlatPort Port(double air_gap_mm, double glass_mm) {
@@ -130,4 +130,4 @@ TEST(ThinPortBias, DocsTableIsCurrent) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::thin_port_bias_test

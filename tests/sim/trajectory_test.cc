@@ -7,7 +7,7 @@
 
 #include "rcm/sim/reference_rigs.h"
 
-namespace rcm {
+namespace rcm::trajectory_test {
 namespace {
 
 constexpr double kDegrees = M_PI / 180.0;
@@ -186,4 +186,4 @@ TEST(Trajectory, AStillCameraHovers) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::trajectory_test

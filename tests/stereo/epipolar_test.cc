@@ -7,7 +7,7 @@
 #include "rcm/sim/stereo_sampler.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::epipolar_test {
 namespace {
 
 // e is a triple product of O(1) bearings (unit baseline): exact data give
@@ -72,4 +72,4 @@ TEST(Epipolar, EssentialMatrixHasUnitTranslation) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::epipolar_test

@@ -8,7 +8,7 @@
 #include "rcm/sim/stereo_sampler.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::locus_test {
 namespace {
 
 // yr from the locus vs yr from the sampler: both exact, so agreement to the
@@ -63,4 +63,4 @@ TEST(RectifiedLocus, DegeneratesToAxisForPointsOnTheAxis) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::locus_test

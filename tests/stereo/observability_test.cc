@@ -12,7 +12,7 @@
 #include "rcm/sim/stereo_sampler.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::observability_test {
 namespace {
 
 std::vector<StereoCorrespondence> ObservableMatches(const StereoRig& rig,
@@ -166,4 +166,4 @@ TEST(Observability, FirstOrderSigmaGrowsTowardTheAxes) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::observability_test

@@ -7,7 +7,7 @@
 
 #include "rcm/sim/reference_rigs.h"
 
-namespace rcm {
+namespace rcm::stereo_rectification_test {
 namespace {
 
 bool IsRotation(const Eigen::Matrix3d& r) {
@@ -70,4 +70,4 @@ TEST(StereoRectification, ViewsLookAlongTheAverageAxis) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::stereo_rectification_test

@@ -8,7 +8,7 @@
 #include "rcm/camera/refractive_camera.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::stereo_rig_test {
 namespace {
 
 TEST(StereoRig, RejectsZeroBaseline) {
@@ -101,4 +101,4 @@ TEST(StereoRig, WithCam1MovedRefusesNonFiniteAndZeroBaseline) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::stereo_rig_test

@@ -25,7 +25,7 @@
 #include "support/temp_file.h"
 #include "support/test_rigs.h"
 
-namespace rcm {
+namespace rcm::virtual_pinhole_rig_test {
 namespace {
 
 constexpr double kN = 1.333;
@@ -711,11 +711,11 @@ TEST(VirtualPinholeRig, CorrectedImagesSatisfyPinholeEpipolarGeometry) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::virtual_pinhole_rig_test
 
 // --- A rig with thick ports: corrected for a reference depth.
 
-namespace rcm {
+namespace rcm::virtual_pinhole_rig_test {
 namespace {
 
 // Points at the reference depth are imaged by the corrected pinhole rig
@@ -779,4 +779,4 @@ TEST(VirtualPinholeRig, ThickPortIsExactAtTheReferenceDepth) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::virtual_pinhole_rig_test

@@ -12,7 +12,7 @@
 
 #include "rcm/util/message_text.h"
 
-namespace rcm {
+namespace rcm::number_format_test {
 namespace {
 
 struct Case {
@@ -121,4 +121,4 @@ TEST(FormatFixed, PrintsFixedDecimalsAndNaForNonFinite) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::number_format_test

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-namespace rcm {
+namespace rcm::status_test {
 namespace {
 
 StatusOr<std::vector<int>> MakeVector(bool fail) {
@@ -60,4 +60,4 @@ TEST(StatusOrDeathTest, ConstructionFromOkStatusIsProgrammerError) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::status_test

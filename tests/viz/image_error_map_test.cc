@@ -13,7 +13,7 @@
 
 #include "rcm/plot/color_map.h"
 
-namespace rcm {
+namespace rcm::image_error_map_test {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -519,4 +519,4 @@ TEST(ImageErrorMap, CheckFailuresAreOneLineErrors) {
 }
 
 }  // namespace
-}  // namespace rcm
+}  // namespace rcm::image_error_map_test
