@@ -1,12 +1,17 @@
 // Cost per correspondence of the closed form and the paper's estimator,
 // and of the first-order sigma (a Jet pass through both undistortions);
-// the Sampson residual of the refinement; and the refinement's run time
-// against the number of correspondences, which must grow linearly (the
-// complexity fit reported as BM_RefineRefractiveIndex_BigO); the
-// thick-port residual and refinement.
+// the Sampson residual of the refinement, and its Jacobian in n, cam1's
+// rotation and the focal scales by autodiff and written out; the
+// refinement's run time against the number of correspondences, which must
+// grow linearly (the complexity fit reported as
+// BM_RefineRefractiveIndex_BigO), and with the drift priors of a camchain
+// without a sidecar (rcm estimate's final estimate); the thick-port
+// residual and refinement.
 #include <benchmark/benchmark.h>
+#include <ceres/cost_function.h>
 
 #include <algorithm>
+#include <memory>
 #include <vector>
 
 #include "rcm/estimation/batch_refinement.h"
@@ -16,9 +21,11 @@
 #include "rcm/estimation/online_estimator.h"
 #include "rcm/estimation/paper_online_estimator.h"
 #include "rcm/estimation/prepared_correspondence.h"
+#include "rcm/estimation/sampson_coplanarity_cost_function.h"
 #include "rcm/estimation/sampson_coplanarity_error.h"
 #include "rcm/estimation/sliding_window_estimator.h"
 #include "rcm/estimation/thick_port_refinement.h"
+#include "rcm/io/stereo_rig_file.h"
 #include "rcm/sim/reference_rigs.h"
 #include "rcm/sim/stereo_sampler.h"
 #include "rcm/stereo/epipolar.h"
@@ -108,6 +115,47 @@ void BM_SampsonResidual(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_SampsonResidual);
+
+// One residual and its Jacobian in n, cam1's rotation and the focal
+// scales, as the batch refinement's Ceres solves evaluate it when the rig
+// carries drift priors (rcm estimate's default): the autodiff functor
+// (Jet<double, 6>) against the Jacobian written out
+// (sampson_coplanarity_cost_function.h), at one solve's parameters.
+void BM_SampsonJacobian(benchmark::State& state, bool analytic) {
+  const StereoRig rig = AlphasenseFrontUnrectifiedRig();
+  const std::vector<StereoCorrespondence> raw = Matches(rig);
+  std::vector<PreparedCorrespondence> matches =
+      PrepareCorrespondences(rig, raw).prepared;
+  const FocalStepRigs steps = FocalStepRigs::Of(rig).value();
+  for (size_t i = 0; i < matches.size(); ++i) {
+    PrepareFocalDerivatives(steps, raw[i], &matches[i]);
+  }
+  const Eigen::Matrix3d essential = EssentialMatrix(rig.right_from_left());
+  std::vector<std::unique_ptr<ceres::CostFunction>> costs;
+  for (const PreparedCorrespondence& match : matches) {
+    costs.emplace_back(
+        analytic
+            ? SampsonCoplanarityCostFunction::Create(essential, match, true)
+            : SampsonCoplanarityError::CreateWithRotationAndFocal(essential,
+                                                                  match));
+  }
+  const double n = 1.333;
+  const double rotation[3] = {1e-3, -2e-3, 5e-4};
+  const double focal[2] = {1e-3, -1e-3};
+  const double* blocks[3] = {&n, rotation, focal};
+  double residual = 0.0;
+  double jacobian[6];
+  double* jacobians[3] = {jacobian, jacobian + 1, jacobian + 4};
+  size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(costs[i]->Evaluate(blocks, &residual, jacobians));
+    benchmark::DoNotOptimize(jacobian);
+    i = (i + 1 == costs.size()) ? 0 : i + 1;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK_CAPTURE(BM_SampsonJacobian, autodiff, false);
+BENCHMARK_CAPTURE(BM_SampsonJacobian, analytic, true);
 
 // A frame's matches into the locus cost function on one thread: each match
 // at the 577 nodes, r and dr/dn vectorized over the matches
@@ -199,6 +247,30 @@ BENCHMARK(BM_RefineRefractiveIndex)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Complexity(benchmark::oN);
+
+// The same on a rig with the default drift priors, as rcm reads a camchain
+// without a sidecar: n with cam1's rotation and the focal scales under
+// their priors (the robust stage, stage 2 until the prior's weight
+// settles, the focal passes), what `rcm estimate`'s final estimate solves.
+void BM_RefineRefractiveIndexSelfCalibrating(benchmark::State& state) {
+  const StereoRig rig = WithDefaultCalibrationUncertainty(
+                            AlphasenseFrontUnrectifiedRig(), RigFileOptions())
+                            .value();
+  std::vector<StereoCorrespondence> matches =
+      Matches(rig, static_cast<int>(state.range(0)));
+  AddPixelNoise(0.5, 2, &matches);
+  AddOutliers(rig, 0.2, 3, &matches);
+  const RefinementOptions options;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(RefineRefractiveIndex(rig, matches, options));
+  }
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+}
+BENCHMARK(BM_RefineRefractiveIndexSelfCalibrating)
+    ->Arg(2000)
+    ->Arg(12000)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // One frame of 200 matches (0.5 px noise, 10 % outliers) into the online
 // estimator: the frame's robust fit, its inliers' cost function at the

@@ -19,6 +19,7 @@
 #include "rcm/estimation/paper_online_estimator.h"
 #include "rcm/estimation/prepared_correspondence.h"
 #include "rcm/estimation/robust_locus_fit.h"
+#include "rcm/estimation/sampson_coplanarity_cost_function.h"
 #include "rcm/estimation/sampson_coplanarity_error.h"
 #include "rcm/estimation/thick_port_refinement.h"
 #include "rcm/stereo/epipolar.h"
@@ -170,15 +171,16 @@ ceres::Solver::Summary Solve(const Eigen::Matrix3d& essential,
     problem->AddResidualBlock(focal_prior, nullptr, parameters->focal);
   }
   for (const int64_t i : indices) {
+    // With the rotation or the focal scales: the Jacobian written out
+    // (sampson_coplanarity_cost_function.h); n alone: autodiff's Jet<1>.
     if (focal_prior != nullptr) {
       problem->AddResidualBlock(
-          SampsonCoplanarityError::CreateWithRotationAndFocal(essential,
-                                                              matches[i]),
+          SampsonCoplanarityCostFunction::Create(essential, matches[i], true),
           loss_function, &parameters->n, parameters->rotation,
           parameters->focal);
     } else if (with_rotation) {
       problem->AddResidualBlock(
-          SampsonCoplanarityError::CreateWithRotation(essential, matches[i]),
+          SampsonCoplanarityCostFunction::Create(essential, matches[i], false),
           loss_function, &parameters->n, parameters->rotation);
     } else {
       problem->AddResidualBlock(
