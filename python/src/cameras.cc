@@ -15,8 +15,6 @@
 namespace rcm::python {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
 LensModelId LensModelOrThrow(const std::string& name) {
   const std::optional<LensModelId> model = LensModelFromName(name);
   if (!model) {

@@ -12,6 +12,7 @@
 #include <pybind11/pybind11.h>
 
 #include <Eigen/Core>
+#include <limits>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
@@ -25,6 +26,9 @@ namespace rcm::python {
 namespace py = pybind11;
 
 using DoubleArray = py::array_t<double, py::array::c_style>;
+
+// What the bindings return for a value that does not exist (NaN).
+inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // A C-contiguous float64 copy (or view) of `object` of shape (N, cols), or
 // (cols,) when `allow_single` (then `single` is set and the caller returns

@@ -98,8 +98,6 @@ void ApplyRefinementOptions(const py::dict& kwargs, RefinementOptions* options,
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
 RefinementOptions RefinementOptionsFrom(const py::dict& kwargs,
                                         const std::string& function) {
   RefinementOptions options;

@@ -16,8 +16,6 @@
 namespace rcm::python {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
 py::array_t<float> FloatMap(const cv::Mat& map) {
   CHECK(map.type() == CV_32FC1);
   py::array_t<float> array(std::vector<py::ssize_t>{map.rows, map.cols});
