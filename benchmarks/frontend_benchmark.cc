@@ -72,11 +72,14 @@
 //   BM_EndToEnd_Engine         the sequence engine as `rcm estimate` runs it
 //                              (the rig with the default drift priors, the
 //                              field test on), window_matches 100/200/400:
-//                              0.94/0.88/0.92 s for the 10 pairs (2026-12-05)
+//                              0.94/0.88/0.92 s for the 10 pairs; 0.71/0.75/
+//                              0.80 s with the refinement's Jacobian written
+//                              out (2026-12-05)
 //   BM_EndToEnd_RcmProcess     the whole `rcm estimate` process on the PNG
 //                              folders: 1.06-1.15 s, 3.7-5.5x one
 //                              straightforward run of the same benchmark
-//                              over three runs (docs/numbers.md)
+//                              over three runs; 1.05 s, 4.1x with the
+//                              Jacobian written out (docs/numbers.md)
 //
 // Run e.g.
 //   build/bin/frontend_benchmark
