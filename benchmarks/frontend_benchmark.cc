@@ -79,7 +79,8 @@
 //                              folders: 1.06-1.15 s, 3.7-5.5x one
 //                              straightforward run of the same benchmark
 //                              over three runs; 1.05 s, 4.1x with the
-//                              Jacobian written out (docs/numbers.md)
+//                              Jacobian written out; 0.73 s, 5.3x with the
+//                              heap padded too (docs/numbers.md)
 //
 // Run e.g.
 //   build/bin/frontend_benchmark

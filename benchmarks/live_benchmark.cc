@@ -23,11 +23,16 @@
 #include "rcm/live/live_pipeline.h"
 #include "rcm/sim/reference_rigs.h"
 #include "rcm/sim/sequence_simulator.h"
+#include "rcm/util/heap_padding.h"
 
 namespace rcm {
 namespace {
 
 constexpr int kPairs = 8;
+
+// The heap as the ROS node sets it up before its first pair
+// (rcm/util/heap_padding.h), so that the CPU per pair is the node's.
+const bool kHeapPadded = PadHeapGrowth();
 
 // The rig as `rcm` and the node read a camchain without a sidecar: with
 // the default drift and focal drift priors, so the estimator

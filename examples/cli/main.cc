@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "command.h"
+#include "rcm/util/heap_padding.h"
 #include "rcm/version.h"
 
 namespace rcm::cli {
@@ -45,6 +46,9 @@ void PrintUsage(std::ostream& out) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // A pair loop's buffers reuse the heap instead of faulting pages in anew
+  // each pair (rcm/util/heap_padding.h).
+  rcm::PadHeapGrowth();
   google::InitGoogleLogging(argv[0]);
   FLAGS_logtostderr = true;
   // A subcommand's errors and warnings are its own one-line messages; the

@@ -58,6 +58,7 @@
 #include "rcm/io/stereo_rig_file.h"
 #include "rcm/live/latest_slot.h"
 #include "rcm/live/live_pipeline.h"
+#include "rcm/util/heap_padding.h"
 #include "rcm/stereo/virtual_pinhole_rig.h"
 #include "rcm_ros/RefractiveIndex.h"
 #include "rcm_ros/Reset.h"
@@ -526,6 +527,9 @@ class RcmRosNode {
 }  // namespace rcm
 
 int main(int argc, char** argv) {
+  // Each pair's buffers reuse the heap instead of faulting pages in anew
+  // (rcm/util/heap_padding.h).
+  rcm::PadHeapGrowth();
   ros::init(argc, argv, "rcm");
   ros::NodeHandle nh;
   ros::NodeHandle private_nh("~");
