@@ -23,7 +23,8 @@ namespace rcm {
 
 inline constexpr int kHeapPaddingBytes = 16 << 20;
 
-// Sets the padding; false when the C library refused it (or is not glibc).
+// Sets the padding; false when the allocator refused it (AddressSanitizer's,
+// which replaces glibc's, does) or the C library is not glibc.
 bool PadHeapGrowth();
 
 }  // namespace rcm
