@@ -225,11 +225,10 @@ BENCHMARK(BM_RefineRefractiveIndexThickPort)
     ->Args({2000, 1})
     ->Unit(benchmark::kMillisecond);
 
-void BM_RefineRefractiveIndex(benchmark::State& state) {
-  // The whole batch refinement (prepare, scan, robust and least-squares
-  // Ceres stages, covariance) with 0.5 px noise and 20 % outliers, on two
-  // threads.
-  const StereoRig rig = AlphasenseFrontUnrectifiedRig();
+// The whole batch refinement (prepare, scan, robust and least-squares
+// Ceres stages, covariance) of state.range(0) matches of `rig` with 0.5 px
+// noise and 20 % outliers, on two threads.
+void RunRefinement(benchmark::State& state, const StereoRig& rig) {
   std::vector<StereoCorrespondence> matches =
       Matches(rig, static_cast<int>(state.range(0)));
   AddPixelNoise(0.5, 2, &matches);
@@ -240,6 +239,10 @@ void BM_RefineRefractiveIndex(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations() * state.range(0));
   state.SetComplexityN(state.range(0));
+}
+
+void BM_RefineRefractiveIndex(benchmark::State& state) {
+  RunRefinement(state, AlphasenseFrontUnrectifiedRig());
 }
 BENCHMARK(BM_RefineRefractiveIndex)
     ->RangeMultiplier(10)
@@ -253,18 +256,9 @@ BENCHMARK(BM_RefineRefractiveIndex)
 // their priors (the robust stage, stage 2 until the prior's weight
 // settles, the focal passes), what `rcm estimate`'s final estimate solves.
 void BM_RefineRefractiveIndexSelfCalibrating(benchmark::State& state) {
-  const StereoRig rig = WithDefaultCalibrationUncertainty(
-                            AlphasenseFrontUnrectifiedRig(), RigFileOptions())
-                            .value();
-  std::vector<StereoCorrespondence> matches =
-      Matches(rig, static_cast<int>(state.range(0)));
-  AddPixelNoise(0.5, 2, &matches);
-  AddOutliers(rig, 0.2, 3, &matches);
-  const RefinementOptions options;
-  for (auto _ : state) {
-    benchmark::DoNotOptimize(RefineRefractiveIndex(rig, matches, options));
-  }
-  state.SetItemsProcessed(state.iterations() * state.range(0));
+  RunRefinement(state, WithDefaultCalibrationUncertainty(
+                           AlphasenseFrontUnrectifiedRig(), RigFileOptions())
+                           .value());
 }
 BENCHMARK(BM_RefineRefractiveIndexSelfCalibrating)
     ->Arg(2000)

@@ -55,10 +55,11 @@ std::vector<StereoRig> Rigs() {
 std::vector<PreparedCorrespondence> Matches(const StereoRig& rig) {
   std::vector<StereoCorrespondence> data = test::ExactMatches(rig, 1.333, 30);
   AddPixelNoise(0.5, 4, &data);
+  const FocalStepRigs steps = FocalStepRigs::Of(rig).value();
   std::vector<PreparedCorrespondence> prepared;
   for (const StereoCorrespondence& match : data) {
     PreparedCorrespondence p = PrepareCorrespondence(rig, match).value();
-    EXPECT_TRUE(PrepareFocalDerivatives(rig, match, &p));
+    EXPECT_TRUE(PrepareFocalDerivatives(steps, match, &p));
     prepared.push_back(p);
   }
   return prepared;
