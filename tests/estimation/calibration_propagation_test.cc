@@ -150,6 +150,56 @@ TEST(CalibrationPropagation, FocalColumnsMatchJets) {
   }
 }
 
+// The rows of a sequence longer than one chunk of rows, summed on one
+// thread and on two: the same sums to the bit (the chunks are summed in
+// one order whatever the threads), the per-frame sums included.
+TEST(CalibrationPropagation, SumsDoNotDependOnTheThreads) {
+  const StereoRig rig =
+      WithDefaultCalibrationUncertainty(test::AlphasenseRealisticRig()).value();
+  std::vector<StereoCorrespondence> raw =
+      Frames(rig, kTrueN, 0.6, 6.0, 7, 300, 11);
+  AddPixelNoise(0.5, 3, &raw);
+  const PreparedCorrespondences prepared = PrepareCorrespondences(rig, raw);
+  std::vector<StereoCorrespondence> aligned;
+  for (const int64_t i : prepared.source_index) aligned.push_back(raw[i]);
+  std::vector<int64_t> all(prepared.prepared.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int64_t>(i);
+  ASSERT_GT(all.size(), 2000u);
+  const CalibrationParameterLayout layout =
+      CalibrationParameterLayout::Of(rig, 0.0, true, true);
+  const Eigen::Vector3d rotation(0.001, -0.0005, 0.0002);
+  const Eigen::Vector2d focal(1e-3, -5e-4);
+  std::vector<LocusNormalEquations> sums;
+  std::vector<std::vector<LocusNormalEquations>> frames(2);
+  for (const int threads : {1, 2}) {
+    sums.emplace_back(layout.Size());
+    AccumulateLocusNormalEquations(rig, layout, aligned, prepared.prepared, all,
+                                   kTrueN, rotation, focal, &sums.back(),
+                                   &frames[threads - 1], threads);
+  }
+  const auto expect_equal = [](const LocusNormalEquations& a,
+                               const LocusNormalEquations& b) {
+    EXPECT_EQ(a.count, b.count);
+    EXPECT_TRUE(a.information == b.information);
+    EXPECT_TRUE(a.gradient == b.gradient);
+    EXPECT_TRUE(a.gradient_intercept == b.gradient_intercept);
+    EXPECT_EQ(a.intercept_squares, b.intercept_squares);
+    EXPECT_EQ(a.squared_residuals, b.squared_residuals);
+  };
+  EXPECT_EQ(sums[0].count, static_cast<int64_t>(all.size()));
+  expect_equal(sums[0], sums[1]);
+  ASSERT_EQ(frames[0].size(), 7u);
+  ASSERT_EQ(frames[1].size(), 7u);
+  int64_t count = 0;
+  for (size_t f = 0; f < frames[0].size(); ++f) {
+    expect_equal(frames[0][f], frames[1][f]);
+    count += frames[0][f].count;
+  }
+  EXPECT_EQ(count, sums[0].count);
+  // The information is symmetric (rankUpdate fills one triangle).
+  EXPECT_TRUE(sums[0].information == sums[0].information.transpose().eval());
+}
+
 // The implicit-function sensitivities against the estimator itself: n
 // estimated alone (calibration held) on exact data with the calibration
 // moved by +-h, by central differences.

@@ -3,6 +3,7 @@
 #include <ceres/loss_function.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "rcm/sim/stereo_sampler.h"
@@ -28,6 +29,53 @@ TEST(RobustLoss, MatchesCeresLossFunctions) {
     cauchy.Evaluate(s, rho);
     EXPECT_NEAR(RobustLossRho(RobustLoss::kCauchy, 1.5, s), rho[0], kTolerance);
     EXPECT_EQ(RobustLossRho(RobustLoss::kNone, 1.5, s), s);
+  }
+}
+
+// psi(r)^2 = rho(r^2) and psi' psi = rho'(r^2) r (the derivative of
+// rho(r^2) / 2) against Ceres' own loss functions, psi' against a central
+// difference of psi, and psi through zero with slope one, about and beyond
+// the Huber knee (|r| = 1.5) and far out.
+TEST(RobustLoss, RootSquaresToTheLossWithItsDerivative) {
+  // Same formulas as Ceres' in another order: rounding, ~1e-15 relative.
+  constexpr double kTolerance = 1e-13;
+  // Central difference with h = 1e-6 max(1, |r|) of a function whose third
+  // derivative is O(1 / max(1, |r|)^2) here: h^2 ~ 1e-12, plus rounding
+  // 1e-16 |psi| / h <= 1e-10.
+  constexpr double kStep = 1e-6;
+  constexpr double kDifferenceTolerance = 1e-8;
+  const ceres::HuberLoss huber(1.5);
+  const ceres::CauchyLoss cauchy(1.5);
+  for (const RobustLoss loss :
+       {RobustLoss::kNone, RobustLoss::kHuber, RobustLoss::kCauchy}) {
+    for (const double r :
+         {0.0, 1e-9, -1e-6, 0.3, -1.4, 1.5, 1.6, -4.0, 30.0, -1e4}) {
+      double root = NAN;
+      double slope = NAN;
+      RobustLossRoot(loss, 1.5, r, &root, &slope);
+      double rho[3] = {r * r, 1.0, 0.0};
+      if (loss == RobustLoss::kHuber) huber.Evaluate(r * r, rho);
+      if (loss == RobustLoss::kCauchy) cauchy.Evaluate(r * r, rho);
+      const double scale = std::max(1.0, rho[0]);
+      EXPECT_NEAR(root * root, rho[0], kTolerance * scale) << "r " << r;
+      EXPECT_NEAR(slope * root, rho[1] * r, kTolerance * scale) << "r " << r;
+      EXPECT_TRUE(root == 0.0 || std::signbit(root) == std::signbit(r));
+      double plus = NAN;
+      double minus = NAN;
+      double unused = NAN;
+      const double h = kStep * std::max(1.0, std::abs(r));
+      RobustLossRoot(loss, 1.5, r + h, &plus, &unused);
+      RobustLossRoot(loss, 1.5, r - h, &minus, &unused);
+      if (loss != RobustLoss::kHuber || std::abs(std::abs(r) - 1.5) > h) {
+        EXPECT_NEAR(slope, (plus - minus) / (2.0 * h), kDifferenceTolerance)
+            << RobustLossName(loss) << " r " << r;
+      }
+    }
+    double root = NAN;
+    double slope = NAN;
+    RobustLossRoot(loss, 1.5, 0.0, &root, &slope);
+    EXPECT_EQ(root, 0.0);
+    EXPECT_EQ(slope, 1.0);
   }
 }
 

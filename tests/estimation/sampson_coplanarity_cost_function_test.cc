@@ -1,6 +1,8 @@
 #include "rcm/estimation/sampson_coplanarity_cost_function.h"
 
 #include <ceres/cost_function.h>
+#include <ceres/problem.h>
+#include <ceres/solver.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -153,6 +155,219 @@ TEST(SampsonCoplanarityCostFunction, FailsWhereTheGradientVanishes) {
   double jacobian[6];
   EXPECT_FALSE(Evaluate(*analytic, Points()[1], &residual, jacobian));
   EXPECT_FALSE(Evaluate(*autodiff, Points()[1], &residual, jacobian));
+}
+
+// The parameter blocks of `parameters` at `point`, and where their
+// Jacobians go for `count` residuals (row-major count x size per block).
+struct Blocks {
+  std::vector<const double*> values;
+  std::vector<std::vector<double>> jacobians;
+  std::vector<double*> pointers;
+};
+Blocks BlocksOf(SampsonParameters parameters, const Point& point, int count) {
+  Blocks blocks;
+  blocks.values = {&point.n};
+  std::vector<int> sizes = {1};
+  if (parameters != SampsonParameters::kIndex) {
+    blocks.values.push_back(point.rotation);
+    sizes.push_back(3);
+  }
+  if (parameters == SampsonParameters::kIndexRotationFocal) {
+    blocks.values.push_back(point.focal);
+    sizes.push_back(2);
+  }
+  for (const int size : sizes) {
+    blocks.jacobians.emplace_back(static_cast<size_t>(count * size), NAN);
+  }
+  for (std::vector<double>& jacobian : blocks.jacobians) {
+    blocks.pointers.push_back(jacobian.data());
+  }
+  return blocks;
+}
+
+// A block of matches is its matches one by one, row for row, to the bit
+// (the same arithmetic), for each set of parameter blocks; n alone is the
+// n column with the rotation at zero.
+TEST(SampsonCoplanarityCostFunction, BlockOfMatchesIsItsMatchesOneByOne) {
+  for (const StereoRig& rig : Rigs()) {
+    const Eigen::Matrix3d essential = EssentialMatrix(rig.right_from_left());
+    const std::vector<PreparedCorrespondence> matches = Matches(rig);
+    const int count = static_cast<int>(matches.size());
+    for (const SampsonParameters parameters :
+         {SampsonParameters::kIndex, SampsonParameters::kIndexRotation,
+          SampsonParameters::kIndexRotationFocal}) {
+      const SampsonCoplanarityCostFunction block(essential, matches,
+                                                 parameters);
+      ASSERT_EQ(block.num_residuals(), count);
+      for (Point point : Points()) {
+        if (parameters == SampsonParameters::kIndex) {
+          std::fill_n(point.rotation, 3, 0.0);
+        }
+        if (parameters != SampsonParameters::kIndexRotationFocal) {
+          std::fill_n(point.focal, 2, 0.0);
+        }
+        Blocks blocks = BlocksOf(parameters, point, count);
+        std::vector<double> residuals(count, NAN);
+        ASSERT_TRUE(block.Evaluate(blocks.values.data(), residuals.data(),
+                                   blocks.pointers.data()));
+        for (int i = 0; i < count; ++i) {
+          std::unique_ptr<ceres::CostFunction> one(
+              SampsonCoplanarityCostFunction::Create(
+                  essential, matches[i],
+                  parameters == SampsonParameters::kIndexRotationFocal));
+          double residual = NAN;
+          double jacobian[6] = {};
+          ASSERT_TRUE(Evaluate(*one, point, &residual, jacobian));
+          EXPECT_EQ(residuals[i], residual);
+          EXPECT_EQ(blocks.jacobians[0][i], jacobian[0]);
+          if (parameters == SampsonParameters::kIndex) continue;
+          for (int k = 0; k < 3; ++k) {
+            EXPECT_EQ(blocks.jacobians[1][3 * i + k], jacobian[1 + k]);
+          }
+          if (parameters != SampsonParameters::kIndexRotationFocal) continue;
+          for (int k = 0; k < 2; ++k) {
+            EXPECT_EQ(blocks.jacobians[2][2 * i + k], jacobian[4 + k]);
+          }
+        }
+      }
+    }
+  }
+}
+
+// Through a loss, half the block's sum of squares is the robust cost
+// sum rho(r_i^2) / 2 Ceres gives the same matches one block each with the
+// loss, and each row of the Jacobian is the central difference of its
+// residual.
+TEST(SampsonCoplanarityCostFunction, RobustBlockCostIsCeresLossCost) {
+  // The cost: the same sum by other formulas, rounding of ~30 terms.
+  constexpr double kCostTolerance = 1e-12;
+  // Central differences with h = 1e-7 (n, rad, scale): truncation h^2 times
+  // third derivatives of O(10^3) px per unit^3 at this baseline, ~1e-11,
+  // and rounding 1e-16 * 10^3 px / h, ~1e-6 of derivatives of O(10^3).
+  constexpr double kStep = 1e-7;
+  constexpr double kDifferenceTolerance = 1e-6;
+  const StereoRig rig = test::AlphasenseRealisticRig();
+  const Eigen::Matrix3d essential = EssentialMatrix(rig.right_from_left());
+  std::vector<PreparedCorrespondence> matches = Matches(rig);
+  // Outliers: the right pixels of every third match moved several pixels.
+  for (size_t i = 0; i < matches.size(); i += 3) {
+    matches[i].right_normalized[1] += 0.01 * static_cast<double>(i % 7 + 1);
+  }
+  const int count = static_cast<int>(matches.size());
+  const Point point = Points()[3];
+  for (const RobustLoss loss : {RobustLoss::kHuber, RobustLoss::kCauchy}) {
+    const SampsonCoplanarityCostFunction block(
+        essential, matches, SampsonParameters::kIndexRotationFocal, loss, 0.7);
+    ceres::Problem::Options options;
+    options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    ceres::Problem problem(options);
+    Point at = point;
+    std::vector<std::unique_ptr<ceres::CostFunction>> ones;
+    for (const PreparedCorrespondence& match : matches) {
+      ones.emplace_back(
+          SampsonCoplanarityCostFunction::Create(essential, match, true));
+      problem.AddResidualBlock(ones.back().get(), NewLossFunction(loss, 0.7),
+                               &at.n, at.rotation, at.focal);
+    }
+    double ceres_cost = NAN;
+    ASSERT_TRUE(problem.Evaluate(ceres::Problem::EvaluateOptions(), &ceres_cost,
+                                 nullptr, nullptr, nullptr));
+
+    Blocks blocks =
+        BlocksOf(SampsonParameters::kIndexRotationFocal, point, count);
+    std::vector<double> residuals(count, NAN);
+    ASSERT_TRUE(block.Evaluate(blocks.values.data(), residuals.data(),
+                               blocks.pointers.data()));
+    double cost = 0.0;
+    for (const double r : residuals) cost += 0.5 * r * r;
+    EXPECT_NEAR(cost, ceres_cost, kCostTolerance * ceres_cost)
+        << RobustLossName(loss);
+
+    const int sizes[3] = {1, 3, 2};
+    for (int b = 0; b < 3; ++b) {
+      for (int k = 0; k < sizes[b]; ++k) {
+        std::vector<double> plus(count);
+        std::vector<double> minus(count);
+        for (const double sign : {1.0, -1.0}) {
+          Point moved = point;
+          double* values[3] = {&moved.n, moved.rotation, moved.focal};
+          values[b][k] += sign * kStep;
+          const double* moved_blocks[3] = {&moved.n, moved.rotation,
+                                           moved.focal};
+          ASSERT_TRUE(block.Evaluate(
+              moved_blocks, (sign > 0 ? plus : minus).data(), nullptr));
+        }
+        for (int i = 0; i < count; ++i) {
+          const double expected = (plus[i] - minus[i]) / (2.0 * kStep);
+          EXPECT_NEAR(blocks.jacobians[b][sizes[b] * i + k], expected,
+                      kDifferenceTolerance * std::max(1.0, std::abs(expected)))
+              << RobustLossName(loss) << " block " << b << " column " << k
+              << " match " << i;
+        }
+      }
+    }
+  }
+}
+
+// Solved with Ceres, blocks of matches with the loss inside reach the
+// minimum of the same matches one block each under Ceres' loss: the same
+// robust cost, minimized from the same start (only the steps differ).
+TEST(SampsonCoplanarityCostFunction, RobustBlocksSolveToCeresLossMinimum) {
+  // Both solves stop where the cost changes by less than 1e-14 of itself
+  // (function_tolerance); along the minimum's flat valley (n with the
+  // rotation, R ~ 0.97) that leaves n and the rotation ~1e-9 apart
+  // (measured 2.2e-9 with Cauchy's loss), a millionth of sigma_n here.
+  constexpr double kTolerance = 1e-8;
+  const StereoRig rig = test::AlphasenseRealisticRig();
+  const Eigen::Matrix3d essential = EssentialMatrix(rig.right_from_left());
+  std::vector<StereoCorrespondence> data = test::ExactMatches(rig, 1.333, 400);
+  AddPixelNoise(0.5, 9, &data);
+  for (size_t i = 0; i < data.size(); i += 10) {
+    data[i].right_pixel.y() += 3.0 + static_cast<double>(i % 5);  // outliers
+  }
+  const std::vector<PreparedCorrespondence> matches =
+      PrepareCorrespondences(rig, data).prepared;
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_QR;
+  options.function_tolerance = 1e-14;
+  options.gradient_tolerance = 1e-16;
+  options.parameter_tolerance = 1e-12;
+  options.max_num_iterations = 200;
+  for (const RobustLoss loss : {RobustLoss::kHuber, RobustLoss::kCauchy}) {
+    Point ones = {1.36, {0.0, 0.0, 0.0}, {0.0, 0.0}};
+    Point blocks = ones;
+    ceres::Problem one_by_one;
+    for (const PreparedCorrespondence& match : matches) {
+      one_by_one.AddResidualBlock(
+          SampsonCoplanarityCostFunction::Create(essential, match, false),
+          NewLossFunction(loss, 1.0), &ones.n, ones.rotation);
+    }
+    ceres::Problem in_blocks;
+    for (size_t begin = 0; begin < matches.size();
+         begin += kSampsonBlockMatches) {
+      const size_t end =
+          std::min(matches.size(), begin + size_t{kSampsonBlockMatches});
+      in_blocks.AddResidualBlock(
+          SampsonCoplanarityCostFunction::Create(
+              essential, {matches.begin() + begin, matches.begin() + end},
+              SampsonParameters::kIndexRotation, loss, 1.0),
+          nullptr, &blocks.n, blocks.rotation);
+    }
+    ceres::Solver::Summary one_summary;
+    ceres::Solver::Summary block_summary;
+    ceres::Solve(options, &one_by_one, &one_summary);
+    ceres::Solve(options, &in_blocks, &block_summary);
+    ASSERT_TRUE(one_summary.IsSolutionUsable());
+    ASSERT_TRUE(block_summary.IsSolutionUsable());
+    EXPECT_NEAR(blocks.n, ones.n, kTolerance) << RobustLossName(loss);
+    EXPECT_GT(one_summary.num_successful_steps, 0);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(blocks.rotation[k], ones.rotation[k], kTolerance)
+          << RobustLossName(loss);
+    }
+    EXPECT_NEAR(block_summary.final_cost, one_summary.final_cost,
+                1e-12 * one_summary.final_cost);
+  }
 }
 
 }  // namespace

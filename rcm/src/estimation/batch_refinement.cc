@@ -159,8 +159,6 @@ ceres::Solver::Summary Solve(const Eigen::Matrix3d& essential,
                              ceres::CostFunction* n_prior,
                              ceres::CostFunction* focal_prior,
                              Parameters* parameters, ceres::Problem* problem) {
-  ceres::LossFunction* loss_function =
-      NewLossFunction(loss, options.loss_scale_px);
   if (prior != nullptr) {
     problem->AddResidualBlock(prior, nullptr, parameters->rotation);
   }
@@ -170,23 +168,30 @@ ceres::Solver::Summary Solve(const Eigen::Matrix3d& essential,
   if (focal_prior != nullptr) {
     problem->AddResidualBlock(focal_prior, nullptr, parameters->focal);
   }
-  for (const int64_t i : indices) {
-    // With the rotation or the focal scales: the Jacobian written out
-    // (sampson_coplanarity_cost_function.h); n alone: autodiff's Jet<1>.
-    if (focal_prior != nullptr) {
-      problem->AddResidualBlock(
-          SampsonCoplanarityCostFunction::Create(essential, matches[i], true),
-          loss_function, &parameters->n, parameters->rotation,
-          parameters->focal);
-    } else if (with_rotation) {
-      problem->AddResidualBlock(
-          SampsonCoplanarityCostFunction::Create(essential, matches[i], false),
-          loss_function, &parameters->n, parameters->rotation);
-    } else {
-      problem->AddResidualBlock(
-          SampsonCoplanarityError::Create(essential, matches[i]), loss_function,
-          &parameters->n);
-    }
+  // The matches in blocks of kSampsonBlockMatches, the loss inside each
+  // (sampson_coplanarity_cost_function.h); the Jacobian written out.
+  const SampsonParameters blocks =
+      focal_prior != nullptr ? SampsonParameters::kIndexRotationFocal
+      : with_rotation        ? SampsonParameters::kIndexRotation
+                             : SampsonParameters::kIndex;
+  std::vector<double*> parameter_blocks = {&parameters->n};
+  if (blocks != SampsonParameters::kIndex) {
+    parameter_blocks.push_back(parameters->rotation);
+  }
+  if (blocks == SampsonParameters::kIndexRotationFocal) {
+    parameter_blocks.push_back(parameters->focal);
+  }
+  for (size_t begin = 0; begin < indices.size();
+       begin += kSampsonBlockMatches) {
+    const size_t end =
+        std::min(indices.size(), begin + size_t{kSampsonBlockMatches});
+    std::vector<PreparedCorrespondence> block;
+    block.reserve(end - begin);
+    for (size_t k = begin; k < end; ++k) block.push_back(matches[indices[k]]);
+    problem->AddResidualBlock(
+        SampsonCoplanarityCostFunction::Create(
+            essential, std::move(block), blocks, loss, options.loss_scale_px),
+        nullptr, parameter_blocks);
   }
   if (focal_prior != nullptr && !with_rotation) {
     problem->SetParameterBlockConstant(parameters->rotation);
@@ -493,7 +498,7 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
   std::vector<LocusNormalEquations> per_frame;
   AccumulateLocusNormalEquations(solved_rig, layout, raw, matches, inliers,
                                  parameters.n, rotation, focal.prepared_with,
-                                 &equations, &per_frame);
+                                 &equations, &per_frame, options.num_threads);
   summary.consistency = FrameConsistencyOf(per_frame, summary.sigma_px);
   const double inflation =
       summary.consistency ? summary.consistency->inflation : 1.0;

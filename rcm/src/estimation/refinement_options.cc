@@ -44,6 +44,35 @@ double RobustLossRho(RobustLoss loss, double scale, double squared_residual) {
   return squared_residual;
 }
 
+void RobustLossRoot(RobustLoss loss, double scale, double residual,
+                    double* root, double* slope) {
+  switch (loss) {
+    case RobustLoss::kNone:
+      break;
+    case RobustLoss::kHuber: {
+      const double magnitude = std::abs(residual);
+      if (magnitude <= scale) break;
+      const double root_magnitude =
+          std::sqrt(2.0 * scale * magnitude - scale * scale);
+      *root = std::copysign(root_magnitude, residual);
+      *slope = scale / root_magnitude;
+      return;
+    }
+    case RobustLoss::kCauchy: {
+      const double x = residual * residual / (scale * scale);
+      // log(1 + x) / x = 1 - x / 2 + x^2 / 3 - ...: below 1e-10 the first
+      // two terms are exact to rounding, and 0 / 0 is avoided.
+      const double h = x < 1e-10 ? 1.0 - 0.5 * x : std::log1p(x) / x;
+      const double root_h = std::sqrt(h);
+      *root = residual * root_h;
+      *slope = 1.0 / ((1.0 + x) * root_h);
+      return;
+    }
+  }
+  *root = residual;
+  *slope = 1.0;
+}
+
 Status RefinementOptions::Check() const {
   std::ostringstream error;
   if (!(loss_scale_px > 0.0) || !std::isfinite(loss_scale_px)) {

@@ -55,45 +55,31 @@ inline void Chain(double gx, double gy, const double* j, double* out) {
   out[1] = gx * j[1] + gy * j[3];
 }
 
-}  // namespace
-
-SampsonCoplanarityCostFunction::SampsonCoplanarityCostFunction(
-    const Eigen::Matrix3d& essential, const PreparedCorrespondence& match,
-    bool with_focal)
-    : essential_(essential), match_(match), with_focal_(with_focal) {
-  set_num_residuals(1);
-  mutable_parameter_block_sizes()->push_back(1);
-  mutable_parameter_block_sizes()->push_back(3);
-  if (with_focal) mutable_parameter_block_sizes()->push_back(2);
-}
-
-bool SampsonCoplanarityCostFunction::Evaluate(double const* const* parameters,
-                                              double* residuals,
-                                              double** jacobians) const {
-  const double n = parameters[0][0];
-  const RotatedEssential& rotated =
-      RotatedEssentialOf(essential_, parameters[1]);
-  const Eigen::Matrix3d& m = rotated.m;
-  const double* focal = with_focal_ ? parameters[2] : nullptr;
-
-  double xl = match_.left_normalized[0];
-  double yl = match_.left_normalized[1];
-  double xr = match_.right_normalized[0];
-  double yr = match_.right_normalized[1];
+// The residual of `match` and its derivatives (each pointer may be null)
+// for M = R(delta) E, with dm the derivatives of M in delta (null: no
+// rotation block) and `focal` the focal scales (null: none).
+bool EvaluateMatch(const Eigen::Matrix3d& m, const Eigen::Matrix3d* dm,
+                   const PreparedCorrespondence& match, double n,
+                   const double* focal, double* residual, double* jacobian_n,
+                   double* jacobian_rotation, double* jacobian_focal) {
+  double xl = match.left_normalized[0];
+  double yl = match.left_normalized[1];
+  double xr = match.right_normalized[0];
+  double yr = match.right_normalized[1];
   double jl[4];
   double jr[4];
   for (int k = 0; k < 4; ++k) {
-    jl[k] = match_.left_normalized_from_pixel[k];
-    jr[k] = match_.right_normalized_from_pixel[k];
+    jl[k] = match.left_normalized_from_pixel[k];
+    jr[k] = match.right_normalized_from_pixel[k];
   }
   if (focal != nullptr) {
-    xl += focal[0] * match_.left_focal_direction[0];
-    yl += focal[0] * match_.left_focal_direction[1];
-    xr += focal[1] * match_.right_focal_direction[0];
-    yr += focal[1] * match_.right_focal_direction[1];
+    xl += focal[0] * match.left_focal_direction[0];
+    yl += focal[0] * match.left_focal_direction[1];
+    xr += focal[1] * match.right_focal_direction[0];
+    yr += focal[1] * match.right_focal_direction[1];
     for (int k = 0; k < 4; ++k) {
-      jl[k] += focal[0] * match_.left_normalized_from_pixel_focal[k];
-      jr[k] += focal[1] * match_.right_normalized_from_pixel_focal[k];
+      jl[k] += focal[0] * match.left_normalized_from_pixel_focal[k];
+      jr[k] += focal[1] * match.right_normalized_from_pixel_focal[k];
     }
   }
   const double excess = n * n - 1.0;
@@ -117,8 +103,7 @@ bool SampsonCoplanarityCostFunction::Evaluate(double const* const* parameters,
   if (!(g2 > 0.0)) return false;
   const double norm = std::sqrt(g2);
   const double r = e / norm;
-  residuals[0] = r;
-  if (jacobians == nullptr) return true;
+  *residual = r;
 
   // dr/dq from e' and G' (header).
   const auto derivative = [&](double de, const double* dg) {
@@ -136,7 +121,7 @@ bool SampsonCoplanarityCostFunction::Evaluate(double const* const* parameters,
           da[1] + da[2] * sr * yr + a[2] * dsr * yr, jr, dg + 2);
   };
 
-  if (jacobians[0] != nullptr) {
+  if (jacobian_n != nullptr) {
     const double dml = n * (1.0 + rho_l) / ml;
     const double dmr = n * (1.0 + rho_r) / mr;
     const double dsl = (2.0 * n - sl * dml) / ml;
@@ -145,36 +130,36 @@ bool SampsonCoplanarityCostFunction::Evaluate(double const* const* parameters,
     const Eigen::Vector3d dc = dmr * m.row(2).transpose();
     double dg[4];
     gradient_from(da, dc, dsl, dsr, dg);
-    jacobians[0][0] = derivative(dmr * a[2] + dml * c[2], dg);
+    *jacobian_n = derivative(dmr * a[2] + dml * c[2], dg);
   }
-  if (jacobians[1] != nullptr) {
+  if (dm != nullptr && jacobian_rotation != nullptr) {
     for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector3d da = rotated.dm[k] * bl;
-      const Eigen::Vector3d dc = rotated.dm[k].transpose() * br;
+      const Eigen::Vector3d da = dm[k] * bl;
+      const Eigen::Vector3d dc = dm[k].transpose() * br;
       double dg[4];
       gradient_from(da, dc, 0.0, 0.0, dg);
-      jacobians[1][k] = derivative(br.dot(da), dg);
+      jacobian_rotation[k] = derivative(br.dot(da), dg);
     }
   }
-  if (focal != nullptr && jacobians[2] != nullptr) {
+  if (focal != nullptr && jacobian_focal != nullptr) {
     {  // e_l: the left camera's coordinates, m_l, s_l and J_l move.
-      const double dxl = match_.left_focal_direction[0];
-      const double dyl = match_.left_focal_direction[1];
+      const double dxl = match.left_focal_direction[0];
+      const double dyl = match.left_focal_direction[1];
       const double dml = excess * (xl * dxl + yl * dyl) / ml;
       const double dsl = -sl * dml / ml;
       const Eigen::Vector3d da = m * Eigen::Vector3d(dxl, dyl, dml);
       double dg[4];
       double extra[2];
       Chain(c[2] * (dsl * xl + sl * dxl), c[2] * (dsl * yl + sl * dyl), jl, dg);
-      Chain(gl[0], gl[1], match_.left_normalized_from_pixel_focal, extra);
+      Chain(gl[0], gl[1], match.left_normalized_from_pixel_focal, extra);
       dg[0] += extra[0];
       dg[1] += extra[1];
       Chain(da[0] + da[2] * sr * xr, da[1] + da[2] * sr * yr, jr, dg + 2);
-      jacobians[2][0] = derivative(br.dot(da), dg);
+      jacobian_focal[0] = derivative(br.dot(da), dg);
     }
     {  // e_r: the right camera's.
-      const double dxr = match_.right_focal_direction[0];
-      const double dyr = match_.right_focal_direction[1];
+      const double dxr = match.right_focal_direction[0];
+      const double dyr = match.right_focal_direction[1];
       const double dmr = excess * (xr * dxr + yr * dyr) / mr;
       const double dsr = -sr * dmr / mr;
       const Eigen::Vector3d dbr(dxr, dyr, dmr);
@@ -184,10 +169,73 @@ bool SampsonCoplanarityCostFunction::Evaluate(double const* const* parameters,
       Chain(dc[0] + dc[2] * sl * xl, dc[1] + dc[2] * sl * yl, jl, dg);
       Chain(a[2] * (dsr * xr + sr * dxr), a[2] * (dsr * yr + sr * dyr), jr,
             dg + 2);
-      Chain(gr[0], gr[1], match_.right_normalized_from_pixel_focal, extra);
+      Chain(gr[0], gr[1], match.right_normalized_from_pixel_focal, extra);
       dg[2] += extra[0];
       dg[3] += extra[1];
-      jacobians[2][1] = derivative(dbr.dot(a), dg);
+      jacobian_focal[1] = derivative(dbr.dot(a), dg);
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+SampsonCoplanarityCostFunction::SampsonCoplanarityCostFunction(
+    const Eigen::Matrix3d& essential,
+    std::vector<PreparedCorrespondence> matches, SampsonParameters parameters,
+    RobustLoss loss, double loss_scale_px)
+    : essential_(essential),
+      matches_(std::move(matches)),
+      parameters_(parameters),
+      loss_(loss),
+      loss_scale_px_(loss_scale_px) {
+  set_num_residuals(static_cast<int>(matches_.size()));
+  mutable_parameter_block_sizes()->push_back(1);
+  if (parameters != SampsonParameters::kIndex) {
+    mutable_parameter_block_sizes()->push_back(3);
+  }
+  if (parameters == SampsonParameters::kIndexRotationFocal) {
+    mutable_parameter_block_sizes()->push_back(2);
+  }
+}
+
+bool SampsonCoplanarityCostFunction::Evaluate(double const* const* parameters,
+                                              double* residuals,
+                                              double** jacobians) const {
+  const double n = parameters[0][0];
+  const bool with_rotation = parameters_ != SampsonParameters::kIndex;
+  const bool with_focal = parameters_ == SampsonParameters::kIndexRotationFocal;
+  const RotatedEssential* rotated =
+      with_rotation ? &RotatedEssentialOf(essential_, parameters[1]) : nullptr;
+  const Eigen::Matrix3d& m = with_rotation ? rotated->m : essential_;
+  const Eigen::Matrix3d* dm = with_rotation ? rotated->dm : nullptr;
+  const double* focal = with_focal ? parameters[2] : nullptr;
+  double* jacobian_n = jacobians != nullptr ? jacobians[0] : nullptr;
+  double* jacobian_rotation =
+      jacobians != nullptr && with_rotation ? jacobians[1] : nullptr;
+  double* jacobian_focal =
+      jacobians != nullptr && with_focal ? jacobians[2] : nullptr;
+  for (size_t i = 0; i < matches_.size(); ++i) {
+    double* row_rotation =
+        jacobian_rotation != nullptr ? jacobian_rotation + 3 * i : nullptr;
+    double* row_focal =
+        jacobian_focal != nullptr ? jacobian_focal + 2 * i : nullptr;
+    double* row_n = jacobian_n != nullptr ? jacobian_n + i : nullptr;
+    if (!EvaluateMatch(m, dm, matches_[i], n, focal, residuals + i, row_n,
+                       row_rotation, row_focal)) {
+      return false;
+    }
+    if (loss_ == RobustLoss::kNone) continue;
+    double root = 0.0;
+    double slope = 0.0;
+    RobustLossRoot(loss_, loss_scale_px_, residuals[i], &root, &slope);
+    residuals[i] = root;
+    if (row_n != nullptr) *row_n *= slope;
+    if (row_rotation != nullptr) {
+      for (int k = 0; k < 3; ++k) row_rotation[k] *= slope;
+    }
+    if (row_focal != nullptr) {
+      for (int k = 0; k < 2; ++k) row_focal[k] *= slope;
     }
   }
   return true;

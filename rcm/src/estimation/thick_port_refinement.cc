@@ -327,9 +327,10 @@ StatusOr<ThickPortRefinementSummary> RefineRefractiveIndexThickPort(
   std::vector<LocusNormalEquations> per_frame;
   const Eigen::Vector3d rotation(parameters.rotation[0], parameters.rotation[1],
                                  parameters.rotation[2]);
-  AccumulateLocusNormalEquations(
-      *at, layout, raw, matches, inliers, parameters.n, rotation,
-      Eigen::Vector2d::Zero(), &equations, &per_frame);
+  AccumulateLocusNormalEquations(*at, layout, raw, matches, inliers,
+                                 parameters.n, rotation,
+                                 Eigen::Vector2d::Zero(), &equations,
+                                 &per_frame, options.base.num_threads);
   summary.consistency = FrameConsistencyOf(per_frame, summary.sigma_px);
   const double inflation =
       summary.consistency ? summary.consistency->inflation : 1.0;

@@ -277,7 +277,8 @@ struct FrameEstimateSums {
 // and the layout the calibration's. Residuals that are undefined at (n, w)
 // or at a difference step are skipped. Per-frame sums (for the consistency
 // test) go to `per_frame` when it is not null: one entry per distinct
-// raw[i].frame, in order of first appearance.
+// raw[i].frame, in order of first appearance. The rows are summed on up to
+// `num_threads` threads, in an order that does not depend on their number.
 void AccumulateLocusNormalEquations(
     const StereoRig& rig, const CalibrationParameterLayout& layout,
     const std::vector<StereoCorrespondence>& raw,
@@ -285,7 +286,8 @@ void AccumulateLocusNormalEquations(
     const std::vector<int64_t>& indices, double n,
     const Eigen::Vector3d& rotation, const Eigen::Vector2d& focal_scale,
     LocusNormalEquations* equations,
-    std::vector<LocusNormalEquations>* per_frame = nullptr);
+    std::vector<LocusNormalEquations>* per_frame = nullptr,
+    int num_threads = 1);
 
 // The self-calibration of cam1's rotation (and, with the layout's focal
 // columns, of the focal scales) on the quadratic model of `equations`

@@ -41,6 +41,20 @@ std::optional<RobustLoss> RobustLossFromName(std::string_view name);
 // rho(s) above.
 double RobustLossRho(RobustLoss loss, double scale, double squared_residual);
 
+// The loss's square root as a residual, for a cost that holds many
+// residuals in one Ceres block (sampson_coplanarity_cost_function.h):
+//
+//   psi(r) = sign(r) sqrt(rho(r^2)),   psi'(r) = rho'(r^2) r / psi(r),
+//
+// so that psi^2 = rho(r^2) and psi is smooth through r = 0 (psi'(0) = 1):
+//   kNone:   psi = r, psi' = 1;
+//   kHuber:  psi = r for |r| <= c, sign(r) sqrt(2 c |r| - c^2) beyond,
+//            where psi' = c / |psi|;
+//   kCauchy: psi = r sqrt(h), h = log(1 + x) / x, x = r^2 / c^2 (h = 1 at
+//            x = 0), psi' = 1 / ((1 + x) sqrt(h)).
+void RobustLossRoot(RobustLoss loss, double scale, double residual,
+                    double* root, double* slope);
+
 // A Gaussian prior on n: N(n, sigma^2) (medium_prior.h gives the water's).
 struct IndexPrior {
   double n = 0.0;

@@ -39,41 +39,85 @@
 //             a' = 0, e' = a . b_r', J_r' = J_re);
 //
 // g' follows by the product rule from a', c', s' and (x, y)'.
+//
+// One block may hold many matches (K residuals): Ceres' work per residual
+// block (its scratch, the checks of every value, the Jacobian's copy, the
+// loss) costs more than this residual itself, so the refinement gives it
+// blocks of kSampsonBlockMatches. A robust loss then cannot be Ceres' (it
+// applies to the whole block's squared norm): each residual is taken
+// through the loss's square root instead (RobustLossRoot,
+// refinement_options.h),
+//
+//   r~ = sign(r) sqrt(rho(r^2)),   dr~/dq = psi'(r) dr/dq,
+//
+// whose sum of squares is the robust cost Ceres would minimize, so the
+// solution and the cost reported are the same; only the Gauss-Newton
+// model of the steps toward it differs from Ceres' corrected one.
 #ifndef RCM_ESTIMATION_SAMPSON_COPLANARITY_COST_FUNCTION_H_
 #define RCM_ESTIMATION_SAMPSON_COPLANARITY_COST_FUNCTION_H_
 
 #include <ceres/cost_function.h>
 
 #include <Eigen/Core>
+#include <utility>
+#include <vector>
 
 #include "rcm/estimation/prepared_correspondence.h"
+#include "rcm/estimation/refinement_options.h"
 
 namespace rcm {
 
-// One residual; parameter blocks n (1), the rotation correction delta
-// (angle-axis in cam1's frame, 3) and, when `with_focal`, the focal scales
-// (e_l, e_r) (2). Evaluate returns false where the residual is undefined
-// (|G| = 0), as the autodiff form does; a block held constant by the
-// problem gets no Jacobian.
+// The matches per block of the batch refinement's problems: enough that
+// Ceres' work per block is small beside the residuals' (~80 ns each), few
+// enough that a frame's 200 matches still split between two threads.
+constexpr int kSampsonBlockMatches = 64;
+
+// The parameter blocks of the cost: n (1), then the rotation correction
+// delta (angle-axis in cam1's frame, 3), then the focal scales (e_l, e_r)
+// (2).
+enum class SampsonParameters { kIndex, kIndexRotation, kIndexRotationFocal };
+
+// One residual per match, in the order given, through `loss` with scale
+// `loss_scale_px` (kNone: the residual itself). Evaluate returns false
+// where a residual is undefined (|G| = 0), as the autodiff form does; a
+// block held constant by the problem gets no Jacobian.
 class SampsonCoplanarityCostFunction : public ceres::CostFunction {
  public:
   SampsonCoplanarityCostFunction(const Eigen::Matrix3d& essential,
-                                 const PreparedCorrespondence& match,
-                                 bool with_focal);
+                                 std::vector<PreparedCorrespondence> matches,
+                                 SampsonParameters parameters,
+                                 RobustLoss loss = RobustLoss::kNone,
+                                 double loss_scale_px = 1.0);
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
+  // One match, blocks n and delta [and the focal scales], no loss: the
+  // form that ceres::AutoDiffCostFunction<SampsonCoplanarityError, 1, 1, 3
+  // [, 2]> equals.
   static ceres::CostFunction* Create(const Eigen::Matrix3d& essential,
                                      const PreparedCorrespondence& match,
                                      bool with_focal) {
-    return new SampsonCoplanarityCostFunction(essential, match, with_focal);
+    return new SampsonCoplanarityCostFunction(
+        essential, {match},
+        with_focal ? SampsonParameters::kIndexRotationFocal
+                   : SampsonParameters::kIndexRotation);
+  }
+  // A block of matches.
+  static ceres::CostFunction* Create(
+      const Eigen::Matrix3d& essential,
+      std::vector<PreparedCorrespondence> matches, SampsonParameters parameters,
+      RobustLoss loss, double loss_scale_px) {
+    return new SampsonCoplanarityCostFunction(essential, std::move(matches),
+                                              parameters, loss, loss_scale_px);
   }
 
  private:
   const Eigen::Matrix3d essential_;
-  const PreparedCorrespondence match_;
-  const bool with_focal_;
+  const std::vector<PreparedCorrespondence> matches_;
+  const SampsonParameters parameters_;
+  const RobustLoss loss_;
+  const double loss_scale_px_;
 };
 
 }  // namespace rcm

@@ -152,9 +152,9 @@ bool SampsonCoplanarityResidual(const Eigen::Matrix3d& essential,
 // examples/snavely_reprojection_error.h). Parameter blocks: n (size 1) and,
 // for CreateWithRotation, the rotation correction (angle-axis, size 3), and
 // for CreateWithRotationAndFocal also the focal scales (e_l, e_r). The batch
-// refinement solves with Create (n alone); with the rotation it uses the
-// same residual with its Jacobian written out
-// (sampson_coplanarity_cost_function.h), which is tested against these two.
+// refinement solves with the same residual's Jacobian written out, many
+// matches per block (sampson_coplanarity_cost_function.h), which is tested
+// against these.
 class SampsonCoplanarityError {
  public:
   SampsonCoplanarityError(const Eigen::Matrix3d& essential,
