@@ -262,6 +262,68 @@ TEST(PreparedCorrespondence, OneSideRejectsAPixelThatDoesNotPrepare) {
       rig.right(), Eigen::Vector2d(1e9, -1e9), 1, &prepared));
 }
 
+// Near a prepared side, for each lens parameter of every test rig's
+// cameras moved by +-h (h = 1e-6 (1 + |p|), the propagation's step): the
+// central difference of what one Newton step prepares equals that of the
+// undistortion from scratch. The Newton step's own error, ~(h x')^2 ~
+// 1e-12, is the same for +h and -h to O(h^3); the difference of the two
+// over 2h leaves ~1e-12 of the derivatives (rounding ~1e-16 / h ~ 1e-10 of
+// the values dominates).
+TEST(PreparedCorrespondence, NearSideGivesTheCentralDifferencesOfTheFull) {
+  constexpr double kStepScale = 1e-6;
+  constexpr double kTolerance = 1e-8;  // relative to max(1, |derivative|)
+  for (const StereoRig& rig : TestRigs()) {
+    for (const StereoCorrespondence& match :
+         test::ExactMatches(rig, 1.333, 20)) {
+      const PreparedCorrespondence at =
+          PrepareCorrespondence(rig, match).value();
+      for (int side = 0; side < 2; ++side) {
+        const Camera& camera = side == 0 ? rig.left() : rig.right();
+        const Eigen::Vector2d& pixel =
+            side == 0 ? match.left_pixel : match.right_pixel;
+        for (int j = 0; j < camera.num_params(); ++j) {
+          const double h = kStepScale * (1.0 + std::abs(camera.params()[j]));
+          PreparedCorrespondence full[2] = {at, at};
+          PreparedCorrespondence near[2] = {at, at};
+          for (int s = 0; s < 2; ++s) {
+            std::vector<double> params(camera.params(),
+                                       camera.params() + camera.num_params());
+            params[j] += s == 0 ? h : -h;
+            const Camera moved = camera.WithParams(params.data()).value();
+            ASSERT_TRUE(
+                PrepareCorrespondenceSide(moved, pixel, side, &full[s]));
+            ASSERT_TRUE(
+                PrepareCorrespondenceSideNear(moved, pixel, side, &near[s]));
+          }
+          const auto values = [side](const PreparedCorrespondence& p) {
+            std::vector<double> v;
+            const double* normalized =
+                side == 0 ? p.left_normalized : p.right_normalized;
+            const double* jacobian = side == 0 ? p.left_normalized_from_pixel
+                                               : p.right_normalized_from_pixel;
+            const double* focal =
+                side == 0 ? p.left_focal_direction : p.right_focal_direction;
+            v.insert(v.end(), normalized, normalized + 2);
+            v.insert(v.end(), jacobian, jacobian + 4);
+            v.insert(v.end(), focal, focal + 2);
+            return v;
+          };
+          const std::vector<double> full_plus = values(full[0]);
+          const std::vector<double> full_minus = values(full[1]);
+          const std::vector<double> near_plus = values(near[0]);
+          const std::vector<double> near_minus = values(near[1]);
+          for (size_t k = 0; k < full_plus.size(); ++k) {
+            const double expected = (full_plus[k] - full_minus[k]) / (2 * h);
+            EXPECT_NEAR((near_plus[k] - near_minus[k]) / (2 * h), expected,
+                        kTolerance * std::max(1.0, std::abs(expected)))
+                << "side " << side << " parameter " << j << " value " << k;
+          }
+        }
+      }
+    }
+  }
+}
+
 // The focal derivatives with the stepped rigs made once are those made per
 // match.
 TEST(PreparedCorrespondence, FocalStepRigsMadeOnceGiveTheSameDerivatives) {

@@ -161,6 +161,13 @@ class LocusResidualModel {
 
   bool Residual(const PreparedCorrespondence& match, double n, double* r,
                 double* dr_dn) const {
+    if (dr_dn == nullptr) {
+      const bool ok = thick_ ? GeneralizedEpipolarResidual<double>(
+                                   stereo_, match, n, 0.0, r)
+                             : SampsonCoplanarityResidual<double>(
+                                   essential_, match, n, nullptr, r);
+      return ok && std::isfinite(*r);
+    }
     using Jet = ceres::Jet<double, 1>;
     Jet residual;
     const bool ok = thick_
@@ -302,7 +309,7 @@ void AccumulateLocusNormalEquations(
           PreparedCorrespondence prepared = match;
           defined =
               moved_camera.has_value() &&
-              PrepareCorrespondenceSide(
+              PrepareCorrespondenceSideNear(
                   *moved_camera,
                   lens[j].side == 0 ? raw[i].left_pixel : raw[i].right_pixel,
                   lens[j].side, &prepared) &&

@@ -24,11 +24,11 @@ bool NormalizedFromPixelJacobian(const Camera& camera,
   return true;
 }
 
-}  // namespace
-
-bool PrepareCorrespondenceSide(const Camera& camera,
-                               const Eigen::Vector2d& pixel, int side,
-                               PreparedCorrespondence* prepared) {
+// The side's fields of `prepared` from its normalized point `point` (the
+// pixel's under `camera`); false where the lens map folds there.
+bool PrepareSideAt(const Camera& camera, const Eigen::Vector2d& pixel,
+                   const Eigen::Vector2d& point, int side,
+                   PreparedCorrespondence* prepared) {
   double* normalized =
       side == 0 ? prepared->left_normalized : prepared->right_normalized;
   double* normalized_from_pixel = side == 0
@@ -39,12 +39,6 @@ bool PrepareCorrespondenceSide(const Camera& camera,
   double* normalized_from_pixel_focal =
       side == 0 ? prepared->left_normalized_from_pixel_focal
                 : prepared->right_normalized_from_pixel_focal;
-  Eigen::Vector2d point;
-  if (!pixel.allFinite() ||
-      !camera.NormalizedFromImage(pixel.data(), point.data()) ||
-      !point.allFinite()) {
-    return false;
-  }
   double jacobian[4];
   if (!NormalizedFromPixelJacobian(camera, point, jacobian)) return false;
   normalized[0] = point.x();
@@ -59,6 +53,37 @@ bool PrepareCorrespondenceSide(const Camera& camera,
     normalized_from_pixel_focal[k] = -jacobian[k];
   }
   return true;
+}
+
+}  // namespace
+
+bool PrepareCorrespondenceSide(const Camera& camera,
+                               const Eigen::Vector2d& pixel, int side,
+                               PreparedCorrespondence* prepared) {
+  Eigen::Vector2d point;
+  if (!pixel.allFinite() ||
+      !camera.NormalizedFromImage(pixel.data(), point.data()) ||
+      !point.allFinite()) {
+    return false;
+  }
+  return PrepareSideAt(camera, pixel, point, side, prepared);
+}
+
+bool PrepareCorrespondenceSideNear(const Camera& camera,
+                                   const Eigen::Vector2d& pixel, int side,
+                                   PreparedCorrespondence* prepared) {
+  const double* start =
+      side == 0 ? prepared->left_normalized : prepared->right_normalized;
+  const Eigen::Vector2d near(start[0], start[1]);
+  if (!pixel.allFinite() || !near.allFinite()) return false;
+  // x_1 = x_0 + (d pixel / d x)^-1 (pixel - pixel(x_0)).
+  const Eigen::Matrix2d forward = camera.ImageFromNormalizedJacobian(near);
+  const double determinant = forward.determinant();
+  if (!(determinant > 0.0) || !std::isfinite(determinant)) return false;
+  const Eigen::Vector2d point =
+      near + forward.inverse() * (pixel - camera.ImageFromNormalized(near));
+  if (!point.allFinite()) return false;
+  return PrepareSideAt(camera, pixel, point, side, prepared);
 }
 
 std::optional<PreparedCorrespondence> PrepareCorrespondence(

@@ -54,6 +54,19 @@ bool PrepareCorrespondenceSide(const Camera& camera,
                                const Eigen::Vector2d& pixel, int side,
                                PreparedCorrespondence* prepared);
 
+// The same for a camera whose lens differs by a small step h from the one
+// `prepared`'s side was made with (the propagation's central differences):
+// one Newton step from that side's normalized point x_0,
+//
+//   x_1 = x_0 + (d pixel / d x)^-1 (pixel - pixel(x_0)),
+//
+// instead of the undistortion from scratch. Its error is the Newton step's,
+// quadratic in x - x_0 = +-h x' + O(h^2): the same for +h and -h to O(h^3),
+// so a central difference of what it prepares keeps its O(h^2) error.
+bool PrepareCorrespondenceSideNear(const Camera& camera,
+                                   const Eigen::Vector2d& pixel, int side,
+                                   PreparedCorrespondence* prepared);
+
 // The derivatives in e of `prepared`'s inverse lens Jacobians for any lens
 // model, by central differences of the preparation on `rig` with the focal
 // lengths scaled by 1 +- kFocalStep (the undistortion converges to ~1e-14,
