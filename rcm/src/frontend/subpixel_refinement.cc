@@ -1,9 +1,9 @@
 #include "rcm/frontend/subpixel_refinement.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
-#include <Eigen/Core>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
@@ -110,11 +110,10 @@ bool RefineOne(const LeftImage& left_image, const cv::Mat& right,
   // per pixel of the window.
   const Eigen::Matrix2d translation_block =
       hessian.topLeftCorner<2, 2>().selfadjointView<Eigen::Upper>();
-  const double weakest =
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(translation_block,
-                                                     Eigen::EigenvaluesOnly)
-          .eigenvalues()[0] /
-      size;
+  const double weakest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(
+                             translation_block, Eigen::EigenvaluesOnly)
+                             .eigenvalues()[0] /
+                         size;
   if (!(weakest >= options.min_texture)) return false;
   const Eigen::LDLT<Matrix6> solver(hessian.selfadjointView<Eigen::Upper>());
   const Eigen::LDLT<Eigen::Matrix2d> translation_solver(translation_block);
@@ -135,7 +134,8 @@ bool RefineOne(const LeftImage& left_image, const cv::Mat& right,
     for (int v = -half, k = 0; v <= half; ++v) {
       for (int u = -half; u <= half; ++u, ++k) {
         buffers->warped[k] = Bilinear(
-            right, static_cast<float>(warp(0, 0) * u + warp(0, 1) * v + warp(0, 2)),
+            right,
+            static_cast<float>(warp(0, 0) * u + warp(0, 1) * v + warp(0, 2)),
             static_cast<float>(warp(1, 0) * u + warp(1, 1) * v + warp(1, 2)));
       }
     }
@@ -253,21 +253,26 @@ void RefineRightPixels(const cv::Mat& left_gray, const cv::Mat& right_gray,
             cv::BORDER_REPLICATE);
   cv::Sobel(left_image.image, left_image.dy, CV_32F, 0, 1, 1, 0.5, 0.0,
             cv::BORDER_REPLICATE);
-  // About 20 us per match: below ~100 matches one thread is faster.
+  // About 20 us per match: below ~100 matches one thread is faster. The
+  // matches go in chunks of 32 to whichever thread is free (the decoder of
+  // the next pair shares the cores).
   constexpr int64_t kMinMatchesPerThread = 64;
-  ParallelFor(static_cast<int64_t>(left.size()), options.num_threads,
-              kMinMatchesPerThread, [&](int64_t begin, int64_t end) {
-                Buffers buffers;
-                for (int64_t i = begin; i < end; ++i) {
-                  cv::Point2f refined = (*right)[i];
-                  if (RefineOne(left_image, right_float, left[i], &refined,
-                                options, &buffers)) {
-                    (*right)[i] = refined;
-                  } else {
-                    (*kept)[i] = 0;
-                  }
-                }
-              });
+  constexpr int64_t kMatchesPerChunk = 32;
+  const int64_t count = static_cast<int64_t>(left.size());
+  ParallelForChunks(count,
+                    count >= 2 * kMinMatchesPerThread ? options.num_threads : 1,
+                    kMatchesPerChunk, [&](int64_t begin, int64_t end) {
+                      Buffers buffers;
+                      for (int64_t i = begin; i < end; ++i) {
+                        cv::Point2f refined = (*right)[i];
+                        if (RefineOne(left_image, right_float, left[i],
+                                      &refined, options, &buffers)) {
+                          (*right)[i] = refined;
+                        } else {
+                          (*kept)[i] = 0;
+                        }
+                      }
+                    });
 }
 
 }  // namespace rcm
