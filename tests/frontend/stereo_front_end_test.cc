@@ -345,6 +345,57 @@ TEST(StereoFrontEnd, SameMatchesOnOneAndTwoThreads) {
   }
 }
 
+// Detection apart (StereoDetector, on one thread or two) then Match of the
+// detected pair gives the matches of Match on the images, to the bit, in
+// the prior band and guided.
+TEST(StereoFrontEnd, DetectedPairGivesTheSameMatches) {
+  const StereoRig rig = AlphasenseFrontUnrectifiedRig();
+  const SequenceFrame frame =
+      Simulator(rig, {MediaSegment{1.345, 1}})->Frame(0).value();
+  const StereoFrontEndOptions options;
+  StereoDetector detector = StereoDetector::Create(options).value();
+  const RefractiveIndexInterval guide{1.335, 1.355};
+  for (const std::optional<RefractiveIndexInterval>& band :
+       {std::optional<RefractiveIndexInterval>(),
+        std::optional<RefractiveIndexInterval>(guide)}) {
+    const StereoMatches whole =
+        StereoFrontEnd::Create(rig, options)
+            .value()
+            .Match(frame.left, frame.right, 3, 0.5, band)
+            .value();
+    ASSERT_GT(whole.matches.size(), 600u);
+    for (const int threads : {1, 2}) {
+      const DetectedStereoPair detected =
+          detector.Detect(frame.left, frame.right, threads).value();
+      const StereoMatches apart = StereoFrontEnd::Create(rig, options)
+                                      .value()
+                                      .Match(detected, 3, 0.5, band)
+                                      .value();
+      EXPECT_EQ(apart.left_keypoints, whole.left_keypoints);
+      EXPECT_EQ(apart.right_keypoints, whole.right_keypoints);
+      EXPECT_EQ(apart.descriptor_matches, whole.descriptor_matches);
+      ASSERT_EQ(apart.matches.size(), whole.matches.size());
+      for (size_t i = 0; i < whole.matches.size(); ++i) {
+        EXPECT_EQ(apart.matches[i].left_pixel, whole.matches[i].left_pixel);
+        EXPECT_EQ(apart.matches[i].right_pixel, whole.matches[i].right_pixel);
+        EXPECT_EQ(apart.matches[i].frame, 3);
+        EXPECT_EQ(apart.matches[i].timestamp, 0.5);
+      }
+    }
+  }
+  // A detected pair of another size than the calibration's is refused as
+  // the images are.
+  const cv::Mat small(480, 640, CV_8UC1, cv::Scalar(90));
+  EXPECT_EQ(StereoFrontEnd::Create(rig, options)
+                .value()
+                .Match(detector.Detect(small, small, 1).value())
+                .status()
+                .message(),
+            "images are 640 x 480 but the calibration is for 720 x 540 "
+            "(left) and 720 x 540 (right)");
+  EXPECT_FALSE(detector.Detect(cv::Mat(), small, 1).ok());
+}
+
 // max_refined_matches: every k-th descriptor match is refined, each to
 // exactly the pixel the full run refines it to (refinement is per match),
 // and the rest are not.

@@ -68,6 +68,47 @@ TEST(SequenceEstimator, TheLivePipelineRunsIt) {
   EXPECT_TRUE(sequence->frames().empty());  // the live options keep none
 }
 
+// A pair detected apart (as EstimateSequence detects the next pair while
+// this one is added) then added is the pair added whole: the same matches
+// to the bit, pair after pair, and the same estimates (1e-12 allows the
+// order of the solver's sums on two threads).
+TEST(SequenceEstimator, DetectedPairsAreThePairsAddedWhole) {
+  constexpr double kSameRun = 1e-12;
+  std::unique_ptr<SequenceSimulator> simulator = Sequence({{kWater, 3}});
+  const SequenceEstimatorOptions options;
+  std::unique_ptr<SequenceEstimator> whole =
+      SequenceEstimator::Create(RigAsRead(), options).value();
+  std::unique_ptr<SequenceEstimator> apart =
+      SequenceEstimator::Create(RigAsRead(), options).value();
+  for (int i = 0; i < simulator->num_frames(); ++i) {
+    const SequenceFrame frame = simulator->Frame(i).value();
+    const StatusOr<SequencePair> a =
+        whole->AddPair(frame.left, frame.right, i, frame.t);
+    const StatusOr<DetectedStereoPair> detected =
+        apart->Detect(frame.left, frame.right, 1);
+    ASSERT_TRUE(detected.ok()) << detected.status().message();
+    const StatusOr<SequencePair> b =
+        apart->AddDetectedPair(*detected, i, frame.t);
+    ASSERT_TRUE(a.ok()) << a.status().message();
+    ASSERT_TRUE(b.ok()) << b.status().message();
+    ASSERT_EQ(a->matches.size(), b->matches.size());
+    for (size_t k = 0; k < a->matches.size(); ++k) {
+      EXPECT_EQ(a->matches[k].left_pixel, b->matches[k].left_pixel);
+      EXPECT_EQ(a->matches[k].right_pixel, b->matches[k].right_pixel);
+    }
+    ASSERT_EQ(a->own.ok(), b->own.ok());
+    if (a->own.ok()) EXPECT_NEAR(a->own->n, b->own->n, kSameRun) << i;
+    ASSERT_EQ(a->window.ok(), b->window.ok());
+    if (a->window.ok()) EXPECT_NEAR(a->window->n, b->window->n, kSameRun);
+  }
+  const StatusOr<RefractiveIndexEstimate> a = whole->Estimate();
+  const StatusOr<RefractiveIndexEstimate> b = apart->Estimate();
+  ASSERT_TRUE(a.ok()) << a.status().message();
+  ASSERT_TRUE(b.ok()) << b.status().message();
+  EXPECT_NEAR(a->n, b->n, kSameRun);
+  EXPECT_NEAR(a->sigma_n, b->sigma_n, kSameRun);
+}
+
 // cam1 turned by 0.4 degrees since the calibration (4 drift-prior sigmas):
 // the window self-calibrates the turn, the front end follows it, and the
 // final estimate (solved once, over every kept pair) names the stale

@@ -1,5 +1,6 @@
 #include "rcm/frontend/stereo_front_end.h"
 
+#include <algorithm>
 #include <chrono>
 #include <sstream>
 #include <utility>
@@ -44,6 +45,21 @@ ImageFeatures DetectImage(const cv::Mat& image, const ClaheOptions& clahe,
   return out;
 }
 
+// Images of the size the rig is calibrated for.
+Status CheckCalibratedSize(const StereoRig& rig, const cv::Mat& left,
+                           const cv::Mat& right) {
+  if (left.cols == rig.left().width() && left.rows == rig.left().height() &&
+      right.cols == rig.right().width() && right.rows == rig.right().height()) {
+    return Status::Ok();
+  }
+  std::ostringstream message;
+  message << "images are " << left.cols << " x " << left.rows
+          << " but the calibration is for " << rig.left().width() << " x "
+          << rig.left().height() << " (left) and " << rig.right().width()
+          << " x " << rig.right().height() << " (right)";
+  return Status::Error(message.str());
+}
+
 // Stage 3 in the band of one interval, with what verification reuses.
 struct BandMatches {
   LocusBand band;
@@ -74,14 +90,45 @@ Status StereoFrontEndOptions::Check() const {
   return Status::Ok();
 }
 
-StatusOr<StereoFrontEnd> StereoFrontEnd::Create(
-    const StereoRig& rig, const StereoFrontEndOptions& options) {
+StatusOr<StereoDetector> StereoDetector::Create(
+    const StereoFrontEndOptions& options) {
   RCM_RETURN_IF_ERROR(options.Check());
   StatusOr<FeatureDetector> left = FeatureDetector::Create(options.features);
   RCM_RETURN_IF_ERROR(left.status());
   StatusOr<FeatureDetector> right = FeatureDetector::Create(options.features);
   RCM_RETURN_IF_ERROR(right.status());
-  return StereoFrontEnd(rig, options, std::move(*left), std::move(*right));
+  return StereoDetector(options.clahe, std::move(*left), std::move(*right));
+}
+
+StatusOr<DetectedStereoPair> StereoDetector::Detect(const cv::Mat& left,
+                                                    const cv::Mat& right,
+                                                    int num_threads) {
+  RCM_RETURN_IF_ERROR(CheckStereoImages(left, right));
+  // Stages 1-2, the two images at once.
+  ImageFeatures sides[2];
+  const cv::Mat* images[2] = {&left, &right};
+  FeatureDetector* detectors[2] = {&left_, &right_};
+  ParallelFor(2, num_threads, 1, [&](int64_t first, int64_t last) {
+    for (int64_t side = first; side < last; ++side) {
+      sides[side] = DetectImage(*images[side], clahe_, detectors[side]);
+    }
+  });
+  DetectedStereoPair detected;
+  for (int side = 0; side < 2; ++side) {
+    detected.gray[side] = std::move(sides[side].gray);
+    detected.features[side] = std::move(sides[side].features);
+  }
+  detected.preprocess_ms =
+      std::max(sides[0].preprocess_ms, sides[1].preprocess_ms);
+  detected.detect_ms = std::max(sides[0].detect_ms, sides[1].detect_ms);
+  return detected;
+}
+
+StatusOr<StereoFrontEnd> StereoFrontEnd::Create(
+    const StereoRig& rig, const StereoFrontEndOptions& options) {
+  StatusOr<StereoDetector> detector = StereoDetector::Create(options);
+  RCM_RETURN_IF_ERROR(detector.status());
+  return StereoFrontEnd(rig, options, std::move(*detector));
 }
 
 StatusOr<StereoMatches> StereoFrontEnd::Match(
@@ -90,33 +137,30 @@ StatusOr<StereoMatches> StereoFrontEnd::Match(
     const std::optional<RefractiveIndexInterval>& guide) {
   const Clock::time_point start = Clock::now();
   RCM_RETURN_IF_ERROR(CheckStereoImages(left, right));
-  if (left.cols != rig_.left().width() || left.rows != rig_.left().height() ||
-      right.cols != rig_.right().width() ||
-      right.rows != rig_.right().height()) {
-    std::ostringstream message;
-    message << "images are " << left.cols << " x " << left.rows
-            << " but the calibration is for " << rig_.left().width() << " x "
-            << rig_.left().height() << " (left) and " << rig_.right().width()
-            << " x " << rig_.right().height() << " (right)";
-    return Status::Error(message.str());
-  }
-  if (guide) RCM_RETURN_IF_ERROR(guide->Check().WithContext("guide"));
+  RCM_RETURN_IF_ERROR(CheckCalibratedSize(rig_, left, right));
+  StatusOr<DetectedStereoPair> detected =
+      detector_.Detect(left, right, options_.num_threads);
+  RCM_RETURN_IF_ERROR(detected.status());
+  StatusOr<StereoMatches> matched = Match(*detected, frame, timestamp, guide);
+  if (matched.ok()) matched->timings.total_ms = MillisecondsSince(start);
+  return matched;
+}
 
-  // Stages 1-2, the two images at once.
-  ImageFeatures sides[2];
-  const cv::Mat* images[2] = {&left, &right};
-  FeatureDetector* detectors[2] = {&left_detector_, &right_detector_};
-  ParallelFor(2, options_.num_threads, 1, [&](int64_t first, int64_t last) {
-    for (int64_t side = first; side < last; ++side) {
-      sides[side] = DetectImage(*images[side], options_.clahe, detectors[side]);
-    }
-  });
+StatusOr<StereoMatches> StereoFrontEnd::Match(
+    const DetectedStereoPair& detected, int64_t frame,
+    std::optional<double> timestamp,
+    const std::optional<RefractiveIndexInterval>& guide) {
+  const Clock::time_point start = Clock::now();
+  const cv::Mat& left = detected.gray[0];
+  const cv::Mat& right = detected.gray[1];
+  RCM_RETURN_IF_ERROR(CheckCalibratedSize(rig_, left, right));
+  if (guide) RCM_RETURN_IF_ERROR(guide->Check().WithContext("guide"));
+  const Features* features = detected.features;
   StereoMatches result;
-  result.left_keypoints = static_cast<int>(sides[0].features.keypoints.size());
-  result.right_keypoints = static_cast<int>(sides[1].features.keypoints.size());
-  result.timings.preprocess_ms =
-      std::max(sides[0].preprocess_ms, sides[1].preprocess_ms);
-  result.timings.detect_ms = std::max(sides[0].detect_ms, sides[1].detect_ms);
+  result.left_keypoints = static_cast<int>(features[0].keypoints.size());
+  result.right_keypoints = static_cast<int>(features[1].keypoints.size());
+  result.timings.preprocess_ms = detected.preprocess_ms;
+  result.timings.detect_ms = detected.detect_ms;
 
   // Stage 3 in a band; the band's keys are cheap (one undistortion per
   // keypoint) next to detection.
@@ -125,13 +169,12 @@ StatusOr<StereoMatches> StereoFrontEnd::Match(
       [&](const RefractiveIndexInterval& interval) -> StatusOr<BandMatches> {
     StatusOr<LocusBand> band = LocusBand::Create(rig_, interval, options_.band);
     RCM_RETURN_IF_ERROR(band.status());
-    std::vector<LocusKey> left_keys =
-        band->LeftKeys(sides[0].features.keypoints);
+    std::vector<LocusKey> left_keys = band->LeftKeys(features[0].keypoints);
     const std::vector<LocusKey> right_keys =
-        band->RightKeys(sides[1].features.keypoints);
+        band->RightKeys(features[1].keypoints);
     std::vector<KeypointMatch> matches =
-        MatchInLocusBand(sides[0].features, left_keys, sides[1].features,
-                         right_keys, *band, options_.matching);
+        MatchInLocusBand(features[0], left_keys, features[1], right_keys, *band,
+                         options_.matching);
     return BandMatches{std::move(*band), std::move(left_keys),
                        std::move(matches)};
   };
@@ -173,12 +216,12 @@ StatusOr<StereoMatches> StereoFrontEnd::Match(
   left_points.reserve(descriptor_matches.size());
   right_points.reserve(descriptor_matches.size());
   for (const KeypointMatch& match : descriptor_matches) {
-    left_points.push_back(sides[0].features.keypoints[match.left].pt);
-    right_points.push_back(sides[1].features.keypoints[match.right].pt);
+    left_points.push_back(features[0].keypoints[match.left].pt);
+    right_points.push_back(features[1].keypoints[match.right].pt);
   }
   std::vector<unsigned char> kept;
-  RefineRightPixels(sides[0].gray, sides[1].gray, left_points, &right_points,
-                    &kept, options_.subpixel);
+  RefineRightPixels(left, right, left_points, &right_points, &kept,
+                    options_.subpixel);
   result.matches.reserve(left_points.size());
   for (size_t i = 0; i < left_points.size(); ++i) {
     if (!kept[i]) continue;

@@ -79,6 +79,9 @@ Status SequenceEstimatorOptions::Check() const {
 StatusOr<std::unique_ptr<SequenceEstimator>> SequenceEstimator::Create(
     const StereoRig& rig, const SequenceEstimatorOptions& options) {
   RCM_RETURN_IF_ERROR(options.Check());
+  StatusOr<StereoDetector> detector =
+      StereoDetector::Create(options.FrontEnd());
+  if (!detector.ok()) return detector.status();
   StatusOr<StereoFrontEnd> front_end =
       StereoFrontEnd::Create(rig, options.FrontEnd());
   if (!front_end.ok()) return front_end.status();
@@ -86,15 +89,18 @@ StatusOr<std::unique_ptr<SequenceEstimator>> SequenceEstimator::Create(
       SlidingWindowRefractiveIndexEstimator::Create(
           rig, options.WindowRefinement(), options.estimation.window);
   if (!window.ok()) return window.status();
-  return std::unique_ptr<SequenceEstimator>(new SequenceEstimator(
-      rig, options, std::move(*front_end), std::move(*window)));
+  return std::unique_ptr<SequenceEstimator>(
+      new SequenceEstimator(rig, options, std::move(*detector),
+                            std::move(*front_end), std::move(*window)));
 }
 
 SequenceEstimator::SequenceEstimator(
     const StereoRig& rig, const SequenceEstimatorOptions& options,
-    StereoFrontEnd front_end, SlidingWindowRefractiveIndexEstimator window)
+    StereoDetector detector, StereoFrontEnd front_end,
+    SlidingWindowRefractiveIndexEstimator window)
     : rig_(rig),
       options_(options),
+      detector_(std::move(detector)),
       front_end_(std::move(front_end)),
       window_(std::move(window)) {}
 
@@ -130,9 +136,29 @@ Status SequenceEstimator::Restart(const Eigen::Vector3d& rotation) {
 StatusOr<SequencePair> SequenceEstimator::AddPair(
     const cv::Mat& left, const cv::Mat& right, int64_t frame,
     std::optional<double> timestamp) {
+  const auto start = std::chrono::steady_clock::now();
+  StatusOr<DetectedStereoPair> detected =
+      Detect(left, right, options_.FrontEnd().num_threads);
+  if (!detected.ok()) return detected.status();
+  const double detect_ms = SequenceMilliseconds(start);
+  StatusOr<SequencePair> pair = AddDetectedPair(*detected, frame, timestamp);
+  // The front end's whole time: stages 1-2 here, 3-5 in AddDetectedPair.
+  if (pair.ok()) pair->timings.total_ms += detect_ms;
+  return pair;
+}
+
+StatusOr<DetectedStereoPair> SequenceEstimator::Detect(const cv::Mat& left,
+                                                       const cv::Mat& right,
+                                                       int num_threads) {
+  return detector_.Detect(left, right, num_threads);
+}
+
+StatusOr<SequencePair> SequenceEstimator::AddDetectedPair(
+    const DetectedStereoPair& detected, int64_t frame,
+    std::optional<double> timestamp) {
   // 1. Matches within the guide's band.
   StatusOr<StereoMatches> matched =
-      front_end_.Match(left, right, frame, timestamp, guide_);
+      front_end_.Match(detected, frame, timestamp, guide_);
   if (!matched.ok()) return matched.status();
   if (!any_pair_) {
     first_ = followed_;
@@ -247,17 +273,24 @@ StatusOr<SequenceRun> EstimateSequence(const StereoRig& rig,
     run = SequenceRun();
     run.passes = pass;
     const auto start = std::chrono::steady_clock::now();
-    // The next pair is decoded on another thread while this one is matched
-    // and estimated (one read at a time: the source is read in order, never
-    // by two threads at once).
+    // The next pair is decoded and detected (the front end's stages 1-2,
+    // which do not depend on the guide) on another thread while this one is
+    // matched and estimated: one read at a time, the source read in order,
+    // never by two threads at once; one thread for the detection, the
+    // matching has the others.
     struct Read {
       StatusOr<StereoImagePair> images = Status::Error("not read");
+      StatusOr<DetectedStereoPair> detected = Status::Error("not detected");
       double ms = 0.0;
     };
-    const auto read = [source](size_t i) {
+    const auto read = [source, &sequence](size_t i) {
       const auto read_start = std::chrono::steady_clock::now();
-      Read result{source->ReadPair(i), 0.0};
+      Read result{source->ReadPair(i), Status::Error("not detected"), 0.0};
       result.ms = SequenceMilliseconds(read_start);
+      if (result.images.ok()) {
+        result.detected =
+            sequence.Detect(result.images->left, result.images->right, 1);
+      }
       return result;
     };
     std::future<Read> next;
@@ -268,8 +301,11 @@ StatusOr<SequenceRun> EstimateSequence(const StereoRig& rig,
       if (i + 1 < pairs) next = std::async(std::launch::async, read, i + 1);
       run.read_ms += current.ms;
       const StereoImagePair& images = *current.images;
-      StatusOr<SequencePair> pair = sequence.AddPair(
-          images.left, images.right, images.frame, images.timestamp);
+      StatusOr<SequencePair> pair =
+          current.detected.ok()
+              ? sequence.AddDetectedPair(*current.detected, images.frame,
+                                         images.timestamp)
+              : StatusOr<SequencePair>(current.detected.status());
       if (!pair.ok()) {
         return pair.status().WithContext(images.left_name + " and " +
                                          images.right_name);

@@ -9,7 +9,11 @@
 //                   (at most max_refined_matches of them)
 //   5. verify       refined pairs still in the band  (locus_band.h)
 //
-// Stages 1-2 (and the band keys) run on the two images at once. The band
+// Stages 1-2 (and the band keys) run on the two images at once. Stages 1-2
+// depend on the images and the options alone, not on the rig or n:
+// StereoDetector runs them apart (a sequence detects the next pair while
+// this one is matched and estimated, sequence_estimator.h), and Match takes
+// their result. The band
 // is the prior search range until an estimate exists; a caller that has
 // one (n, sigma_n) passes RefractiveIndexInterval::Around(...) as the
 // guide, which narrows the band to the locus of the current estimate plus
@@ -101,6 +105,38 @@ struct StereoMatches {
   FrontEndTimings timings;
 };
 
+// Stages 1-2 of one stereo pair: each image preprocessed (gray, CLAHE) and
+// its features.
+struct DetectedStereoPair {
+  cv::Mat gray[2];  // left, right
+  Features features[2];
+  double preprocess_ms = 0.0;  // wall clock, the slower image's
+  double detect_ms = 0.0;
+};
+
+// Stages 1-2 of the front end, with their own detectors: one Detect at a
+// time per object (OpenCV's detectors keep state), on any thread.
+class StereoDetector {
+ public:
+  // Errors: options.Check().
+  static StatusOr<StereoDetector> Create(const StereoFrontEndOptions& options);
+
+  // The two images checked (CheckStereoImages), preprocessed and detected,
+  // on up to `num_threads` threads (2: the two images at once); the
+  // features do not depend on the threads.
+  StatusOr<DetectedStereoPair> Detect(const cv::Mat& left, const cv::Mat& right,
+                                      int num_threads);
+
+ private:
+  StereoDetector(const ClaheOptions& clahe, FeatureDetector left,
+                 FeatureDetector right)
+      : clahe_(clahe), left_(std::move(left)), right_(std::move(right)) {}
+
+  ClaheOptions clahe_;
+  FeatureDetector left_;
+  FeatureDetector right_;
+};
+
 class StereoFrontEnd {
  public:
   // Errors: options.Check().
@@ -116,20 +152,24 @@ class StereoFrontEnd {
       std::optional<double> timestamp = std::nullopt,
       const std::optional<RefractiveIndexInterval>& guide = std::nullopt);
 
+  // Stages 3-5 of a pair detected by a StereoDetector with these options
+  // (Match above is Detect, then this): the same matches. Errors: images
+  // whose size differs from the rig's calibration, guide->Check().
+  StatusOr<StereoMatches> Match(
+      const DetectedStereoPair& detected, int64_t frame = 0,
+      std::optional<double> timestamp = std::nullopt,
+      const std::optional<RefractiveIndexInterval>& guide = std::nullopt);
+
   const StereoFrontEndOptions& options() const { return options_; }
 
  private:
   StereoFrontEnd(const StereoRig& rig, const StereoFrontEndOptions& options,
-                 FeatureDetector left_detector, FeatureDetector right_detector)
-      : rig_(rig),
-        options_(options),
-        left_detector_(std::move(left_detector)),
-        right_detector_(std::move(right_detector)) {}
+                 StereoDetector detector)
+      : rig_(rig), options_(options), detector_(std::move(detector)) {}
 
   StereoRig rig_;
   StereoFrontEndOptions options_;
-  FeatureDetector left_detector_;
-  FeatureDetector right_detector_;
+  StereoDetector detector_;
   // Matches of the last frame matched with the prior search range.
   int prior_band_matches_ = -1;
 };

@@ -130,6 +130,18 @@ class SequenceEstimator {
                                  int64_t frame,
                                  std::optional<double> timestamp = {});
 
+  // AddPair in two steps, for a caller that detects the next pair while
+  // this one is added (EstimateSequence does): Detect runs the front end's
+  // stages 1-2 with the sequence's own detectors, on `num_threads`
+  // threads; it may run on another thread while AddDetectedPair runs, one
+  // Detect at a time. AddDetectedPair(Detect(l, r, k), ...) is
+  // AddPair(l, r, ...), to the bit. Errors: as AddPair's.
+  StatusOr<DetectedStereoPair> Detect(const cv::Mat& left, const cv::Mat& right,
+                                      int num_threads);
+  StatusOr<SequencePair> AddDetectedPair(const DetectedStereoPair& detected,
+                                         int64_t frame,
+                                         std::optional<double> timestamp = {});
+
   // The final estimate (above), with its warnings. Errors: the
   // estimator's (too few matches, n not observable, ...).
   StatusOr<RefractiveIndexEstimate> Estimate() const;
@@ -159,11 +171,14 @@ class SequenceEstimator {
  private:
   SequenceEstimator(const StereoRig& rig,
                     const SequenceEstimatorOptions& options,
-                    StereoFrontEnd front_end,
+                    StereoDetector detector, StereoFrontEnd front_end,
                     SlidingWindowRefractiveIndexEstimator window);
 
   StereoRig rig_;
   SequenceEstimatorOptions options_;
+  // Stages 1-2, never rebuilt (they do not depend on the rig): Detect may
+  // use them while AddDetectedPair rebuilds front_end_ to follow cam1.
+  StereoDetector detector_;
   StereoFrontEnd front_end_;
   SlidingWindowRefractiveIndexEstimator window_;
   std::optional<RefractiveIndexInterval> guide_;
@@ -206,9 +221,11 @@ using SequenceProgress =
     std::function<void(int pass, size_t done, size_t total,
                        const StereoImagePair& images, const SequencePair&)>;
 
-// Errors: a pair that cannot be read or matched (with its file names);
-// options' and the rig's as Create. An estimate that fails is
-// SequenceRun::estimate's error.
+// The pairs of `source` through one SequenceEstimator, in order, and its
+// final estimate; the next pair is read and detected (Detect, one thread)
+// on another thread while this one is added. Errors: a pair that cannot be
+// read or matched (with its file names); options' and the rig's as Create.
+// An estimate that fails is SequenceRun::estimate's error.
 StatusOr<SequenceRun> EstimateSequence(const StereoRig& rig,
                                        StereoImageSource* source,
                                        const SequenceEstimatorOptions& options,
