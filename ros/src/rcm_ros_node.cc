@@ -128,6 +128,7 @@ StatusOr<NodeOptions> ReadOptions(const ros::NodeHandle& nh) {
   p.window_matches = Param(nh, "window_matches", p.window_matches);
   p.map_update_threshold =
       Param(nh, "map_update_threshold", p.map_update_threshold);
+  p.map_update_sigmas = Param(nh, "map_update_sigmas", p.map_update_sigmas);
   p.initial_n = Param(nh, "initial_n", p.initial_n);
   p.min_contrast = Param(nh, "min_contrast", p.min_contrast);
   p.correction.rectify = Param(nh, "rectify", p.correction.rectify);

@@ -95,6 +95,10 @@ Status LivePipelineOptions::Check() const {
         "the map update threshold must be positive and finite, not " +
         FormatDouble(map_update_threshold));
   }
+  if (!(map_update_sigmas >= 0.0) || !std::isfinite(map_update_sigmas)) {
+    return Status::Error("the map update sigmas must be >= 0 and finite, not " +
+                         FormatDouble(map_update_sigmas));
+  }
   if (window_matches < 0) {
     return Status::Error("window matches must be >= 0, not " +
                          std::to_string(window_matches));
@@ -235,7 +239,9 @@ StatusOr<LiveFrame> LivePipeline::Process(const cv::Mat& left,
   // 4. The maps, then the corrected pair.
   out.maps_updated = CollectBuild(/*wait=*/false);
   if (!hold_ && out.estimate.ok() && !pending_.valid() &&
-      std::abs(out.estimate->n - maps_->n()) > options_.map_update_threshold) {
+      std::abs(out.estimate->n - maps_->n()) >
+          std::max(options_.map_update_threshold,
+                   options_.map_update_sigmas * out.estimate->sigma_n_noise)) {
     StartBuild(out.estimate->n);
   }
   const auto remap_start = std::chrono::steady_clock::now();
