@@ -141,6 +141,15 @@ void LocusNormalEquations::Add(const LocusNormalEquations& other) {
   count += other.count;
 }
 
+void LocusNormalEquations::AddRow(const Vector& row, double r, double a) {
+  information.selfadjointView<Eigen::Lower>().rankUpdate(row);
+  gradient += r * row;
+  gradient_intercept += a * row;
+  intercept_squares += a * a;
+  squared_residuals += r * r;
+  ++count;
+}
+
 namespace {
 
 // The locus residual of a prepared match for extrinsics `cam1_from_cam0`
@@ -277,7 +286,6 @@ void AccumulateLocusNormalEquations(
   std::vector<Chunk> chunks(num_chunks, Chunk{LocusNormalEquations(size), {}});
   const auto accumulate = [&](int64_t chunk_index) {
     Chunk& chunk = chunks[chunk_index];
-    LocusNormalEquations* const equations = &chunk.total;
     LocusNormalEquations::Vector row(size);
     const size_t first = static_cast<size_t>(chunk_index * kRowsPerChunk);
     const size_t last =
@@ -353,12 +361,7 @@ void AccumulateLocusNormalEquations(
       if (!defined || !row.allFinite()) continue;
       double a = r - n * row[0] - rotation.dot(row.segment<3>(1));
       if (layout.focal) a -= focal_scale.dot(row.segment<2>(layout.Focal()));
-      equations->information.selfadjointView<Eigen::Lower>().rankUpdate(row);
-      equations->gradient += r * row;
-      equations->gradient_intercept += a * row;
-      equations->intercept_squares += a * a;
-      equations->squared_residuals += r * r;
-      ++equations->count;
+      chunk.total.AddRow(row, r, a);
       if (per_frame != nullptr) {
         auto slot = std::find_if(
             chunk.frames.rbegin(), chunk.frames.rend(),
@@ -367,13 +370,7 @@ void AccumulateLocusNormalEquations(
           chunk.frames.emplace_back(raw[i].frame, LocusNormalEquations(size));
           slot = chunk.frames.rbegin();
         }
-        LocusNormalEquations& frame = slot->second;
-        frame.information.selfadjointView<Eigen::Lower>().rankUpdate(row);
-        frame.gradient += r * row;
-        frame.gradient_intercept += a * row;
-        frame.intercept_squares += a * a;
-        frame.squared_residuals += r * r;
-        ++frame.count;
+        slot->second.AddRow(row, r, a);
       }
     }
   };

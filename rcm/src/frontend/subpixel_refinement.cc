@@ -262,7 +262,8 @@ void RefineRightPixels(const cv::Mat& left_gray, const cv::Mat& right_gray,
   ParallelForChunks(count,
                     count >= 2 * kMinMatchesPerThread ? options.num_threads : 1,
                     kMatchesPerChunk, [&](int64_t begin, int64_t end) {
-                      Buffers buffers;
+                      // Per thread, not per chunk: sized once.
+                      thread_local Buffers buffers;
                       for (int64_t i = begin; i < end; ++i) {
                         cv::Point2f refined = (*right)[i];
                         if (RefineOne(left_image, right_float, left[i],

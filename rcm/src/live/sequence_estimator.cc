@@ -138,7 +138,7 @@ StatusOr<SequencePair> SequenceEstimator::AddPair(
     std::optional<double> timestamp) {
   const auto start = std::chrono::steady_clock::now();
   StatusOr<DetectedStereoPair> detected =
-      Detect(left, right, options_.FrontEnd().num_threads);
+      Detect(left, right, front_end_.options().num_threads);
   if (!detected.ok()) return detected.status();
   const double detect_ms = SequenceMilliseconds(start);
   StatusOr<SequencePair> pair = AddDetectedPair(*detected, frame, timestamp);

@@ -228,6 +228,10 @@ struct LocusNormalEquations {
         gradient_intercept(Vector::Zero(size)) {}
   int size() const { return static_cast<int>(gradient.size()); }
   void Add(const LocusNormalEquations& other);
+  // One row j with residual r and intercept a: M += j j^T (its lower
+  // triangle only: symmetrize the sum after the last row), g += r j,
+  // intercept += a j, A += a^2, C += r^2.
+  void AddRow(const Vector& row, double r, double a);
 };
 
 // The unknowns self-calibrated beside n: cam1's rotation w (radians) and
