@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <memory>
 #include <random>
 
@@ -321,6 +322,30 @@ TEST(PreparedCorrespondence, NearSideGivesTheCentralDifferencesOfTheFull) {
         }
       }
     }
+  }
+}
+
+// The matches prepared on two threads are those prepared on one, bit for
+// bit, in input order, with the same matches left out (a pixel far outside
+// the image does not prepare) and enough matches for several chunks.
+TEST(PreparedCorrespondence, PreparedOnThreadsAsOnOne) {
+  const StereoRig rig = test::AlphasenseRealisticRig();
+  std::vector<StereoCorrespondence> matches =
+      test::ExactMatches(rig, 1.333, 1500);
+  for (size_t i = 7; i < matches.size(); i += 97) {
+    matches[i].right_pixel = Eigen::Vector2d(1e7, -1e7);
+  }
+  const PreparedCorrespondences one = PrepareCorrespondences(rig, matches, 1);
+  const PreparedCorrespondences two = PrepareCorrespondences(rig, matches, 2);
+  ASSERT_LT(one.prepared.size(), matches.size());
+  ASSERT_GT(one.prepared.size(), 1000u);
+  EXPECT_EQ(two.source_index, one.source_index);
+  ASSERT_EQ(two.prepared.size(), one.prepared.size());
+  for (size_t i = 0; i < one.prepared.size(); ++i) {
+    EXPECT_EQ(std::memcmp(&two.prepared[i], &one.prepared[i],
+                          sizeof(PreparedCorrespondence)),
+              0)
+        << "match " << i;
   }
 }
 

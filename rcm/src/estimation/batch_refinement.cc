@@ -23,6 +23,7 @@
 #include "rcm/estimation/sampson_coplanarity_error.h"
 #include "rcm/estimation/thick_port_refinement.h"
 #include "rcm/stereo/epipolar.h"
+#include "rcm/util/parallel_for.h"
 
 namespace rcm {
 namespace {
@@ -104,7 +105,7 @@ struct FocalScales {
 void PrepareWithFocalScale(
     const StereoRig& rig, const Eigen::Vector2d& scale,
     const std::vector<StereoCorrespondence>& correspondences,
-    const std::vector<int64_t>& source_index, bool derivatives,
+    const std::vector<int64_t>& source_index, bool derivatives, int num_threads,
     std::vector<PreparedCorrespondence>* matches) {
   const StatusOr<StereoRig> scaled = rig.WithFocalScaled(scale[0], scale[1]);
   if (!scaled.ok()) return;
@@ -114,25 +115,33 @@ void PrepareWithFocalScale(
     if (!made.ok()) return;
     steps = *std::move(made);
   }
-  for (size_t i = 0; i < matches->size(); ++i) {
-    const StereoCorrespondence& correspondence =
-        correspondences[source_index[i]];
-    std::optional<PreparedCorrespondence> prepared =
-        PrepareCorrespondence(*scaled, correspondence);
-    if (!prepared) continue;
-    PreparedCorrespondence& match = (*matches)[i];
-    if (derivatives) {
-      if (!PrepareFocalDerivatives(*steps, correspondence, &*prepared)) {
-        continue;
-      }
-    } else {
-      std::copy_n(match.left_normalized_from_pixel_focal, 4,
-                  prepared->left_normalized_from_pixel_focal);
-      std::copy_n(match.right_normalized_from_pixel_focal, 4,
-                  prepared->right_normalized_from_pixel_focal);
-    }
-    match = *prepared;
-  }
+  // Each match's own: on the threads in chunks, the result independent of
+  // them.
+  constexpr int64_t kMatchesPerChunk = 256;
+  const int64_t count = static_cast<int64_t>(matches->size());
+  ParallelForChunks(
+      count, count >= 2 * kMatchesPerChunk ? num_threads : 1, kMatchesPerChunk,
+      [&](int64_t begin, int64_t end) {
+        for (int64_t i = begin; i < end; ++i) {
+          const StereoCorrespondence& correspondence =
+              correspondences[source_index[i]];
+          std::optional<PreparedCorrespondence> prepared =
+              PrepareCorrespondence(*scaled, correspondence);
+          if (!prepared) continue;
+          PreparedCorrespondence& match = (*matches)[i];
+          if (derivatives) {
+            if (!PrepareFocalDerivatives(*steps, correspondence, &*prepared)) {
+              continue;
+            }
+          } else {
+            std::copy_n(match.left_normalized_from_pixel_focal, 4,
+                        prepared->left_normalized_from_pixel_focal);
+            std::copy_n(match.right_normalized_from_pixel_focal, 4,
+                        prepared->right_normalized_from_pixel_focal);
+          }
+          match = *prepared;
+        }
+      });
 }
 
 // The prior on n (RefinementOptions::n_prior) in pixels of residual:
@@ -265,7 +274,7 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
   RefinementSummary summary;
   summary.num_correspondences = static_cast<int64_t>(correspondences.size());
   const PreparedCorrespondences prepared =
-      PrepareCorrespondences(rig, correspondences);
+      PrepareCorrespondences(rig, correspondences, options.num_threads);
   // Prepared with the calibration's lenses; with the focal scales
   // estimated, prepared again with each estimate of them.
   std::vector<PreparedCorrespondence> matches = prepared.prepared;
@@ -314,7 +323,7 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
     at->focal[0] = at->focal[1] = 0.0;
     PrepareWithFocalScale(rig, focal.prepared_with, correspondences,
                           prepared.source_index, focal_preparations++ == 0,
-                          &matches);
+                          options.num_threads, &matches);
   };
 
   // Seed and stage 1 (robust, all usable matches).

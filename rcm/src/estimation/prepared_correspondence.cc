@@ -3,6 +3,8 @@
 #include <Eigen/LU>
 #include <cmath>
 
+#include "rcm/util/parallel_for.h"
+
 namespace rcm {
 namespace {
 
@@ -136,16 +138,30 @@ bool PrepareFocalDerivatives(const StereoRig& rig,
 
 PreparedCorrespondences PrepareCorrespondences(
     const StereoRig& rig,
-    const std::vector<StereoCorrespondence>& correspondences) {
+    const std::vector<StereoCorrespondence>& correspondences, int num_threads) {
+  // Prepared in place on the threads, then the failures dropped in order.
+  const int64_t count = static_cast<int64_t>(correspondences.size());
+  std::vector<PreparedCorrespondence> all(correspondences.size());
+  std::vector<unsigned char> ok(correspondences.size(), 0);
+  constexpr int64_t kMatchesPerChunk = 256;
+  ParallelForChunks(
+      count, count >= 2 * kMatchesPerChunk ? num_threads : 1, kMatchesPerChunk,
+      [&](int64_t begin, int64_t end) {
+        for (int64_t i = begin; i < end; ++i) {
+          if (std::optional<PreparedCorrespondence> prepared =
+                  PrepareCorrespondence(rig, correspondences[i])) {
+            all[i] = *prepared;
+            ok[i] = 1;
+          }
+        }
+      });
   PreparedCorrespondences result;
   result.prepared.reserve(correspondences.size());
   result.source_index.reserve(correspondences.size());
-  for (size_t i = 0; i < correspondences.size(); ++i) {
-    if (std::optional<PreparedCorrespondence> prepared =
-            PrepareCorrespondence(rig, correspondences[i])) {
-      result.prepared.push_back(*prepared);
-      result.source_index.push_back(static_cast<int64_t>(i));
-    }
+  for (int64_t i = 0; i < count; ++i) {
+    if (!ok[i]) continue;
+    result.prepared.push_back(all[i]);
+    result.source_index.push_back(i);
   }
   return result;
 }

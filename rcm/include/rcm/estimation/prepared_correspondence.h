@@ -91,14 +91,17 @@ bool PrepareFocalDerivatives(const FocalStepRigs& rigs,
                              PreparedCorrespondence* prepared);
 
 // The correspondences that could be prepared, with the index of each in the
-// input, in input order.
+// input, in input order; the matches prepared on up to `num_threads`
+// threads (each match's preparation is its own, so the result does not
+// depend on them).
 struct PreparedCorrespondences {
   std::vector<PreparedCorrespondence> prepared;
   std::vector<int64_t> source_index;
 };
 PreparedCorrespondences PrepareCorrespondences(
     const StereoRig& rig,
-    const std::vector<StereoCorrespondence>& correspondences);
+    const std::vector<StereoCorrespondence>& correspondences,
+    int num_threads = 1);
 
 }  // namespace rcm
 
