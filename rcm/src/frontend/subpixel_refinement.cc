@@ -21,10 +21,11 @@ using Vector6 = Eigen::Matrix<double, kNumParameters, 1>;
 using Matrix6 = Eigen::Matrix<double, kNumParameters, kNumParameters>;
 
 // Bilinear interpolation of a CV_32F image; (x, y) must lie at least one
-// pixel inside the last row and column.
+// pixel inside the last row and column (so that they are positive, and
+// truncation is their floor).
 inline float Bilinear(const cv::Mat& image, float x, float y) {
-  const int x0 = static_cast<int>(std::floor(x));
-  const int y0 = static_cast<int>(std::floor(y));
+  const int x0 = static_cast<int>(x);
+  const int y0 = static_cast<int>(y);
   const float ax = x - x0;
   const float ay = y - y0;
   const float* row0 = image.ptr<float>(y0) + x0;
@@ -95,10 +96,14 @@ bool RefineOne(const LeftImage& left_image, const cv::Mat& right,
       buffers->patch[k] = Bilinear(left, x, y);
       buffers->dx[k] = Bilinear(left_image.dx, x, y);
       buffers->dy[k] = Bilinear(left_image.dy, x, y);
-      Vector6 descent;
-      descent << buffers->dx[k], buffers->dy[k], buffers->dx[k] * u,
-          buffers->dx[k] * v, buffers->dy[k] * u, buffers->dy[k] * v;
-      hessian.selfadjointView<Eigen::Upper>().rankUpdate(descent);
+      // H += d d^T on the upper triangle, written out (Eigen's rankUpdate
+      // of a 6-vector goes through its general product kernel).
+      const double descent[kNumParameters] = {
+          buffers->dx[k],     buffers->dy[k],     buffers->dx[k] * u,
+          buffers->dx[k] * v, buffers->dy[k] * u, buffers->dy[k] * v};
+      for (int j = 0; j < kNumParameters; ++j) {
+        for (int i = 0; i <= j; ++i) hessian(i, j) += descent[j] * descent[i];
+      }
     }
   }
   double template_mean = 0.0;
@@ -151,20 +156,34 @@ bool RefineOne(const LeftImage& left_image, const cv::Mat& right,
       gain = template_deviation / deviation;
       offset = template_mean - gain * mean;
     }
+    // The translation's two sums alone until the warp is fitted.
     Vector6 gradient = Vector6::Zero();
-    for (int v = -half, k = 0; v <= half; ++v) {
-      for (int u = -half; u <= half; ++u, ++k) {
+    if (affine) {
+      for (int v = -half, k = 0; v <= half; ++v) {
+        for (int u = -half; u <= half; ++u, ++k) {
+          const double error =
+              gain * buffers->warped[k] + offset - buffers->patch[k];
+          const double ex = buffers->dx[k] * error;
+          const double ey = buffers->dy[k] * error;
+          gradient[0] += ex;
+          gradient[1] += ey;
+          gradient[2] += ex * u;
+          gradient[3] += ex * v;
+          gradient[4] += ey * u;
+          gradient[5] += ey * v;
+        }
+      }
+    } else {
+      double gx = 0.0;
+      double gy = 0.0;
+      for (int k = 0; k < size; ++k) {
         const double error =
             gain * buffers->warped[k] + offset - buffers->patch[k];
-        const double ex = buffers->dx[k] * error;
-        const double ey = buffers->dy[k] * error;
-        gradient[0] += ex;
-        gradient[1] += ey;
-        gradient[2] += ex * u;
-        gradient[3] += ex * v;
-        gradient[4] += ey * u;
-        gradient[5] += ey * v;
+        gx += buffers->dx[k] * error;
+        gy += buffers->dy[k] * error;
       }
+      gradient[0] = gx;
+      gradient[1] = gy;
     }
     // Translation alone until it is within a tenth of a pixel (the affine
     // terms are poorly determined far from the optimum), then the warp.
