@@ -37,6 +37,8 @@
 #define RCM_FRONTEND_LOCUS_BAND_H_
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -97,8 +99,21 @@ class LocusBand {
   LocusKey LeftKey(const Eigen::Vector2d& pixel) const;
   LocusKey RightKey(const Eigen::Vector2d& pixel) const;
 
-  // The band test of the header comment.
-  bool Contains(const LocusKey& left, const LocusKey& right) const;
+  // The band test of the header comment (inline: the matcher's inner loop).
+  bool Contains(const LocusKey& left, const LocusKey& right) const {
+    if (!left.valid || !right.valid) return false;
+    const double d0 = left.phi[0] - right.phi[0];
+    const double d1 = left.phi[1] - right.phi[1];
+    const bool coplanar =
+        (d0 <= 0.0) != (d1 <= 0.0) ||
+        std::min(std::abs(d0), std::abs(d1)) <= angle_tolerance_;
+    if (!coplanar) return false;
+    const double u_tolerance = angle_tolerance_ * (1.0 + left.u[0] * left.u[0]);
+    const double v0 = left.u[0] - right.u[0];
+    const double v1 = left.u[1] - right.u[1];
+    return std::max(v0, v1) >= -u_tolerance &&
+           std::min(v0, v1) <= max_disparity_ + u_tolerance;
+  }
 
   // The angular tolerance, radians (tolerance_px / f_min).
   double angle_tolerance() const { return angle_tolerance_; }
