@@ -62,9 +62,9 @@ TEST(Camera, RejectsNonFiniteCoefficient) {
 // Found by fuzz_camera_model: k2 = 2.4e68 broke the series the equidistant
 // model uses near the axis, and a pixel did not reproject onto itself.
 TEST(Camera, RejectsAbsurdCoefficient) {
-  const StatusOr<Camera> camera = Camera::Create(
-      LensModelId::kEquidistant, 640, 480, {300.0, 300.0, 320.0, 240.0},
-      {-1.0, 2.4e68, 0.0, 0.0});
+  const StatusOr<Camera> camera =
+      Camera::Create(LensModelId::kEquidistant, 640, 480,
+                     {300.0, 300.0, 320.0, 240.0}, {-1.0, 2.4e68, 0.0, 0.0});
   ASSERT_FALSE(camera.ok());
   EXPECT_EQ(camera.status().message(),
             "distortion coefficient 1 = 2.4e+68 is beyond the accepted "
@@ -85,8 +85,9 @@ TEST(Camera, RejectsFocalLengthOutsidePixelRange) {
   const StatusOr<Camera> metres = Camera::Create(
       LensModelId::kPinhole, 640, 480, {0.004, 0.004, 320.0, 240.0}, {});
   ASSERT_FALSE(metres.ok());
-  EXPECT_EQ(metres.status().message(),
-            "fx = 0.004 is not a focal length in pixels (accepted: 1 to 1e+06)");
+  EXPECT_EQ(
+      metres.status().message(),
+      "fx = 0.004 is not a focal length in pixels (accepted: 1 to 1e+06)");
   EXPECT_FALSE(Camera::Create(LensModelId::kPinhole, 640, 480,
                               {300.0, 7e-322, 320.0, 240.0}, {})
                    .ok());
@@ -138,7 +139,8 @@ TEST(Camera, LensModelNamesRoundTrip) {
   EXPECT_EQ(NumDistortionParams(LensModelId::kRational), 8);
   EXPECT_EQ(NumDistortionParams(LensModelId::kDoubleSphere), 2);
   EXPECT_EQ(NumDistortionParams(LensModelId::kEucm), 2);
-  EXPECT_EQ(LensModelNameList(), "none, radtan, equidistant, rational, ds, eucm");
+  EXPECT_EQ(LensModelNameList(),
+            "none, radtan, equidistant, rational, ds, eucm");
   EXPECT_FALSE(LensModelFromName("fov").has_value());
   EXPECT_FALSE(LensModelFromName("").has_value());
 }
@@ -167,6 +169,29 @@ TEST(Camera, ImageFromNormalizedJacobianMatchesCentralDifferences) {
   }
 }
 
+// The pixel and the Jacobian from one lens evaluation are the two calls'
+// numbers, bit for bit, for every model, near the axis (the equidistant
+// series) and off it.
+TEST(Camera, JacobianWithPixelIsBothCallsExactly) {
+  for (const Camera& camera : test::AllTestCameras()) {
+    for (const Eigen::Vector2d& p :
+         {Eigen::Vector2d(0.31, -0.22), Eigen::Vector2d(-0.05, 0.4),
+          Eigen::Vector2d(1e-9, -2e-9), Eigen::Vector2d(0.0, 0.0)}) {
+      Eigen::Vector2d pixel;
+      const Eigen::Matrix2d jacobian =
+          camera.ImageFromNormalizedJacobian(p, &pixel);
+      const Eigen::Vector2d expected = camera.ImageFromNormalized(p);
+      EXPECT_EQ(pixel.x(), expected.x()) << p.transpose();
+      EXPECT_EQ(pixel.y(), expected.y()) << p.transpose();
+      const Eigen::Matrix2d expected_jacobian =
+          camera.ImageFromNormalizedJacobian(p);
+      for (int k = 0; k < 4; ++k) {
+        EXPECT_EQ(jacobian(k), expected_jacobian(k)) << p.transpose();
+      }
+    }
+  }
+}
+
 // Out-of-range coefficients of the unified models: one line naming the
 // coefficient.
 TEST(Camera, RejectsUnifiedModelCoefficientsOutOfRange) {
@@ -176,10 +201,18 @@ TEST(Camera, RejectsUnifiedModelCoefficientsOutOfRange) {
     std::vector<double> distortion;
     const char* expected;
   } kCases[] = {
-      {LensModelId::kDoubleSphere, {1.5, 0.5}, "ds xi = 1.5 is outside (-1, 1]"},
-      {LensModelId::kDoubleSphere, {-1.0, 0.5}, "ds xi = -1 is outside (-1, 1]"},
-      {LensModelId::kDoubleSphere, {0.1, -0.1}, "ds alpha = -0.1 is outside [0, 1]"},
-      {LensModelId::kDoubleSphere, {0.1, 1.2}, "ds alpha = 1.2 is outside [0, 1]"},
+      {LensModelId::kDoubleSphere,
+       {1.5, 0.5},
+       "ds xi = 1.5 is outside (-1, 1]"},
+      {LensModelId::kDoubleSphere,
+       {-1.0, 0.5},
+       "ds xi = -1 is outside (-1, 1]"},
+      {LensModelId::kDoubleSphere,
+       {0.1, -0.1},
+       "ds alpha = -0.1 is outside [0, 1]"},
+      {LensModelId::kDoubleSphere,
+       {0.1, 1.2},
+       "ds alpha = 1.2 is outside [0, 1]"},
       {LensModelId::kEucm, {1.01, 1.0}, "eucm alpha = 1.01 is outside [0, 1]"},
       {LensModelId::kEucm, {0.5, 0.0}, "eucm beta = 0 is outside (0, 1000]"},
       {LensModelId::kEucm, {0.5, -2.0}, "eucm beta = -2 is outside (0, 1000]"},
@@ -192,13 +225,18 @@ TEST(Camera, RejectsUnifiedModelCoefficientsOutOfRange) {
     EXPECT_EQ(camera.status().message().find('\n'), std::string::npos);
   }
   // The edges of the ranges are accepted.
-  EXPECT_TRUE(Camera::Create(LensModelId::kDoubleSphere, 640, 480, k, {1.0, 0.0}).ok());
-  EXPECT_TRUE(Camera::Create(LensModelId::kDoubleSphere, 640, 480, k, {-0.99, 1.0}).ok());
-  EXPECT_TRUE(Camera::Create(LensModelId::kEucm, 640, 480, k, {1.0, 1e-3}).ok());
+  EXPECT_TRUE(
+      Camera::Create(LensModelId::kDoubleSphere, 640, 480, k, {1.0, 0.0}).ok());
+  EXPECT_TRUE(
+      Camera::Create(LensModelId::kDoubleSphere, 640, 480, k, {-0.99, 1.0})
+          .ok());
+  EXPECT_TRUE(
+      Camera::Create(LensModelId::kEucm, 640, 480, k, {1.0, 1e-3}).ok());
   EXPECT_TRUE(Camera::Create(LensModelId::kEucm, 640, 480, k, {0.0, 1.0}).ok());
   // Rational: 8 coefficients, any sign.
-  EXPECT_FALSE(Camera::Create(LensModelId::kRational, 640, 480, k,
-                              {0.1, 0.0, 0.0, 0.0}).ok());
+  EXPECT_FALSE(
+      Camera::Create(LensModelId::kRational, 640, 480, k, {0.1, 0.0, 0.0, 0.0})
+          .ok());
 }
 
 TEST(Camera, LensInvertibleAtDetectsFold) {

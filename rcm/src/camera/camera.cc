@@ -277,6 +277,24 @@ std::optional<Eigen::Vector2d> Camera::NormalizedFromImage(
 }
 
 Eigen::Matrix2d Camera::ImageFromNormalizedJacobian(
+    const Eigen::Vector2d& normalized, Eigen::Vector2d* pixel) const {
+  double distorted[2];
+  double jacobian[4] = {1.0, 0.0, 0.0, 1.0};
+  RCM_LENS_MODEL_SWITCH(
+      model_, LensModel::DistortWithJacobian(params_.data() + 4, normalized.x(),
+                                             normalized.y(), &distorted[0],
+                                             &distorted[1], jacobian);
+      break;)
+  // As BaseLens::ImgFromCam.
+  pixel->x() = params_[0] * distorted[0] + params_[2];
+  pixel->y() = params_[1] * distorted[1] + params_[3];
+  Eigen::Matrix2d result;
+  result << fx() * jacobian[0], fx() * jacobian[1], fy() * jacobian[2],
+      fy() * jacobian[3];
+  return result;
+}
+
+Eigen::Matrix2d Camera::ImageFromNormalizedJacobian(
     const Eigen::Vector2d& normalized) const {
   double distorted[2];
   double jacobian[4] = {1.0, 0.0, 0.0, 1.0};

@@ -79,11 +79,13 @@ bool PrepareCorrespondenceSideNear(const Camera& camera,
   const Eigen::Vector2d near(start[0], start[1]);
   if (!pixel.allFinite() || !near.allFinite()) return false;
   // x_1 = x_0 + (d pixel / d x)^-1 (pixel - pixel(x_0)).
-  const Eigen::Matrix2d forward = camera.ImageFromNormalizedJacobian(near);
+  // The pixel of x_0 and the Jacobian there from one lens evaluation.
+  Eigen::Vector2d at_near;
+  const Eigen::Matrix2d forward =
+      camera.ImageFromNormalizedJacobian(near, &at_near);
   const double determinant = forward.determinant();
   if (!(determinant > 0.0) || !std::isfinite(determinant)) return false;
-  const Eigen::Vector2d point =
-      near + forward.inverse() * (pixel - camera.ImageFromNormalized(near));
+  const Eigen::Vector2d point = near + forward.inverse() * (pixel - at_near);
   if (!point.allFinite()) return false;
   return PrepareSideAt(camera, pixel, point, side, prepared);
 }

@@ -44,32 +44,32 @@ std::vector<DistortionBound> DistortionBounds(LensModelId model);
 
 // Calls `body` with `LensModel` bound to the static model struct of `id`,
 // e.g. RCM_LENS_MODEL_SWITCH(model_, return LensModel::kNumParams;)
-#define RCM_LENS_MODEL_SWITCH(id, ...)          \
-  switch (id) {                                 \
-    case ::rcm::LensModelId::kPinhole: {        \
-      using LensModel = ::rcm::PinholeLens;     \
-      __VA_ARGS__                               \
-    }                                           \
-    case ::rcm::LensModelId::kRadTan: {         \
-      using LensModel = ::rcm::RadTanLens;      \
-      __VA_ARGS__                               \
-    }                                           \
-    case ::rcm::LensModelId::kEquidistant: {    \
-      using LensModel = ::rcm::EquidistantLens; \
-      __VA_ARGS__                               \
-    }                                           \
-    case ::rcm::LensModelId::kRational: {       \
-      using LensModel = ::rcm::RationalLens;    \
-      __VA_ARGS__                               \
-    }                                           \
-    case ::rcm::LensModelId::kDoubleSphere: {   \
+#define RCM_LENS_MODEL_SWITCH(id, ...)           \
+  switch (id) {                                  \
+    case ::rcm::LensModelId::kPinhole: {         \
+      using LensModel = ::rcm::PinholeLens;      \
+      __VA_ARGS__                                \
+    }                                            \
+    case ::rcm::LensModelId::kRadTan: {          \
+      using LensModel = ::rcm::RadTanLens;       \
+      __VA_ARGS__                                \
+    }                                            \
+    case ::rcm::LensModelId::kEquidistant: {     \
+      using LensModel = ::rcm::EquidistantLens;  \
+      __VA_ARGS__                                \
+    }                                            \
+    case ::rcm::LensModelId::kRational: {        \
+      using LensModel = ::rcm::RationalLens;     \
+      __VA_ARGS__                                \
+    }                                            \
+    case ::rcm::LensModelId::kDoubleSphere: {    \
       using LensModel = ::rcm::DoubleSphereLens; \
-      __VA_ARGS__                               \
-    }                                           \
-    case ::rcm::LensModelId::kEucm: {           \
-      using LensModel = ::rcm::EucmLens;        \
-      __VA_ARGS__                               \
-    }                                           \
+      __VA_ARGS__                                \
+    }                                            \
+    case ::rcm::LensModelId::kEucm: {            \
+      using LensModel = ::rcm::EucmLens;         \
+      __VA_ARGS__                                \
+    }                                            \
   }
 
 class Camera {
@@ -143,6 +143,11 @@ class Camera {
   // analytic lens Jacobian scaled by the focal lengths.
   Eigen::Matrix2d ImageFromNormalizedJacobian(
       const Eigen::Vector2d& normalized) const;
+  // Both at once from one evaluation of the lens: the Jacobian returned,
+  // the pixel in `pixel`. The same numbers as the two calls (every lens
+  // model's Distort is its DistortWithJacobian without the Jacobian).
+  Eigen::Matrix2d ImageFromNormalizedJacobian(const Eigen::Vector2d& normalized,
+                                              Eigen::Vector2d* pixel) const;
 
   // True where the point lies on the lens map's principal branch: inside
   // the radius where the radial polynomial first folds back
