@@ -38,13 +38,67 @@ inline bool Inside(const cv::Mat& image, double x, double y) {
   return x >= 1.0 && y >= 1.0 && x < image.cols - 2 && y < image.rows - 2;
 }
 
-// Per thread: the template window, its gradients and the warped patch.
+// Per thread: the template window, its gradients and the warped patch,
+// and the window's offsets and the warped samples' corners and weights
+// (WarpPatch).
 struct Buffers {
   std::vector<float> patch;
   std::vector<float> dx;
   std::vector<float> dy;
   std::vector<float> warped;
+  std::vector<double> u;
+  std::vector<double> v;
+  std::vector<float> x;
+  std::vector<float> y;
+  std::vector<int> x0;
+  std::vector<int> y0;
+  std::vector<float> top_left, top_right, bottom_left, bottom_right;
 };
+
+// buffers->warped[k] = Bilinear(image, W (u_k, v_k)) for the window's
+// offsets (u_k, v_k) under the affine warp W, row by row of the window in
+// the template's order: the same arithmetic as Bilinear per sample, in
+// passes over arrays that the compiler vectorizes (only the four pixel
+// reads of each sample stay scalar). The warp must keep every sample at
+// least one pixel inside the image (positive coordinates).
+void WarpPatch(const cv::Mat& image, const Eigen::Matrix3d& warp, int size,
+               Buffers* buffers) {
+  const double w00 = warp(0, 0), w01 = warp(0, 1), w02 = warp(0, 2);
+  const double w10 = warp(1, 0), w11 = warp(1, 1), w12 = warp(1, 2);
+  const double* u = buffers->u.data();
+  const double* v = buffers->v.data();
+  float* x = buffers->x.data();
+  float* y = buffers->y.data();
+  for (int k = 0; k < size; ++k) {
+    x[k] = static_cast<float>(w00 * u[k] + w01 * v[k] + w02);
+    y[k] = static_cast<float>(w10 * u[k] + w11 * v[k] + w12);
+  }
+  int* x0 = buffers->x0.data();
+  int* y0 = buffers->y0.data();
+  for (int k = 0; k < size; ++k) {
+    x0[k] = static_cast<int>(x[k]);
+    y0[k] = static_cast<int>(y[k]);
+  }
+  float* a = buffers->top_left.data();
+  float* b = buffers->top_right.data();
+  float* c = buffers->bottom_left.data();
+  float* d = buffers->bottom_right.data();
+  for (int k = 0; k < size; ++k) {
+    const float* row0 = image.ptr<float>(y0[k]) + x0[k];
+    const float* row1 = image.ptr<float>(y0[k] + 1) + x0[k];
+    a[k] = row0[0];
+    b[k] = row0[1];
+    c[k] = row1[0];
+    d[k] = row1[1];
+  }
+  float* warped = buffers->warped.data();
+  for (int k = 0; k < size; ++k) {
+    const float ax = x[k] - x0[k];
+    const float ay = y[k] - y0[k];
+    warped[k] = (1.0f - ay) * ((1.0f - ax) * a[k] + ax * b[k]) +
+                ay * ((1.0f - ax) * c[k] + ax * d[k]);
+  }
+}
 
 // Mean and standard deviation of a patch.
 void MeanAndDeviation(const std::vector<float>& values, double* mean,
@@ -88,6 +142,23 @@ bool RefineOne(const LeftImage& left_image, const cv::Mat& right,
   buffers->dx.resize(size);
   buffers->dy.resize(size);
   buffers->warped.resize(size);
+  for (std::vector<float>* values :
+       {&buffers->x, &buffers->y, &buffers->top_left, &buffers->top_right,
+        &buffers->bottom_left, &buffers->bottom_right}) {
+    values->resize(size);
+  }
+  buffers->x0.resize(size);
+  buffers->y0.resize(size);
+  if (static_cast<int>(buffers->u.size()) != size) {
+    buffers->u.resize(size);
+    buffers->v.resize(size);
+    for (int v = -half, k = 0; v <= half; ++v) {
+      for (int u = -half; u <= half; ++u, ++k) {
+        buffers->u[k] = u;
+        buffers->v[k] = v;
+      }
+    }
+  }
   Matrix6 hessian = Matrix6::Zero();
   for (int v = -half, k = 0; v <= half; ++v) {
     for (int u = -half; u <= half; ++u, ++k) {
@@ -136,14 +207,7 @@ bool RefineOne(const LeftImage& left_image, const cv::Mat& right,
         if (!Inside(right, corner.x(), corner.y())) return false;
       }
     }
-    for (int v = -half, k = 0; v <= half; ++v) {
-      for (int u = -half; u <= half; ++u, ++k) {
-        buffers->warped[k] = Bilinear(
-            right,
-            static_cast<float>(warp(0, 0) * u + warp(0, 1) * v + warp(0, 2)),
-            static_cast<float>(warp(1, 0) * u + warp(1, 1) * v + warp(1, 2)));
-      }
-    }
+    WarpPatch(right, warp, size, buffers);
     // Exposure: error = gain * warped + offset - template, the identity
     // unless normalize_exposure matches mean and contrast.
     double gain = 1.0;
