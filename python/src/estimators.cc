@@ -74,8 +74,39 @@ std::vector<OptionField> RefinementOptionFields(RefinementOptions* o) {
         if (!o->n_prior) return py::none();
         return py::make_tuple(o->n_prior->n, o->n_prior->sigma);
       }};
+  // Where the normal equations are taken: None or cam1's rotation
+  // correction (3 numbers, angle-axis radians).
+  OptionField rows_at_rotation{
+      "rows_at_rotation",
+      [o](const py::handle& value) {
+        if (value.is_none()) {
+          o->rows_at_rotation.reset();
+          return;
+        }
+        py::sequence vector;
+        if (!py::isinstance<py::sequence>(value) ||
+            py::isinstance<py::str>(value) ||
+            (vector = value.cast<py::sequence>()).size() != 3) {
+          ThrowTypeError(
+              "rows_at_rotation must be None or 3 numbers (angle-axis, "
+              "radians)");
+        }
+        try {
+          o->rows_at_rotation = Eigen::Vector3d(vector[0].cast<double>(),
+                                                vector[1].cast<double>(),
+                                                vector[2].cast<double>());
+        } catch (const py::cast_error&) {
+          ThrowTypeError("rows_at_rotation must be 3 numbers (radians)");
+        }
+      },
+      [o]() -> py::object {
+        if (!o->rows_at_rotation) return py::none();
+        const Eigen::Vector3d& w = *o->rows_at_rotation;
+        return py::make_tuple(w.x(), w.y(), w.z());
+      }};
   return {loss,
           n_prior,
+          rows_at_rotation,
           DoubleOption("loss_scale_px", &o->loss_scale_px),
           DoubleOption("inlier_threshold_px", &o->inlier_threshold_px, true),
           IntOption("num_scan_points", &o->num_scan_points),
@@ -418,6 +449,11 @@ void BindEstimators(py::module_& module) {
       {"detect_systematic",
        "Test the residuals for a smooth field and widen sigma_n by it "
        "(False; rcm estimate turns it on)."},
+      {"rows_at_rotation",
+       "Take the normal equations (and the uncertainty from them) at this "
+       "rotation correction of cam1, 3 numbers, angle-axis radians, instead "
+       "of the solution's, with the rotation self-calibrated: for pooling "
+       "frames' rows at one point (None: at the solution)."},
       {"max_num_iterations", "Solver iterations per stage; >= 1 (100)."},
       {"num_threads", "Threads for the residuals; >= 1 (2)."}};
   BindOptionsClass<RefinementOptions>(module, "RefinementOptions", R"doc(

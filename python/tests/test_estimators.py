@@ -193,7 +193,7 @@ def test_option_keywords():
         "refine_rotation": False, "self_calibrate_rotation": True,
         "self_calibrate_focal": True, "systematic_px": 0.0,
         "detect_systematic": False, "max_num_iterations": 100, "num_threads": 2,
-        "n_prior": None}
+        "n_prior": None, "rows_at_rotation": None}
 
 
 def test_n_prior_of_the_medium(realistic_rig):
@@ -420,6 +420,16 @@ def test_refinement_options_class(ideal_rig):
                                     inlier_threshold_px=1.5,
                                     min_inliers=12).n
     assert set(by_object.to_dict()) >= {"n", "sigma_n", "calibration"}
+    # Where the rows are taken: None (the default) or 3 numbers.
+    assert rcm.RefinementOptions().rows_at_rotation is None
+    options.rows_at_rotation = [0.0, 1e-3, 0.0]
+    assert options.rows_at_rotation == (0.0, 1e-3, 0.0)
+    with pytest.raises(TypeError) as error:
+        rcm.RefinementOptions(rows_at_rotation=(1.0, 2.0))
+    one_line(error)
+    with pytest.raises(ValueError) as error:
+        rcm.RefinementOptions(rows_at_rotation=(0.0, float("nan"), 0.0)).check()
+    one_line(error)
     with pytest.raises(TypeError) as error:
         rcm.RefinementOptions(no_such_option=1)
     one_line(error)

@@ -364,5 +364,56 @@ TEST(OnlineEstimator, CreateRejectsInvalidOptions) {
   EXPECT_EQ(with_invalid.status().message(), invalid.Check().message());
 }
 
+// A frame's rows at the estimator's linearization rotation are its
+// refinement's, taken there (RefinementOptions::rows_at_rotation): the
+// same numbers, bit for bit, and not those at the frame's own rotation
+// (the option takes effect); the refinement's solution does not move.
+TEST(FitFrame, RowsAtTheLinearizationAreTheRefinementsTakenThere) {
+  const StereoRig nominal = test::AlphasenseRealisticRig();
+  const StereoRig truth =
+      nominal.WithCam1Moved(Eigen::Vector3d(0.0, 0.1, 0.05) * M_PI / 180.0)
+          .value();
+  const StereoRig rig = nominal
+                            .WithCalibrationUncertainty(
+                                CalibrationUncertainty::DefaultDriftPrior())
+                            .value();
+  std::vector<StereoCorrespondence> frame =
+      test::ExactSequence(truth, 1.333, 1, 200, 21);
+  AddPixelNoise(0.3, 22, &frame);
+  RefinementOptions options;
+  options.systematic_px = 0.03;
+  const Eigen::Vector3d linearization =
+      Eigen::Vector3d(0.01, 0.08, 0.06) * M_PI / 180.0;
+  const FrameFit fit = FitFrame(rig, frame, options, linearization);
+  ASSERT_TRUE(fit.estimate.ok()) << fit.estimate.status().message();
+
+  RefinementOptions frame_options = options;
+  frame_options.self_calibrate_focal =
+      SelfCalibrationLayout(rig, options).focal;
+  const RefinementSummary own =
+      RefineRefractiveIndex(rig, frame, frame_options).value();
+  frame_options.rows_at_rotation = linearization;
+  const RefinementSummary there =
+      RefineRefractiveIndex(rig, frame, frame_options).value();
+  ASSERT_TRUE(own.rotation && there.rotation && own.normal_equations &&
+              there.normal_equations && there.rows_rotation);
+  EXPECT_EQ(there.n, own.n);
+  EXPECT_EQ(there.rotation->angle_axis, own.rotation->angle_axis);
+  EXPECT_EQ(*own.rows_rotation, own.rotation->angle_axis);
+  EXPECT_EQ(*there.rows_rotation, linearization);
+  ASSERT_EQ(fit.inliers.size(), there.inliers.size());
+
+  const LocusNormalEquations& taken = *there.normal_equations;
+  EXPECT_EQ(fit.normal_equations.information, taken.information);
+  EXPECT_EQ(fit.normal_equations.gradient, taken.gradient);
+  EXPECT_EQ(fit.normal_equations.gradient_intercept, taken.gradient_intercept);
+  EXPECT_EQ(fit.normal_equations.count, taken.count);
+  EXPECT_NE(own.normal_equations->gradient_intercept, taken.gradient_intercept);
+
+  RefinementOptions invalid = options;
+  invalid.rows_at_rotation = Eigen::Vector3d(0.0, NAN, 0.0);
+  EXPECT_FALSE(invalid.Check().ok());
+}
+
 }  // namespace
 }  // namespace rcm::online_estimator_test

@@ -503,11 +503,14 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
     if (!scaled.ok()) return scaled.status();
     solved_rig = *std::move(scaled);
   }
+  // The rows at the solution's rotation, or at the caller's.
+  const Eigen::Vector3d rows_rotation =
+      with_rotation ? options.rows_at_rotation.value_or(rotation) : rotation;
   LocusNormalEquations equations(layout.Size());
   std::vector<LocusNormalEquations> per_frame;
-  AccumulateLocusNormalEquations(solved_rig, layout, raw, matches, inliers,
-                                 parameters.n, rotation, focal.prepared_with,
-                                 &equations, &per_frame, options.num_threads);
+  AccumulateLocusNormalEquations(
+      solved_rig, layout, raw, matches, inliers, parameters.n, rows_rotation,
+      focal.prepared_with, &equations, &per_frame, options.num_threads);
   summary.consistency = FrameConsistencyOf(per_frame, summary.sigma_px);
   const double inflation =
       summary.consistency ? summary.consistency->inflation : 1.0;
@@ -544,6 +547,7 @@ StatusOr<RefinementSummary> RefineRefractiveIndex(
     summary.calibration = *propagation;
   }
   summary.normal_equations = std::move(equations);
+  summary.rows_rotation = rows_rotation;
 
   // An estimate pinned at the upper bound is a failure, not a number.
   RCM_RETURN_IF_ERROR(CheckNotPinnedAtUpperBound(summary.n, summary.sigma_n));

@@ -83,9 +83,13 @@ FrameFit FitFrame(
   std::vector<int64_t> chosen;  // indices into prepared.prepared
   // The refinement's normal equations over its inliers (`chosen`).
   std::optional<LocusNormalEquations> own_equations;
+  Eigen::Vector3d own_rows_rotation = Eigen::Vector3d::Zero();  // where taken
   if (SelfCalibrates(rig, options)) {
     RefinementOptions frame_options = options;
     frame_options.self_calibrate_focal = layout.focal;
+    // Its rows at the estimator's linearization rotation, where this frame
+    // pools them (below).
+    frame_options.rows_at_rotation = linearization_rotation;
     StatusOr<RefinementSummary> own =
         RefineRefractiveIndex(rig, frame_matches, frame_options);
     if (own.ok() && own->rotation) {
@@ -116,6 +120,7 @@ FrameFit FitFrame(
       }
       if (chosen.size() == own->inliers.size()) {
         own_equations = std::move(own->normal_equations);
+        own_rows_rotation = own->rows_rotation.value_or(rotation);
       }
     }
   }
@@ -166,13 +171,13 @@ FrameFit FitFrame(
   // linearization rotation when there is one (header), else at the
   // frame's own (whether the frame's refinement self-calibrated or fell
   // back to the calibration's rotation: the intercepts carry where the
-  // rows were taken). The refinement's, when they are at that rotation
-  // and the frame keeps all its inliers (the rows are the same; the
-  // refinement took them at its own n, which the intercepts carry to
-  // first order); else taken here.
+  // rows were taken). The refinement's, which it took at that rotation
+  // (rows_at_rotation above), when the frame keeps all its inliers (the
+  // rows are the same; the refinement took them at its own n, which the
+  // intercepts carry to first order); else taken here.
   const Eigen::Vector3d linearization =
       linearization_rotation.value_or(rotation);
-  if (own_equations && rejected.empty() && linearization == rotation &&
+  if (own_equations && rejected.empty() && linearization == own_rows_rotation &&
       own_equations->information.rows() == layout.Size()) {
     fit.normal_equations = *std::move(own_equations);
   } else if (rig.calibration_uncertainty() || options.systematic_px > 0.0) {

@@ -101,6 +101,8 @@ Status RefinementOptions::Check() const {
               !(n_prior->sigma > 0.0) || !std::isfinite(n_prior->sigma))) {
     error << "the prior on n needs n in [1, 2] and a positive sigma, got "
           << n_prior->n << " +- " << n_prior->sigma;
+  } else if (rows_at_rotation && !rows_at_rotation->allFinite()) {
+    error << "rows_at_rotation must be finite";
   } else if (num_threads < 1) {
     error << "num_threads must be at least 1, got " << num_threads;
   } else {

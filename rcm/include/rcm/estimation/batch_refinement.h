@@ -124,8 +124,12 @@ struct RefinementSummary {
   std::optional<FrameConsistency> consistency;
   // The inliers' normal equations at the solution, over the layout of the
   // propagation (thin ports; calibration_propagation.h), for callers that
-  // pool refinements (the online estimators' frames).
+  // pool refinements (the online estimators' frames), and cam1's rotation
+  // correction they were taken at: the solution's, or
+  // RefinementOptions::rows_at_rotation when the rotation self-calibrated
+  // (unset: the thick port's model).
   std::optional<LocusNormalEquations> normal_equations;
+  std::optional<Eigen::Vector3d> rows_rotation;
 };
 
 // A rig with a thick port (StereoRig::HasThickPort, from a camchain's port

@@ -230,8 +230,9 @@ struct FrameFit {
 // tenths of a degree apart along the ridge where n and the rotation trade,
 // and the pooled n is biased (z mean +1.5 to +2.9 in the pool, +7 on a
 // narrow board, measured). Taken at one point they agree; exact data stay
-// exact (the point is then the truth). The refinement's own normal
-// equations are then not reused.
+// exact (the point is then the truth). The frame's refinement takes its
+// rows there too (RefinementOptions::rows_at_rotation), and they are
+// reused as they are at the frame's own rotation without an estimator.
 FrameFit FitFrame(const StereoRig& rig,
                   const std::vector<StereoCorrespondence>& frame_matches,
                   const RefinementOptions& options,

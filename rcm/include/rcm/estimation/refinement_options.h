@@ -130,6 +130,13 @@ struct RefinementOptions {
   // from cam1's rotation (a narrow field at one depth) it is what makes
   // the rotation observable. Unset (the default): n is the free unknown.
   std::optional<IndexPrior> n_prior;
+  // Where the normal equations (and the uncertainty reported from them)
+  // are taken with cam1's rotation self-calibrated: at this rotation
+  // correction (angle-axis, radians) instead of the solution's, for a
+  // caller that pools frames' rows at one point (FitFrame's linearization
+  // rotation); the solution is the same. Unset (the default): at the
+  // solution. Finite.
+  std::optional<Eigen::Vector3d> rows_at_rotation;
   // Solver iterations per stage; >= 1.
   int max_num_iterations = 100;
   // Threads for evaluating residuals; >= 1.
