@@ -91,7 +91,12 @@
 //                              4.39 s (7.4x), medians 7.2x, in a slow
 //                              phase of the machine; 0.46-0.48 s in a fast
 //                              one, where the straightforward run took
-//                              2.9-3.8 s (docs/numbers.md)
+//                              2.9-3.8 s. On 2026-12-06 (no line search in
+//                              the solves, the preparations threaded, the
+//                              subpixel sampling vectorized, the frames'
+//                              rows taken once): 0.40-0.51 s against
+//                              1.9-4.7 s, 4.8-9.3x over four runs
+//                              (docs/numbers.md)
 //
 // Run e.g.
 //   build/bin/frontend_benchmark

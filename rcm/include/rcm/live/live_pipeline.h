@@ -34,19 +34,21 @@
 //
 // Cost per 720x540 pair (live_benchmark, this project's 2-core machine,
 // whose speed drifts by tens of percent from minute to minute; medians of
-// three runs on 2026-12-05): a whole pair (checks, front end, window,
-// remaps) takes 27-29 ms of CPU and 19 ms of wall time in air or water
-// (BM_LivePipelinePair; 40-50 ms before the refinement's blocks of matches
-// and the maps' noise test; 43 ms of CPU when the window took, and the
-// front end refined, all ~1200 matches). Of it the window's update of its
-// 200 matches and both remaps take 8.4 ms of CPU for a rig read as `rcm`
-// reads a camchain without a sidecar (the default drift and focal drift
-// priors: each pair's refinement estimates cam1's rotation and both focal
-// scales with n, and its normal equations, taken at the window's
-// rotation, carry the lenses' columns). At 20 Hz a pair has 50 ms; the
-// caller drops whole the pairs that come while one is processed
-// (latest_slot.h). The map threshold's default, 1e-3, moves the corrected
-// images' focal length by 0.1 %, below what a metric depth of 1 % needs.
+// three repetitions on 2026-12-06): a whole pair (checks, front end,
+// window, remaps) takes 22-31 ms of CPU and 15-19 ms of wall time in air
+// or water (BM_LivePipelinePair; 22.5-23.3 ms in a fast phase; 40-50 ms
+// before the refinement's blocks of matches and the maps' noise test;
+// 28-34 ms of CPU for the window's update and remaps when it took, and
+// the front end refined, all ~1200 matches). Of it the window's update of
+// its 200 matches takes 4.3-5.5 ms and, with both remaps, 8.7 ms of CPU
+// for a rig read as `rcm` reads a camchain without a sidecar (the default
+// drift and focal drift priors: each pair's refinement estimates cam1's
+// rotation and both focal scales with n, and its normal equations, taken
+// once at the window's rotation, carry the lenses' columns). At 20 Hz a
+// pair has 50 ms; the caller drops whole the pairs that come while one is
+// processed (latest_slot.h). The map threshold's default, 1e-3, moves the
+// corrected images' focal length by 0.1 %, below what a metric depth of
+// 1 % needs.
 //
 // Hold (SetHold): the maps stay at their n and no build starts; the
 // estimation keeps running and is reported. Reset(n): a new window and no
