@@ -189,6 +189,22 @@ TEST(OnlineEstimator, FrameEstimateIsTheBatchOfThatFrame) {
   }
 }
 
+// The dataset rig as calibrated, with the default drift priors (`rig`),
+// and as it is (`truth`): cam1 turned by (0, 0.1, 0.05) deg since.
+struct TurnedRig {
+  StereoRig truth;
+  StereoRig rig;
+};
+TurnedRig TurnedRigWithDriftPriors() {
+  const StereoRig nominal = test::AlphasenseRealisticRig();
+  return {nominal.WithCam1Moved(Eigen::Vector3d(0.0, 0.1, 0.05) * M_PI / 180.0)
+              .value(),
+          nominal
+              .WithCalibrationUncertainty(
+                  CalibrationUncertainty::DefaultDriftPrior())
+              .value()};
+}
+
 // With a calibration uncertainty (the default drift prior, so cam1's
 // rotation is self-calibrated) and the front end's systematic floor, a
 // frame's own estimate counts what the batch's sigma counts on that frame:
@@ -200,14 +216,9 @@ TEST(OnlineEstimator, FrameEstimateIsTheBatchOfThatFrame) {
 // of sigma, not to the solver's tolerance.
 TEST(OnlineEstimator, FrameEstimateWithCalibrationIsTheBatchOfThatFrame) {
   constexpr double kFractionOfSigma = 0.05;
-  const StereoRig nominal = test::AlphasenseRealisticRig();
-  const StereoRig truth =
-      nominal.WithCam1Moved(Eigen::Vector3d(0.0, 0.1, 0.05) * M_PI / 180.0)
-          .value();
-  const StereoRig rig = nominal
-                            .WithCalibrationUncertainty(
-                                CalibrationUncertainty::DefaultDriftPrior())
-                            .value();
+  const TurnedRig turned = TurnedRigWithDriftPriors();
+  const StereoRig& truth = turned.truth;
+  const StereoRig& rig = turned.rig;
   std::vector<StereoCorrespondence> sequence =
       test::ExactSequence(truth, 1.333, 3, 200, 16);
   AddPixelNoise(0.3, 17, &sequence);
@@ -369,14 +380,9 @@ TEST(OnlineEstimator, CreateRejectsInvalidOptions) {
 // same numbers, bit for bit, and not those at the frame's own rotation
 // (the option takes effect); the refinement's solution does not move.
 TEST(FitFrame, RowsAtTheLinearizationAreTheRefinementsTakenThere) {
-  const StereoRig nominal = test::AlphasenseRealisticRig();
-  const StereoRig truth =
-      nominal.WithCam1Moved(Eigen::Vector3d(0.0, 0.1, 0.05) * M_PI / 180.0)
-          .value();
-  const StereoRig rig = nominal
-                            .WithCalibrationUncertainty(
-                                CalibrationUncertainty::DefaultDriftPrior())
-                            .value();
+  const TurnedRig turned = TurnedRigWithDriftPriors();
+  const StereoRig& truth = turned.truth;
+  const StereoRig& rig = turned.rig;
   std::vector<StereoCorrespondence> frame =
       test::ExactSequence(truth, 1.333, 1, 200, 21);
   AddPixelNoise(0.3, 22, &frame);

@@ -296,17 +296,8 @@ Eigen::Matrix2d Camera::ImageFromNormalizedJacobian(
 
 Eigen::Matrix2d Camera::ImageFromNormalizedJacobian(
     const Eigen::Vector2d& normalized) const {
-  double distorted[2];
-  double jacobian[4] = {1.0, 0.0, 0.0, 1.0};
-  RCM_LENS_MODEL_SWITCH(
-      model_, LensModel::DistortWithJacobian(params_.data() + 4, normalized.x(),
-                                             normalized.y(), &distorted[0],
-                                             &distorted[1], jacobian);
-      break;)
-  Eigen::Matrix2d result;
-  result << fx() * jacobian[0], fx() * jacobian[1], fy() * jacobian[2],
-      fy() * jacobian[3];
-  return result;
+  Eigen::Vector2d pixel;  // not wanted; the lens computes it anyway
+  return ImageFromNormalizedJacobian(normalized, &pixel);
 }
 
 std::optional<Eigen::Vector2d> Camera::ProjectNormalized(

@@ -143,7 +143,8 @@ PreparedCorrespondences PrepareCorrespondences(
     const std::vector<StereoCorrespondence>& correspondences, int num_threads) {
   // Prepared in place on the threads, then the failures dropped in order.
   const int64_t count = static_cast<int64_t>(correspondences.size());
-  std::vector<PreparedCorrespondence> all(correspondences.size());
+  PreparedCorrespondences result;
+  result.prepared.resize(correspondences.size());
   std::vector<unsigned char> ok(correspondences.size(), 0);
   constexpr int64_t kMatchesPerChunk = 256;
   ParallelForChunks(
@@ -152,19 +153,18 @@ PreparedCorrespondences PrepareCorrespondences(
         for (int64_t i = begin; i < end; ++i) {
           if (std::optional<PreparedCorrespondence> prepared =
                   PrepareCorrespondence(rig, correspondences[i])) {
-            all[i] = *prepared;
+            result.prepared[i] = *prepared;
             ok[i] = 1;
           }
         }
       });
-  PreparedCorrespondences result;
-  result.prepared.reserve(correspondences.size());
   result.source_index.reserve(correspondences.size());
   for (int64_t i = 0; i < count; ++i) {
     if (!ok[i]) continue;
-    result.prepared.push_back(all[i]);
+    result.prepared[result.source_index.size()] = result.prepared[i];
     result.source_index.push_back(i);
   }
+  result.prepared.resize(result.source_index.size());
   return result;
 }
 

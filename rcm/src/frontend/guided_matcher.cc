@@ -25,8 +25,9 @@ RightIndex IndexRightKeys(const std::vector<LocusKey>& keys) {
   for (size_t j = 0; j < keys.size(); ++j) {
     if (!keys[j].valid) continue;
     order.push_back(static_cast<int>(j));
-    index.max_half_width = std::max(
-        index.max_half_width, 0.5 * std::abs(keys[j].phi[1] - keys[j].phi[0]));
+    index.max_half_width =
+        std::max(index.max_half_width,
+                 0.5 * std::abs(keys[j].phi[1] - keys[j].phi[0]));
   }
   const auto center = [&](int j) {
     return 0.5 * (keys[j].phi[0] + keys[j].phi[1]);
@@ -47,8 +48,8 @@ RightIndex IndexRightKeys(const std::vector<LocusKey>& keys) {
 float Distance(const cv::Mat& a, int i, const cv::Mat& b, int j,
                int norm_type) {
   if (norm_type == cv::NORM_L2) {
-    return std::sqrt(
-        cv::hal::normL2Sqr_(a.ptr<float>(i), b.ptr<float>(j), a.cols));
+    return std::sqrt(cv::hal::normL2Sqr_(a.ptr<float>(i), b.ptr<float>(j),
+                                         a.cols));
   }
   return static_cast<float>(
       cv::hal::normHamming(a.ptr<uchar>(i), b.ptr<uchar>(j), a.cols));
@@ -109,12 +110,12 @@ std::vector<KeypointMatch> MatchInLocusBand(
   ParallelFor(threads, threads, 1, [&](int64_t first, int64_t last) {
     for (int64_t t = first; t < last; ++t) {
       Partial& partial = partials[t];
-      partial.best_left_distance.assign(num_right,
-                                        std::numeric_limits<float>::infinity());
+      partial.best_left_distance.assign(
+          num_right, std::numeric_limits<float>::infinity());
       partial.best_left.assign(num_right, -1);
       const int begin = static_cast<int>(t * chunk);
-      const int end =
-          static_cast<int>(std::min<int64_t>(num_left, (t + 1) * chunk));
+      const int end = static_cast<int>(std::min<int64_t>(num_left,
+                                                         (t + 1) * chunk));
       for (int i = begin; i < end; ++i) {
         const LocusKey& key = left_keys[i];
         if (!key.valid) continue;

@@ -39,8 +39,8 @@ inline bool Inside(const cv::Mat& image, double x, double y) {
 }
 
 // Per thread: the template window, its gradients and the warped patch,
-// and the window's offsets and the warped samples' corners and weights
-// (WarpPatch).
+// and the window's offsets and the warped samples' positions and corners
+// (WarpPatch); sized by Resize, which allocates only when the window grows.
 struct Buffers {
   std::vector<float> patch;
   std::vector<float> dx;
@@ -53,6 +53,28 @@ struct Buffers {
   std::vector<int> x0;
   std::vector<int> y0;
   std::vector<float> top_left, top_right, bottom_left, bottom_right;
+
+  // For a window of (2 half + 1)^2 pixels, in row-major order.
+  void Resize(int half) {
+    const int side = 2 * half + 1;
+    const size_t size = static_cast<size_t>(side) * side;
+    for (std::vector<float>* values :
+         {&patch, &dx, &dy, &warped, &x, &y, &top_left, &top_right,
+          &bottom_left, &bottom_right}) {
+      values->resize(size);
+    }
+    x0.resize(size);
+    y0.resize(size);
+    if (u.size() == size) return;  // the offsets of this window already
+    u.resize(size);
+    v.resize(size);
+    for (int row = -half, k = 0; row <= half; ++row) {
+      for (int column = -half; column <= half; ++column, ++k) {
+        u[k] = column;
+        v[k] = row;
+      }
+    }
+  }
 };
 
 // buffers->warped[k] = Bilinear(image, W (u_k, v_k)) for the window's
@@ -138,27 +160,7 @@ bool RefineOne(const LeftImage& left_image, const cv::Mat& right,
       !Inside(left, left_pixel.x + half + 1, left_pixel.y + half + 1)) {
     return false;
   }
-  buffers->patch.resize(size);
-  buffers->dx.resize(size);
-  buffers->dy.resize(size);
-  buffers->warped.resize(size);
-  for (std::vector<float>* values :
-       {&buffers->x, &buffers->y, &buffers->top_left, &buffers->top_right,
-        &buffers->bottom_left, &buffers->bottom_right}) {
-    values->resize(size);
-  }
-  buffers->x0.resize(size);
-  buffers->y0.resize(size);
-  if (static_cast<int>(buffers->u.size()) != size) {
-    buffers->u.resize(size);
-    buffers->v.resize(size);
-    for (int v = -half, k = 0; v <= half; ++v) {
-      for (int u = -half; u <= half; ++u, ++k) {
-        buffers->u[k] = u;
-        buffers->v[k] = v;
-      }
-    }
-  }
+  buffers->Resize(half);
   Matrix6 hessian = Matrix6::Zero();
   for (int v = -half, k = 0; v <= half; ++v) {
     for (int u = -half; u <= half; ++u, ++k) {

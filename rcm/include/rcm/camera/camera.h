@@ -44,32 +44,32 @@ std::vector<DistortionBound> DistortionBounds(LensModelId model);
 
 // Calls `body` with `LensModel` bound to the static model struct of `id`,
 // e.g. RCM_LENS_MODEL_SWITCH(model_, return LensModel::kNumParams;)
-#define RCM_LENS_MODEL_SWITCH(id, ...)           \
-  switch (id) {                                  \
-    case ::rcm::LensModelId::kPinhole: {         \
-      using LensModel = ::rcm::PinholeLens;      \
-      __VA_ARGS__                                \
-    }                                            \
-    case ::rcm::LensModelId::kRadTan: {          \
-      using LensModel = ::rcm::RadTanLens;       \
-      __VA_ARGS__                                \
-    }                                            \
-    case ::rcm::LensModelId::kEquidistant: {     \
-      using LensModel = ::rcm::EquidistantLens;  \
-      __VA_ARGS__                                \
-    }                                            \
-    case ::rcm::LensModelId::kRational: {        \
-      using LensModel = ::rcm::RationalLens;     \
-      __VA_ARGS__                                \
-    }                                            \
-    case ::rcm::LensModelId::kDoubleSphere: {    \
+#define RCM_LENS_MODEL_SWITCH(id, ...)          \
+  switch (id) {                                 \
+    case ::rcm::LensModelId::kPinhole: {        \
+      using LensModel = ::rcm::PinholeLens;     \
+      __VA_ARGS__                               \
+    }                                           \
+    case ::rcm::LensModelId::kRadTan: {         \
+      using LensModel = ::rcm::RadTanLens;      \
+      __VA_ARGS__                               \
+    }                                           \
+    case ::rcm::LensModelId::kEquidistant: {    \
+      using LensModel = ::rcm::EquidistantLens; \
+      __VA_ARGS__                               \
+    }                                           \
+    case ::rcm::LensModelId::kRational: {       \
+      using LensModel = ::rcm::RationalLens;    \
+      __VA_ARGS__                               \
+    }                                           \
+    case ::rcm::LensModelId::kDoubleSphere: {   \
       using LensModel = ::rcm::DoubleSphereLens; \
-      __VA_ARGS__                                \
-    }                                            \
-    case ::rcm::LensModelId::kEucm: {            \
-      using LensModel = ::rcm::EucmLens;         \
-      __VA_ARGS__                                \
-    }                                            \
+      __VA_ARGS__                               \
+    }                                           \
+    case ::rcm::LensModelId::kEucm: {           \
+      using LensModel = ::rcm::EucmLens;        \
+      __VA_ARGS__                               \
+    }                                           \
   }
 
 class Camera {
