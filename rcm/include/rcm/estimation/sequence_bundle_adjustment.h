@@ -1,0 +1,215 @@
+// SequenceBundleAdjustment: n, cam1's turn since the air calibration and
+// the rig's trajectory from landmarks tracked over a dive, with no target
+// (issue 32; the paper's promise of a model "self-calibrating in real-time
+// and free of known correspondences or calibration targets").
+//
+// Why motion helps. From one stereo pair, n and cam1's rotation w are
+// nearly one unknown for epipolar geometry (docs/design.md Sec. 3:
+// multiple correlation 0.97 on the paper's rig). A thin flat port keeps
+// each camera central, with n acting as a radial distortion of known form
+// (refractive_model.h): seen from many poses, the same landmarks fix it,
+// as a moving camera self-calibrates its distortion; the calibrated
+// baseline then fixes w and the metric scale.
+//
+// The problem. Keyframes f = 0..F-1 with the left camera's pose
+// cam0_from_world_f, landmarks X_l (world = keyframe 0's left camera),
+// observations u_fcl of landmark l by camera c in keyframe f. Minimized:
+//
+//   sum_fcl rho(|pi_c(n, w, u, cam0_from_world_f, X_l) - u_fcl|^2)
+//
+// pi_c the refractive projection of stereo_track_reprojection_error.h, rho
+// a robust loss (stage 1), then the plain least squares over the inliers
+// (stage 2, |r| <= inlier_threshold_px), as the epipolar estimator
+// (batch_refinement.h). Keyframe 0's pose is held (the gauge of the
+// position and orientation), the baseline |t| is the calibration's (the
+// scale); n is bounded to [1, 2]. Ceres' sparse Schur solver eliminates
+// the landmarks; rotations live on the quaternion manifold, the
+// translation's direction (when free) on the sphere.
+//
+// The uncertainty (docs/design.md Sec. 3's total sigma_n):
+//
+//   sigma_n^2 = sigma_n_noise^2 + sigma_n_calibration^2
+//
+// sigma_n_noise from the stage-2 covariance (J^T J)^-1 scaled by the
+// pixel noise s^2 = sum r^2 / (N - p) over the inliers; the rotation's
+// covariance likewise, and `correlation_n_rotation` the multiple
+// correlation of n with w that the data leave (0: motion separates them;
+// near 1: the data cannot tell them apart). sigma_n_calibration carries
+// what the calibration leaves uncertain and the bundle holds (the
+// translation's change dt, the lenses; calibration_uncertainty.h): the
+// joint covariance of [w; dt; lenses] is split into its principal
+// directions e_k (eigenvalues l_k), the bundle is solved again
+// (Gauss-Newton steps from its solution) with the rig moved by
+// +- sqrt(l_k) e_k, and the parts it estimates (the turn, the direction
+// when free) absorb their own moves:
+//
+//   sigma_n_calibration^2 = sum_k ((n(+k) - n(-k)) / 2)^2.
+//
+// Refusals, one line and never a number: tracks that reference a frame,
+// camera or landmark that does not exist or hold a non-finite pixel; a
+// keyframe that shares too few landmarks with the ones before it; fewer
+// inlier observations than unknowns; a singular covariance (the data do
+// not observe n); n pinned at the upper bound 2, which no medium reaches.
+#ifndef RCM_ESTIMATION_SEQUENCE_BUNDLE_ADJUSTMENT_H_
+#define RCM_ESTIMATION_SEQUENCE_BUNDLE_ADJUSTMENT_H_
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "rcm/estimation/refinement_options.h"
+#include "rcm/estimation/stereo_track_reprojection_error.h"
+#include "rcm/geometry/rigid3d.h"
+#include "rcm/stereo/stereo_rig.h"
+#include "rcm/util/status.h"
+
+namespace rcm {
+
+// One observation of a tracked landmark: keyframe `frame` (0-based index
+// of the bundle's keyframes), camera 0 (left) or 1 (right), raw pixel.
+struct StereoTrackObservation {
+  int frame = 0;
+  int camera = 0;
+  int landmark = 0;
+  Eigen::Vector2d pixel = Eigen::Vector2d::Zero();
+};
+
+// Landmarks tracked over keyframes.
+struct StereoTracks {
+  int num_frames = 0;
+  int num_landmarks = 0;
+  std::vector<StereoTrackObservation> observations;
+
+  // Indices in range, pixels finite, at least two keyframes: "observation
+  // 12 names landmark 40 of 30".
+  Status Check() const;
+};
+
+struct SequenceBundleOptions {
+  // Where n starts, and the index the initial landmarks are triangulated
+  // with: water by default; a prior estimate (the epipolar one) is better.
+  double initial_n = 1.333;
+  // Estimate cam1's rotation change since the calibration (the drift the
+  // epipolar estimator cannot tell from n); false holds the camchain's.
+  bool refine_rotation = true;
+  // Estimate the direction of cam1_from_cam0's translation too (its
+  // length stays the calibration's: the scale).
+  bool refine_translation_direction = false;
+  // Stage 1's loss on the reprojection error, and its scale in pixels.
+  RobustLoss loss = RobustLoss::kCauchy;
+  double loss_scale_px = 1.0;
+  // Observations within this many pixels of their projection after stage 1
+  // are stage 2's inliers.
+  double inlier_threshold_px = 2.0;
+  // Triangulation: rays closer to parallel than this (degrees) do not
+  // initialize a landmark (its depth would be noise).
+  double min_triangulation_angle_deg = 0.1;
+  // A keyframe needs this many landmarks of the keyframes before it to be
+  // placed (its pose is the PnP of those).
+  int min_shared_landmarks = 8;
+  // Ceres iterations of each stage.
+  int max_iterations = 100;
+  // Undamped Gauss-Newton steps of each re-solve of the calibration
+  // propagation, from the solution to the moved rig's: the first is the
+  // linear response (n's change within 0.2 % of the converged one in the
+  // tests), the next two make a turn the bundle estimates vanish from it
+  // to 1e-8.
+  int max_propagation_iterations = 3;
+  // Carry the calibration's remaining uncertainty into sigma_n (above).
+  bool propagate_calibration = true;
+  // Principal directions of the calibration's covariance below this
+  // fraction of its largest eigenvalue are dropped from the propagation.
+  double propagation_eigenvalue_floor = 1e-12;
+  // Threads of Ceres and of the covariance.
+  int num_threads = 2;
+
+  // Errors name the field: "initial n = 0.9 is outside [1, 2]".
+  Status Check() const;
+};
+
+// The bundle's unknowns.
+struct SequenceBundleState {
+  double n = 1.333;
+  // w of StereoRig::WithCam1Moved: cam1 turned about its own centre
+  // (radians, cam1 frame).
+  Eigen::Vector3d cam1_rotation = Eigen::Vector3d::Zero();
+  // Unit direction of cam1_from_cam0's translation before the turn (cam1
+  // frame): the calibration's t / |t| unless refined.
+  Eigen::Vector3d cam1_direction = Eigen::Vector3d::UnitX();
+  // One per keyframe; keyframe 0's is the identity (the world frame).
+  std::vector<Rigid3d> cam0_from_world;
+  // World points, metres; NaN for a landmark that could not be placed.
+  std::vector<Eigen::Vector3d> landmarks;
+};
+
+struct SequenceBundleResult {
+  static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+  SequenceBundleState state;
+  double n = kNaN;
+  // Total, and its parts (above).
+  double sigma_n = kNaN;
+  double sigma_n_noise = kNaN;
+  double sigma_n_calibration = kNaN;
+  // Covariance of cam1_rotation from the noise, rad^2 (zero when held).
+  Eigen::Matrix3d rotation_covariance = Eigen::Matrix3d::Zero();
+  // Multiple correlation of n with cam1_rotation left by the data (NaN
+  // when the rotation is held).
+  double correlation_n_rotation = kNaN;
+  // Pixel noise estimated from the stage-2 residuals.
+  double pixel_sigma = kNaN;
+  int64_t num_observations = 0;  // given
+  int64_t num_inliers = 0;       // in stage 2
+  int num_landmarks = 0;         // placed and used in stage 2
+  int num_frames = 0;
+  int iterations = 0;  // Ceres iterations, both stages
+  // Principal directions of the calibration the propagation moved.
+  int propagation_directions = 0;
+
+  // world_from_cam0 of keyframe f: the left camera's pose in keyframe 0's
+  // frame (the trajectory TUM files hold).
+  Rigid3d WorldFromCam0(int f) const {
+    return state.cam0_from_world[f].Inverse();
+  }
+};
+
+class SequenceBundleAdjustment {
+ public:
+  // Fails when the options do not Check or the rig has no baseline.
+  static StatusOr<SequenceBundleAdjustment> Create(
+      const StereoRig& rig, const SequenceBundleOptions& options);
+
+  // A starting state from the tracks alone: n = options.initial_n, w = 0,
+  // each landmark triangulated from its first stereo observation (or from
+  // two left views once their poses are known), keyframe 0 the world and
+  // each later keyframe placed by the PnP (OpenCV's RANSAC, then its
+  // iterative refinement) of the landmarks already placed, in water
+  // bearings (a central camera: the thin port, or a thick one made
+  // central at 2 m). Errors: tracks that do not Check, a keyframe with
+  // fewer than min_shared_landmarks placed landmarks in view.
+  StatusOr<SequenceBundleState> Initialize(const StereoTracks& tracks) const;
+
+  // Stages 1 and 2 from `initial`, then the uncertainty (above).
+  StatusOr<SequenceBundleResult> Solve(
+      const StereoTracks& tracks, const SequenceBundleState& initial) const;
+  // Initialize, then Solve.
+  StatusOr<SequenceBundleResult> Solve(const StereoTracks& tracks) const;
+
+  const StereoRig& rig() const { return rig_; }
+  const SequenceBundleOptions& options() const { return options_; }
+
+ private:
+  SequenceBundleAdjustment(const StereoRig& rig,
+                           const SequenceBundleOptions& options)
+      : rig_(rig), options_(options) {}
+
+  StereoRig rig_;
+  SequenceBundleOptions options_;
+};
+
+}  // namespace rcm
+
+#endif  // RCM_ESTIMATION_SEQUENCE_BUNDLE_ADJUSTMENT_H_

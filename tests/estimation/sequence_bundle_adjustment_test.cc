@@ -1,0 +1,368 @@
+#include "rcm/estimation/sequence_bundle_adjustment.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "rcm/camera/refractive_camera.h"
+#include "rcm/geometry/calibration_uncertainty.h"
+#include "support/test_rigs.h"
+
+namespace rcm {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDeg = kPi / 180.0;
+
+// Noise-free data and a converged Ceres solve: the unknowns agree with the
+// truth to rounding amplified by the problem's conditioning (n's
+// sensitivity is ~1e3 px per unit, a pose's ~1e3 px per metre).
+constexpr double kExactTolerance = 1e-9;
+
+// cam1's turn since the calibration in the tests: 0.5 degrees about a skew
+// axis (the drift).
+Eigen::Vector3d TrueTurn() {
+  return 0.5 * kDeg * Eigen::Vector3d(0.3, 1.0, 0.2).normalized();
+}
+
+struct Dive {
+  StereoTracks tracks;
+  std::vector<Rigid3d> cam0_from_world;  // truth
+  std::vector<Eigen::Vector3d> landmarks;
+};
+
+// A rig moving through a field of landmarks 1.5-8 m ahead: `frames`
+// keyframes on a gently curving path (0.12 m apart, turning up to ~8
+// degrees), every landmark projected exactly through `truth`'s refractive
+// cameras at index n, plus Gaussian noise of `sigma_px`.
+Dive MakeDive(const StereoRig& truth, double n, int frames, int landmarks,
+              double sigma_px, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  Dive dive;
+  for (int l = 0; l < landmarks; ++l) {
+    const double z = 1.5 + 6.5 * unit(rng);
+    dive.landmarks.emplace_back((unit(rng) - 0.5) * 1.6 * z + 0.06 * frames,
+                                (unit(rng) - 0.5) * 1.2 * z, z);
+  }
+  for (int f = 0; f < frames; ++f) {
+    const double s = static_cast<double>(f);
+    const Eigen::Matrix3d world_from_cam0_rotation =
+        (Eigen::AngleAxisd(0.04 * std::sin(0.5 * s), Eigen::Vector3d::UnitX()) *
+         Eigen::AngleAxisd(0.14 * std::sin(0.3 * s), Eigen::Vector3d::UnitY()) *
+         Eigen::AngleAxisd(0.03 * s / frames, Eigen::Vector3d::UnitZ()))
+            .toRotationMatrix();
+    const Eigen::Vector3d position(0.12 * s, 0.05 * std::sin(0.7 * s),
+                                   0.04 * s);
+    dive.cam0_from_world.push_back(
+        Rigid3d{world_from_cam0_rotation, position}.Inverse());
+  }
+  // The exact port when the rig has one (ImageFromPointInWater is exact at
+  // every depth; the reference depth only shapes the bearings).
+  const auto camera_of = [&](const Camera& camera, bool left_camera) {
+    if (!truth.ports()) return RefractiveCamera::Create(camera, n).value();
+    const FlatPort& port =
+        left_camera ? truth.ports()->left : truth.ports()->right;
+    return RefractiveCamera::CreateWithPort(camera, n, port, 2.0).value();
+  };
+  const RefractiveCamera left = camera_of(truth.left(), true);
+  const RefractiveCamera right = camera_of(truth.right(), false);
+  dive.tracks.num_frames = frames;
+  dive.tracks.num_landmarks = landmarks;
+  for (int f = 0; f < frames; ++f) {
+    for (int l = 0; l < landmarks; ++l) {
+      const Eigen::Vector3d p0 = dive.cam0_from_world[f] * dive.landmarks[l];
+      const Eigen::Vector3d p1 = truth.right_from_left() * p0;
+      for (int c = 0; c < 2; ++c) {
+        const RefractiveCamera& camera = c == 0 ? left : right;
+        const std::optional<Eigen::Vector2d> pixel =
+            camera.ImageFromPointInWater(c == 0 ? p0 : p1);
+        if (!pixel || !camera.camera().InImage(*pixel)) continue;
+        StereoTrackObservation observation;
+        observation.frame = f;
+        observation.camera = c;
+        observation.landmark = l;
+        observation.pixel =
+            *pixel + sigma_px * Eigen::Vector2d(noise(rng), noise(rng));
+        dive.tracks.observations.push_back(observation);
+      }
+    }
+  }
+  return dive;
+}
+
+// The camchain the user holds (cam1 as calibrated in air) and the rig as
+// it is in the dive (cam1 turned since).
+StereoRig Calibration() { return test::AlphasenseRealisticRig(); }
+StereoRig TurnedTruth() {
+  return Calibration().WithCam1Moved(TrueTurn()).value();
+}
+
+double RotationError(const Rigid3d& a, const Rigid3d& b) {
+  return Eigen::AngleAxisd(a.rotation.transpose() * b.rotation).angle();
+}
+
+TEST(SequenceBundleAdjustment, NoiseFreeRecoversNTurnAndEveryPose) {
+  const double n = 1.34;
+  const Dive dive = MakeDive(TurnedTruth(), n, 8, 300, 0.0, 1);
+  SequenceBundleOptions options;
+  options.initial_n = 1.333;  // water's tabulated index, not the truth
+  const SequenceBundleAdjustment bundle =
+      SequenceBundleAdjustment::Create(Calibration(), options).value();
+  const StatusOr<SequenceBundleResult> result = bundle.Solve(dive.tracks);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  EXPECT_NEAR(result->n, n, kExactTolerance);
+  EXPECT_LT((result->state.cam1_rotation - TrueTurn()).norm(), kExactTolerance);
+  ASSERT_EQ(result->state.cam0_from_world.size(), 8u);
+  for (int f = 0; f < 8; ++f) {
+    EXPECT_LT(RotationError(result->state.cam0_from_world[f],
+                            dive.cam0_from_world[f]),
+              kExactTolerance)
+        << "keyframe " << f;
+    EXPECT_LT((result->state.cam0_from_world[f].translation -
+               dive.cam0_from_world[f].translation)
+                  .norm(),
+              kExactTolerance)
+        << "keyframe " << f;
+  }
+  int compared = 0;
+  for (size_t l = 0; l < dive.landmarks.size(); ++l) {
+    if (!result->state.landmarks[l].allFinite()) continue;
+    EXPECT_LT((result->state.landmarks[l] - dive.landmarks[l]).norm(), 1e-8)
+        << "landmark " << l;
+    ++compared;
+  }
+  EXPECT_EQ(compared, result->num_landmarks);
+  EXPECT_GT(result->num_landmarks, 200);
+  // Every observation of a placed landmark is an inlier.
+  int64_t placed = 0;
+  for (const StereoTrackObservation& o : dive.tracks.observations) {
+    placed += result->state.landmarks[o.landmark].allFinite() ? 1 : 0;
+  }
+  EXPECT_EQ(result->num_inliers, placed);
+  // Motion separates n from the turn: the epipolar estimate's correlation
+  // on this rig is 0.97 (docs/design.md).
+  EXPECT_LT(result->correlation_n_rotation, 0.9);
+}
+
+TEST(SequenceBundleAdjustment, TranslationDirectionRecoveredWhenFree) {
+  const double n = 1.34;
+  const Eigen::Vector3d dt(0.0, 0.0006, -0.0008);  // metres, cam1 frame
+  const StereoRig calibration = Calibration();
+  const StereoRig truth = calibration.WithCam1Moved(TrueTurn(), dt).value();
+  // The bundle holds the calibration's baseline length: the truth's
+  // translation rescaled to it, so that the data are exact.
+  const Eigen::Vector3d t_truth = truth.right_from_left().translation;
+  const double b = calibration.Baseline();
+  const StereoRig exact =
+      StereoRig::Create(truth.left(), truth.right(),
+                        Rigid3d{truth.right_from_left().rotation,
+                                t_truth * (b / t_truth.norm())})
+          .value();
+  const Dive dive = MakeDive(exact, n, 8, 300, 0.0, 2);
+  SequenceBundleOptions options;
+  options.refine_translation_direction = true;
+  const SequenceBundleAdjustment bundle =
+      SequenceBundleAdjustment::Create(calibration, options).value();
+  const StatusOr<SequenceBundleResult> result = bundle.Solve(dive.tracks);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  EXPECT_NEAR(result->n, n, kExactTolerance);
+  EXPECT_LT((result->state.cam1_rotation - TrueTurn()).norm(), kExactTolerance);
+  // u = exp(-[w]x) t' / b.
+  const Eigen::Vector3d direction =
+      Eigen::AngleAxisd(TrueTurn().norm(), TrueTurn().normalized())
+          .toRotationMatrix()
+          .transpose() *
+      exact.right_from_left().translation / b;
+  EXPECT_LT((result->state.cam1_direction - direction).norm(), kExactTolerance);
+}
+
+// A thick port (air gap, glass, a tilted normal): the bundle projects
+// through the exact port (flat_port_projection.h), which the initializer
+// only approximates (a central camera at 2 m).
+TEST(SequenceBundleAdjustment, NoiseFreeThroughThickPorts) {
+  const double n = 1.34;
+  FlatPort port;
+  port.air_gap = 0.008;
+  port.glass_thickness = 0.01;
+  port.normal = Eigen::Vector3d(0.02, -0.01, 1.0).normalized();
+  const StereoRig calibration = Calibration().WithPorts(port, port).value();
+  const StereoRig truth = calibration.WithCam1Moved(TrueTurn()).value();
+  const Dive dive = MakeDive(truth, n, 8, 300, 0.0, 7);
+  const StatusOr<SequenceBundleResult> result =
+      SequenceBundleAdjustment::Create(calibration, SequenceBundleOptions())
+          .value()
+          .Solve(dive.tracks);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  EXPECT_NEAR(result->n, n, kExactTolerance);
+  EXPECT_LT((result->state.cam1_rotation - TrueTurn()).norm(), kExactTolerance);
+  for (int f = 0; f < 8; ++f) {
+    EXPECT_LT((result->state.cam0_from_world[f].translation -
+               dive.cam0_from_world[f].translation)
+                  .norm(),
+              kExactTolerance)
+        << "keyframe " << f;
+  }
+}
+
+// 0.5 px of pixel noise: n within 4 of its reported noise sigma (a 6e-5
+// chance for an honest sigma), and the estimated pixel noise within 5 % of
+// the truth (~60k residuals: its relative standard error is ~0.3 %, the
+// bias of the dropped outliers of a Gaussian beyond 2 px is nil).
+TEST(SequenceBundleAdjustment, NoisyWithinItsSigma) {
+  const double n = 1.34;
+  const double sigma_px = 0.5;
+  const Dive dive = MakeDive(TurnedTruth(), n, 10, 400, sigma_px, 3);
+  const SequenceBundleAdjustment bundle =
+      SequenceBundleAdjustment::Create(Calibration(), SequenceBundleOptions())
+          .value();
+  const StatusOr<SequenceBundleResult> result = bundle.Solve(dive.tracks);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  EXPECT_GT(result->sigma_n_noise, 0.0);
+  EXPECT_LT(std::abs(result->n - n), 4.0 * result->sigma_n_noise)
+      << "n " << result->n << " +- " << result->sigma_n_noise;
+  EXPECT_NEAR(result->pixel_sigma, sigma_px, 0.05 * sigma_px);
+  const double turn_error = (result->state.cam1_rotation - TrueTurn()).norm();
+  EXPECT_LT(turn_error, 4.0 * std::sqrt(result->rotation_covariance.trace()));
+  // No calibration uncertainty on the test rig: the noise is the total.
+  EXPECT_EQ(result->propagation_directions, 0);
+  EXPECT_DOUBLE_EQ(result->sigma_n, result->sigma_n_noise);
+}
+
+// The default drift prior and focal drift (what a camchain without a
+// sidecar gets): the bundle estimates the turn, so the rotation's share
+// vanishes from sigma_n_calibration, while the translation and the lenses
+// stay in it.
+TEST(SequenceBundleAdjustment, CalibrationUncertaintyCarriedIntoSigma) {
+  const double n = 1.34;
+  CalibrationUncertainty uncertainty =
+      CalibrationUncertainty::DefaultDriftPrior();
+  const StereoRig calibration = Calibration();
+  const int p_l = calibration.left().num_params();
+  const int p_r = calibration.right().num_params();
+  uncertainty.AddFocalDrift(
+      0.003,
+      Eigen::Map<const Eigen::VectorXd>(calibration.left().params(), p_l),
+      Eigen::Map<const Eigen::VectorXd>(calibration.right().params(), p_r));
+  const StereoRig uncertain =
+      calibration.WithCalibrationUncertainty(uncertainty).value();
+  const Dive dive = MakeDive(TurnedTruth(), n, 6, 250, 0.0, 4);
+  SequenceBundleOptions options;
+  const SequenceBundleAdjustment bundle =
+      SequenceBundleAdjustment::Create(uncertain, options).value();
+  const StatusOr<SequenceBundleResult> result = bundle.Solve(dive.tracks);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  EXPECT_NEAR(result->n, n, kExactTolerance);
+  EXPECT_GT(result->propagation_directions, 0);
+  EXPECT_GT(result->sigma_n_calibration, 0.0);
+  EXPECT_TRUE(std::isfinite(result->sigma_n_calibration));
+  EXPECT_NEAR(result->sigma_n,
+              std::hypot(result->sigma_n_noise, result->sigma_n_calibration),
+              1e-15);
+
+  // The same with only a rotation uncertain: the bundle absorbs it, so it
+  // moves n by rounding only.
+  const StereoRig turned_only =
+      calibration
+          .WithCalibrationUncertainty(
+              CalibrationUncertainty::DriftPrior(0.1 * kDeg, 0.0))
+          .value();
+  const StatusOr<SequenceBundleResult> absorbed =
+      SequenceBundleAdjustment::Create(turned_only, options)
+          .value()
+          .Solve(dive.tracks);
+  ASSERT_TRUE(absorbed.ok()) << absorbed.status().message();
+  EXPECT_EQ(absorbed->propagation_directions, 3);
+  EXPECT_LT(absorbed->sigma_n_calibration, 1e-8);
+}
+
+TEST(SequenceBundleAdjustment, SolvedFromTheTruthStaysThere) {
+  // The functor's residual at the truth is the RefractiveCamera's pixel
+  // minus the observed one (zero), for both cameras.
+  const double n = 1.36;
+  const StereoRig rig = Calibration();
+  const Dive dive = MakeDive(rig, n, 2, 50, 0.0, 5);
+  SequenceBundleState truth;
+  truth.n = n;
+  truth.cam1_direction = rig.right_from_left().translation.normalized();
+  truth.cam0_from_world = dive.cam0_from_world;
+  truth.landmarks = dive.landmarks;
+  // Solving from the truth stays there: every residual is zero.
+  SequenceBundleOptions options;
+  options.propagate_calibration = false;
+  const StatusOr<SequenceBundleResult> result =
+      SequenceBundleAdjustment::Create(rig, options)
+          .value()
+          .Solve(dive.tracks, truth);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  EXPECT_NEAR(result->n, n, 1e-12);
+  EXPECT_LT(result->state.cam1_rotation.norm(), 1e-12);
+}
+
+TEST(SequenceBundleAdjustment, BadTracksRefusedInOneLine) {
+  const SequenceBundleAdjustment bundle =
+      SequenceBundleAdjustment::Create(Calibration(), SequenceBundleOptions())
+          .value();
+  StereoTracks tracks;
+  tracks.num_frames = 2;
+  tracks.num_landmarks = 1;
+  tracks.observations.push_back({0, 0, 3, Eigen::Vector2d(10, 10)});
+  StatusOr<SequenceBundleResult> result = bundle.Solve(tracks);
+  ASSERT_FALSE(result.ok());
+  EXPECT_EQ(result.status().message(), "observation 0 names landmark 3 of 1");
+  tracks.observations = {{0, 2, 0, Eigen::Vector2d(10, 10)}};
+  EXPECT_FALSE(bundle.Solve(tracks).ok());
+  tracks.observations = {{5, 0, 0, Eigen::Vector2d(10, 10)}};
+  EXPECT_FALSE(bundle.Solve(tracks).ok());
+  tracks.observations = {{0, 0, 0, Eigen::Vector2d(NAN, 10)}};
+  EXPECT_FALSE(bundle.Solve(tracks).ok());
+  tracks.num_frames = 1;
+  tracks.observations = {{0, 0, 0, Eigen::Vector2d(10, 10)}};
+  EXPECT_FALSE(bundle.Solve(tracks).ok());
+}
+
+TEST(SequenceBundleAdjustment, BrokenTrackChainRefused) {
+  // Keyframe 2 shares no landmark with keyframes 0-1.
+  Dive first = MakeDive(Calibration(), 1.34, 2, 100, 0.0, 6);
+  StereoTracks tracks = first.tracks;
+  tracks.num_frames = 3;
+  tracks.num_landmarks = 200;
+  for (const StereoTrackObservation& o : first.tracks.observations) {
+    if (o.frame != 0) continue;
+    StereoTrackObservation moved = o;
+    moved.frame = 2;
+    moved.landmark += 100;
+    tracks.observations.push_back(moved);
+  }
+  const StatusOr<SequenceBundleResult> result =
+      SequenceBundleAdjustment::Create(Calibration(), SequenceBundleOptions())
+          .value()
+          .Solve(tracks);
+  ASSERT_FALSE(result.ok());
+  EXPECT_NE(result.status().message().find("keyframe 2 sees 0 landmarks"),
+            std::string::npos)
+      << result.status().message();
+}
+
+TEST(SequenceBundleOptions, CheckNamesTheField) {
+  SequenceBundleOptions options;
+  EXPECT_TRUE(options.Check().ok());
+  options.initial_n = 0.9;
+  EXPECT_EQ(options.Check().message(), "initial n = 0.9 is outside [1, 2]");
+  options = SequenceBundleOptions();
+  options.min_shared_landmarks = 3;
+  EXPECT_FALSE(options.Check().ok());
+  options = SequenceBundleOptions();
+  options.num_threads = 0;
+  EXPECT_FALSE(options.Check().ok());
+  options = SequenceBundleOptions();
+  options.loss_scale_px = -1.0;
+  EXPECT_FALSE(options.Check().ok());
+}
+
+}  // namespace
+}  // namespace rcm
