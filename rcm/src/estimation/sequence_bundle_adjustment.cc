@@ -242,16 +242,16 @@ StageResult SolveStage(const RigConstants& constants,
     // Steps from a solution to the nearby one of a moved rig: undamped.
     solver.initial_trust_region_radius = 1e16;
   }
-  // The least squares converge to rounding (quadratically: 4-6 iterations
+  // The least squares converge to rounding (quadratically: 4-7 iterations
   // from stage 1's solution), so the noise-free bundle recovers its
   // unknowns to 1e-9 (sequence_bundle_adjustment_test.cc). The robust
-  // stage only sorts the inliers: under Cauchy's loss Ceres' corrected
-  // Gauss-Newton converges linearly, and a relative decrease of 1e-8 ends
-  // it ~40 iterations before rounding does, where the cost has long
-  // stopped moving (10 keyframes, 0.5 px: 1240.4239 from iteration 25).
-  solver.function_tolerance = robust ? 1e-8 : 1e-12;
+  // stage only sorts the inliers (2 px): under Cauchy's loss Ceres'
+  // corrected Gauss-Newton converges linearly, creeping by 1e-6 of the
+  // cost per iteration for 100 iterations on a rendered dive, so it ends
+  // at Ceres' default relative decrease of 1e-6 (~10 iterations).
+  solver.function_tolerance = robust ? 1e-6 : 1e-12;
   solver.gradient_tolerance = 1e-15;
-  solver.parameter_tolerance = robust ? 1e-10 : 1e-12;
+  solver.parameter_tolerance = robust ? 1e-8 : 1e-12;
   solver.num_threads = options.num_threads;
   solver.logging_type = ceres::SILENT;
   ceres::Solve(solver, &problem, &result.summary);
@@ -353,38 +353,6 @@ StatusOr<StereoRig> MovedRig(const StereoRig& rig,
 }
 
 }  // namespace
-
-Status StereoTracks::Check() const {
-  if (num_frames < 2) {
-    return Status::Error("the bundle needs at least 2 keyframes, not " +
-                         std::to_string(num_frames));
-  }
-  if (num_landmarks < 1) {
-    return Status::Error("the bundle needs landmarks, not " +
-                         std::to_string(num_landmarks));
-  }
-  for (size_t i = 0; i < observations.size(); ++i) {
-    const StereoTrackObservation& o = observations[i];
-    const std::string name = "observation " + std::to_string(i);
-    if (o.frame < 0 || o.frame >= num_frames) {
-      return Status::Error(name + " names keyframe " + std::to_string(o.frame) +
-                           " of " + std::to_string(num_frames));
-    }
-    if (o.camera != 0 && o.camera != 1) {
-      return Status::Error(name + " names camera " + std::to_string(o.camera) +
-                           " (0 left, 1 right)");
-    }
-    if (o.landmark < 0 || o.landmark >= num_landmarks) {
-      return Status::Error(name + " names landmark " +
-                           std::to_string(o.landmark) + " of " +
-                           std::to_string(num_landmarks));
-    }
-    if (!o.pixel.allFinite()) {
-      return Status::Error(name + " has a non-finite pixel");
-    }
-  }
-  return Status::Ok();
-}
 
 Status SequenceBundleOptions::Check() const {
   if (!(initial_n >= RefractiveCamera::kMinIndex &&

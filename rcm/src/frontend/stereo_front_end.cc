@@ -223,6 +223,7 @@ StatusOr<StereoMatches> StereoFrontEnd::Match(
   RefineRightPixels(left, right, left_points, &right_points, &kept,
                     options_.subpixel);
   result.matches.reserve(left_points.size());
+  result.left_keypoints_of_matches.reserve(left_points.size());
   for (size_t i = 0; i < left_points.size(); ++i) {
     if (!kept[i]) continue;
     StereoCorrespondence correspondence;
@@ -238,6 +239,7 @@ StatusOr<StereoMatches> StereoFrontEnd::Match(
       continue;
     }
     result.matches.push_back(correspondence);
+    result.left_keypoints_of_matches.push_back(descriptor_matches[i].left);
   }
   result.timings.refine_ms = MillisecondsSince(refine_start);
   result.timings.total_ms = MillisecondsSince(start);

@@ -63,30 +63,11 @@
 #include "rcm/estimation/refinement_options.h"
 #include "rcm/estimation/stereo_track_reprojection_error.h"
 #include "rcm/geometry/rigid3d.h"
+#include "rcm/geometry/stereo_tracks.h"
 #include "rcm/stereo/stereo_rig.h"
 #include "rcm/util/status.h"
 
 namespace rcm {
-
-// One observation of a tracked landmark: keyframe `frame` (0-based index
-// of the bundle's keyframes), camera 0 (left) or 1 (right), raw pixel.
-struct StereoTrackObservation {
-  int frame = 0;
-  int camera = 0;
-  int landmark = 0;
-  Eigen::Vector2d pixel = Eigen::Vector2d::Zero();
-};
-
-// Landmarks tracked over keyframes.
-struct StereoTracks {
-  int num_frames = 0;
-  int num_landmarks = 0;
-  std::vector<StereoTrackObservation> observations;
-
-  // Indices in range, pixels finite, at least two keyframes: "observation
-  // 12 names landmark 40 of 30".
-  Status Check() const;
-};
 
 struct SequenceBundleOptions {
   // Where n starts, and the index the initial landmarks are triangulated

@@ -97,6 +97,10 @@ struct FrontEndTimings {
 
 struct StereoMatches {
   std::vector<StereoCorrespondence> matches;  // raw pixels
+  // Per match, the index of its left keypoint in the detected pair's
+  // features[0] (whose pixel is the match's left pixel): what a tracker
+  // links across pairs by its descriptor (stereo_tracker.h).
+  std::vector<int> left_keypoints_of_matches;
   int left_keypoints = 0;
   int right_keypoints = 0;
   int descriptor_matches = 0;    // after stage 3
