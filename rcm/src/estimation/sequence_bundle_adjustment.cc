@@ -1,6 +1,5 @@
 #include "rcm/estimation/sequence_bundle_adjustment.h"
 
-#include <ceres/covariance.h>
 #include <ceres/manifold.h>
 #include <ceres/ordered_groups.h>
 #include <ceres/problem.h>
@@ -10,8 +9,10 @@
 #include <ceres/sphere_manifold.h>
 #include <glog/logging.h>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -22,6 +23,7 @@
 
 #include "rcm/camera/camera.h"
 #include "rcm/camera/refractive_camera.h"
+#include "rcm/estimation/batch_refinement.h"
 #include "rcm/util/number_format.h"
 
 namespace rcm {
@@ -32,6 +34,11 @@ constexpr double kPi = 3.14159265358979323846;
 // the initial bearings, metres (RefractiveCamera::CreateWithPort): the
 // bundle then projects through the exact port.
 constexpr double kInitialReferenceDepth = 2.0;
+// The initial PnP's RANSAC threshold, pixels: the landmarks it places are
+// triangulated with the stale calibration at the initial n, which puts
+// them off by metres on a narrow rig whose cam1 turned a degree (2 px lost
+// keyframes there); a mistracked point is off by tens of pixels.
+constexpr double kPnpThresholdPx = 8.0;
 // n this close to the upper bound is pinned there.
 constexpr double kBoundTolerance = 1e-9;
 // Up to this many keyframes the Schur complement is solved dense.
@@ -159,6 +166,134 @@ struct StageResult {
   Eigen::Matrix3d c_ww = Eigen::Matrix3d::Zero();
 };
 
+// The covariance of n and cam1's turn at the solution, (J^T J)^-1's
+// entries, with the landmarks eliminated exactly: with the columns ordered
+// [landmarks; p], p = [n; w; u; poses 1..F-1] (tangent spaces), and
+// H = J^T J,
+//
+//   S = H_pp - sum_l H_pl H_ll^-1 H_lp       (each H_ll a 3 x 3 block)
+//
+// is the information of p with the landmarks unknown, and S^-1 their
+// marginal covariance. S is small (4 + 6 (F - 1)), so it is factored
+// densely (LDLT) and refused as singular where its reciprocal condition is
+// below 1e-14; a landmark's own block below that is a landmark without
+// depth. (Ceres' Covariance with SPARSE_QR decides the rank over all of J
+// at once, and called a Monte Carlo trial with a lens change rank
+// deficient by one whose S is well conditioned.)
+void ReducedCovariance(ceres::Problem& problem, Blocks& blocks, bool rotation,
+                       bool direction, int num_threads, StageResult* result) {
+  std::vector<double*> order;
+  for (size_t l = 0; l < blocks.landmarks.size(); ++l) {
+    double* landmark = blocks.landmarks[l].data();
+    if (problem.HasParameterBlock(landmark)) order.push_back(landmark);
+  }
+  const int num_landmark_columns = 3 * static_cast<int>(order.size());
+  order.push_back(&blocks.n);
+  int p = 1;
+  const int rotation_column = p;
+  if (rotation) {
+    order.push_back(blocks.rotation.data());
+    p += 3;
+  }
+  if (direction) {
+    order.push_back(blocks.direction.data());
+    p += 2;  // the sphere's tangent
+  }
+  for (size_t f = 1; f < blocks.poses.size(); ++f) {
+    double* pose = blocks.poses[f].data();
+    if (problem.HasParameterBlock(pose)) {
+      order.push_back(pose);
+      p += 6;
+    }
+  }
+  ceres::Problem::EvaluateOptions evaluate;
+  evaluate.parameter_blocks = order;
+  evaluate.num_threads = num_threads;
+  ceres::CRSMatrix jacobian;
+  if (!problem.Evaluate(evaluate, nullptr, nullptr, nullptr, &jacobian)) {
+    return;
+  }
+  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor, int>> j(
+      jacobian.num_rows, jacobian.num_cols,
+      static_cast<int>(jacobian.values.size()), jacobian.rows.data(),
+      jacobian.cols.data(), jacobian.values.data());
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> h =
+      (Eigen::SparseMatrix<double, Eigen::RowMajor>(j.transpose()) * j)
+          .pruned();
+  // S, landmark by landmark.
+  const int m = num_landmark_columns;
+  Eigen::MatrixXd s = Eigen::MatrixXd::Zero(p, p);
+  for (int r = m; r < m + p; ++r) {
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(h, r);
+         it; ++it) {
+      if (it.col() >= m) s(r - m, it.col() - m) = it.value();
+    }
+  }
+  std::vector<int> columns;
+  for (int l = 0; 3 * l < m; ++l) {
+    Eigen::Matrix3d h_ll = Eigen::Matrix3d::Zero();
+    columns.clear();
+    for (int k = 0; k < 3; ++k) {
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(
+               h, 3 * l + k);
+           it; ++it) {
+        if (it.col() < m) {
+          if (it.col() >= 3 * l && it.col() < 3 * l + 3) {
+            h_ll(k, it.col() - 3 * l) = it.value();
+          }
+        } else {
+          columns.push_back(it.col() - m);
+        }
+      }
+    }
+    std::sort(columns.begin(), columns.end());
+    columns.erase(std::unique(columns.begin(), columns.end()), columns.end());
+    Eigen::MatrixXd h_lp = Eigen::MatrixXd::Zero(3, columns.size());
+    for (int k = 0; k < 3; ++k) {
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(
+               h, 3 * l + k);
+           it; ++it) {
+        if (it.col() < m) continue;
+        const auto at =
+            std::lower_bound(columns.begin(), columns.end(), it.col() - m);
+        h_lp(k, at - columns.begin()) = it.value();
+      }
+    }
+    const Eigen::LDLT<Eigen::Matrix3d> landmark(h_ll);
+    if (landmark.info() != Eigen::Success || !landmark.isPositive() ||
+        !(landmark.rcond() > 1e-14)) {
+      return;  // a landmark without depth: singular
+    }
+    const Eigen::MatrixXd reduced = h_lp.transpose() * landmark.solve(h_lp);
+    for (size_t a = 0; a < columns.size(); ++a) {
+      for (size_t b = 0; b < columns.size(); ++b) {
+        s(columns[a], columns[b]) -= reduced(a, b);
+      }
+    }
+  }
+  const Eigen::LDLT<Eigen::MatrixXd> factor(s);
+  if (factor.info() != Eigen::Success || !factor.isPositive() ||
+      !(factor.rcond() > 1e-14)) {
+    return;
+  }
+  const int rows = rotation ? 4 : 1;
+  Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(p, rows);
+  unit(0, 0) = 1.0;
+  for (int k = 1; k < rows; ++k) unit(rotation_column + k - 1, k) = 1.0;
+  const Eigen::MatrixXd covariance = factor.solve(unit);
+  result->c_nn = covariance(0, 0);
+  if (rotation) {
+    for (int k = 0; k < 3; ++k) {
+      result->c_nw[k] = covariance(rotation_column + k, 0);
+      for (int i = 0; i < 3; ++i) {
+        result->c_ww(i, k) = covariance(rotation_column + i, k + 1);
+      }
+    }
+    result->c_ww = 0.5 * (result->c_ww + result->c_ww.transpose()).eval();
+  }
+  result->covariance_ok = true;
+}
+
 StageResult SolveStage(const RigConstants& constants,
                        const StereoTracks& tracks, const std::vector<bool>& use,
                        const SequenceBundleOptions& options, bool robust,
@@ -257,36 +392,9 @@ StageResult SolveStage(const RigConstants& constants,
   ceres::Solve(solver, &problem, &result.summary);
 
   if (covariance && result.summary.IsSolutionUsable()) {
-    ceres::Covariance::Options covariance_options;
-    covariance_options.algorithm_type = ceres::SPARSE_QR;
-    if (!ceres::IsSparseLinearAlgebraLibraryTypeAvailable(
-            ceres::SUITE_SPARSE)) {
-      covariance_options.sparse_linear_algebra_library_type =
-          ceres::EIGEN_SPARSE;
-    }
-    covariance_options.num_threads = options.num_threads;
-    ceres::Covariance estimator(covariance_options);
-    const bool rotation = any_cam1 && options.refine_rotation;
-    std::vector<std::pair<const double*, const double*>> pairs = {
-        {&blocks->n, &blocks->n}};
-    if (rotation) {
-      pairs.push_back({&blocks->n, blocks->rotation.data()});
-      pairs.push_back({blocks->rotation.data(), blocks->rotation.data()});
-    }
-    if (estimator.Compute(pairs, &problem)) {
-      result.covariance_ok =
-          estimator.GetCovarianceBlock(&blocks->n, &blocks->n, &result.c_nn);
-      if (rotation) {
-        Eigen::Matrix<double, 3, 3, Eigen::RowMajor> ww;
-        result.covariance_ok =
-            result.covariance_ok &&
-            estimator.GetCovarianceBlock(&blocks->n, blocks->rotation.data(),
-                                         result.c_nw.data()) &&
-            estimator.GetCovarianceBlock(blocks->rotation.data(),
-                                         blocks->rotation.data(), ww.data());
-        result.c_ww = ww;
-      }
-    }
+    ReducedCovariance(problem, *blocks, any_cam1 && options.refine_rotation,
+                      any_cam1 && options.refine_translation_direction,
+                      options.num_threads, &result);
   }
   return result;
 }
@@ -375,6 +483,18 @@ Status SequenceBundleOptions::Check() const {
                          FormatDouble(min_triangulation_angle_deg) +
                          " deg must be in [0, 90)");
   }
+  for (const auto& [name, value] :
+       {std::pair<const char*, double>{"min translation fraction",
+                                       min_translation_fraction},
+        {"min rotation", min_rotation_deg},
+        {"axial cone", axial_cone_deg},
+        {"plane thickness", plane_thickness},
+        {"plane distance spread", plane_distance_spread}}) {
+    if (!(value >= 0.0) || !std::isfinite(value)) {
+      return Status::Error(std::string(name) + " = " + FormatDouble(value) +
+                           " must be >= 0 and finite");
+    }
+  }
   if (min_shared_landmarks < 6) {
     return Status::Error(
         "min shared landmarks = " + std::to_string(min_shared_landmarks) +
@@ -396,6 +516,119 @@ Status SequenceBundleOptions::Check() const {
   return Status::Ok();
 }
 
+BundleMotionSummary ClassifyBundleMotion(const SequenceBundleState& state,
+                                         const SequenceBundleOptions& options) {
+  BundleMotionSummary summary;
+  const size_t frames = state.cam0_from_world.size();
+  if (frames == 0) return summary;
+  std::vector<Eigen::Vector3d> centres;
+  for (const Rigid3d& pose : state.cam0_from_world) {
+    centres.push_back(pose.Inverse().translation);
+  }
+  const Rigid3d& first = state.cam0_from_world[0];
+  const Eigen::Vector3d axis = first.rotation.transpose().col(2);
+  summary.translation_span_m = 0.0;
+  summary.rotation_span_deg = 0.0;
+  for (size_t f = 0; f < frames; ++f) {
+    summary.translation_span_m =
+        std::max(summary.translation_span_m, (centres[f] - centres[0]).norm());
+    summary.rotation_span_deg = std::max(
+        summary.rotation_span_deg,
+        Eigen::AngleAxisd(first.rotation *
+                          state.cam0_from_world[f].rotation.transpose())
+                .angle() *
+            180.0 / kPi);
+  }
+  summary.axis_angle_deg = 0.0;
+  for (size_t f = 1; f < frames; ++f) {
+    const Eigen::Vector3d displacement = centres[f] - centres[0];
+    // Displacements of a tenth of the span or more (shorter ones point
+    // anywhere at the noise's whim).
+    if (!(displacement.norm() >= 0.1 * summary.translation_span_m) ||
+        !(displacement.norm() > 0.0)) {
+      continue;
+    }
+    const double cosine = std::abs(displacement.normalized().dot(axis));
+    summary.axis_angle_deg = std::max(
+        summary.axis_angle_deg, std::acos(std::min(1.0, cosine)) * 180.0 / kPi);
+  }
+  std::vector<Eigen::Vector3d> points;
+  for (const Eigen::Vector3d& point : state.landmarks) {
+    if (point.allFinite()) points.push_back(point);
+  }
+  if (points.size() >= 3) {
+    std::vector<double> distances;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& point : points) {
+      distances.push_back((point - centres[0]).norm());
+      mean += point;
+    }
+    mean /= static_cast<double>(points.size());
+    std::nth_element(distances.begin(),
+                     distances.begin() + distances.size() / 2, distances.end());
+    summary.median_distance_m = distances[distances.size() / 2];
+    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+    for (const Eigen::Vector3d& point : points) {
+      scatter += (point - mean) * (point - mean).transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> principal(scatter);
+    const Eigen::Vector3d spreads =
+        principal.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+    summary.plane_thickness = spreads[2] > 0.0 ? spreads[0] / spreads[2] : 0.0;
+    const Eigen::Vector3d normal = principal.eigenvectors().col(0);
+    double nearest = std::numeric_limits<double>::infinity();
+    double farthest = 0.0;
+    double sum = 0.0;
+    for (const Eigen::Vector3d& centre : centres) {
+      const double distance = std::abs(normal.dot(centre - mean));
+      nearest = std::min(nearest, distance);
+      farthest = std::max(farthest, distance);
+      sum += distance;
+    }
+    const double mean_distance = sum / static_cast<double>(frames);
+    summary.plane_distance_spread =
+        mean_distance > 0.0 ? (farthest - nearest) / mean_distance : 0.0;
+  }
+  if (!(summary.rotation_span_deg < options.min_rotation_deg)) {
+    return summary;  // a turning rig: kMoving
+  }
+  if (summary.translation_span_m <
+      options.min_translation_fraction * summary.median_distance_m) {
+    summary.kind = BundleMotion::kStatic;
+  } else if (summary.axis_angle_deg < options.axial_cone_deg) {
+    summary.kind = BundleMotion::kAlongAxis;
+  } else if (summary.plane_thickness < options.plane_thickness &&
+             summary.plane_distance_spread < options.plane_distance_spread) {
+    summary.kind = BundleMotion::kOnePlane;
+  }
+  return summary;
+}
+
+std::string BundleMotionSummary::Describe() const {
+  const std::string turn =
+      "turns by " + FormatFixed(rotation_span_deg, 1) + " deg";
+  switch (kind) {
+    case BundleMotion::kStatic:
+      return "the rig does not move: its keyframes lie within " +
+             FormatFixed(1000.0 * translation_span_m, 0) +
+             " mm of the first (landmarks " +
+             FormatFixed(median_distance_m, 1) + " m away) and it " + turn;
+    case BundleMotion::kAlongAxis:
+      return "the rig moves only along its optical axis (within " +
+             FormatFixed(axis_angle_deg, 1) + " deg, over " +
+             FormatFixed(translation_span_m, 2) + " m) and " + turn;
+    case BundleMotion::kOnePlane:
+      return "the rig sees one plane from one distance (plane thickness " +
+             FormatFixed(100.0 * plane_thickness, 1) +
+             " % of its extent, distance spread " +
+             FormatFixed(100.0 * plane_distance_spread, 1) + " %) and " + turn;
+    case BundleMotion::kMoving:
+      break;
+  }
+  return "the rig moves " + FormatFixed(translation_span_m, 2) + " m and " +
+         turn;
+}
+
 StatusOr<SequenceBundleAdjustment> SequenceBundleAdjustment::Create(
     const StereoRig& rig, const SequenceBundleOptions& options) {
   RCM_RETURN_IF_ERROR(options.Check().WithContext("bundle options"));
@@ -408,22 +641,58 @@ StatusOr<SequenceBundleAdjustment> SequenceBundleAdjustment::Create(
 StatusOr<SequenceBundleState> SequenceBundleAdjustment::Initialize(
     const StereoTracks& tracks) const {
   RCM_RETURN_IF_ERROR(tracks.Check());
-  // Bearings in the water at the initial n.
+  // The epipolar seed (options), thin ports.
+  double n0 = options_.initial_n;
+  Eigen::Vector3d w0 = Eigen::Vector3d::Zero();
+  if (options_.epipolar_seed && !rig_.HasThickPort()) {
+    std::vector<std::array<const Eigen::Vector2d*, 2>> seen(
+        static_cast<size_t>(tracks.num_frames) * tracks.num_landmarks,
+        {nullptr, nullptr});
+    std::vector<StereoCorrespondence> pairs;
+    for (const StereoTrackObservation& o : tracks.observations) {
+      seen[static_cast<size_t>(o.frame) * tracks.num_landmarks + o.landmark]
+          [o.camera] = &o.pixel;
+    }
+    for (size_t k = 0; k < seen.size(); ++k) {
+      if (seen[k][0] == nullptr || seen[k][1] == nullptr) continue;
+      StereoCorrespondence pair;
+      pair.frame = static_cast<int64_t>(k / tracks.num_landmarks);
+      pair.left_pixel = *seen[k][0];
+      pair.right_pixel = *seen[k][1];
+      pairs.push_back(pair);
+    }
+    // The calibration as given, without its uncertainty: a free turn.
+    StatusOr<StereoRig> plain =
+        StereoRig::Create(rig_.left(), rig_.right(), rig_.right_from_left());
+    RefinementOptions seed;
+    seed.refine_rotation = true;
+    seed.num_threads = options_.num_threads;
+    if (plain.ok()) {
+      const StatusOr<RefinementSummary> epipolar =
+          RefineRefractiveIndex(*plain, pairs, seed);
+      if (epipolar.ok() && epipolar->rotation) {
+        n0 = epipolar->n;
+        w0 = epipolar->rotation->angle_axis;
+      }
+    }
+  }
+  StatusOr<StereoRig> seeded = rig_.WithCam1Moved(w0);
+  if (!seeded.ok()) return seeded.status();
+  // Bearings in the water at n0.
   std::array<std::optional<RefractiveCamera>, 2> cameras;
   for (int c = 0; c < 2; ++c) {
     const Camera& camera = c == 0 ? rig_.left() : rig_.right();
     std::optional<FlatPort> port;
     if (rig_.ports()) port = c == 0 ? rig_.ports()->left : rig_.ports()->right;
     StatusOr<RefractiveCamera> refractive =
-        port && !port->IsThin()
-            ? RefractiveCamera::CreateWithPort(camera, options_.initial_n,
-                                               *port, kInitialReferenceDepth)
-            : RefractiveCamera::Create(camera, options_.initial_n);
+        port && !port->IsThin() ? RefractiveCamera::CreateWithPort(
+                                      camera, n0, *port, kInitialReferenceDepth)
+                                : RefractiveCamera::Create(camera, n0);
     if (!refractive.ok()) return refractive.status();
     cameras[c] = *refractive;
   }
-  const Eigen::Matrix3d R10 = rig_.right_from_left().rotation;
-  const Eigen::Vector3d t10 = rig_.right_from_left().translation;
+  const Eigen::Matrix3d R10 = seeded->right_from_left().rotation;
+  const Eigen::Vector3d t10 = seeded->right_from_left().translation;
   const Eigen::Vector3d cam1_in_cam0 = -R10.transpose() * t10;
   const double min_angle = options_.min_triangulation_angle_deg * kPi / 180.0;
 
@@ -443,8 +712,9 @@ StatusOr<SequenceBundleState> SequenceBundleAdjustment::Initialize(
   }
 
   SequenceBundleState state;
-  state.n = options_.initial_n;
-  state.cam1_direction = t10.normalized();
+  state.n = n0;
+  state.cam1_rotation = w0;
+  state.cam1_direction = rig_.right_from_left().translation.normalized();
   state.cam0_from_world.assign(tracks.num_frames, Rigid3d());
   state.landmarks.assign(
       tracks.num_landmarks,
@@ -482,7 +752,7 @@ StatusOr<SequenceBundleState> SequenceBundleAdjustment::Initialize(
             " place it): the tracks are broken there");
       }
       // Seeded by the previous keyframe's pose (a rig moves little between
-      // keyframes); RANSAC at 2 px of the left focal length.
+      // keyframes); RANSAC at kPnpThresholdPx of the left focal length.
       const Rigid3d& previous = state.cam0_from_world[f - 1];
       cv::Mat rotation_matrix(3, 3, CV_64F);
       for (int r = 0; r < 3; ++r) {
@@ -496,7 +766,7 @@ StatusOr<SequenceBundleState> SequenceBundleAdjustment::Initialize(
                       previous.translation.y(), previous.translation.z());
       const cv::Mat identity = cv::Mat::eye(3, 3, CV_64F);
       std::vector<int> inliers;
-      const double threshold = 2.0 / rig_.left().fx();
+      const double threshold = kPnpThresholdPx / rig_.left().fx();
       const bool found = cv::solvePnPRansac(
           object, image, identity, cv::noArray(), rvec, tvec,
           /*useExtrinsicGuess=*/true, /*iterationsCount=*/200, threshold,
@@ -622,9 +892,16 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
                          stage1.summary.message);
   }
   result.iterations += static_cast<int>(stage1.summary.iterations.size());
+  result.motion = ClassifyBundleMotion(StateOf(blocks), options_);
+  if (result.motion.kind != BundleMotion::kMoving &&
+      !options_.allow_degenerate_motion) {
+    return Status::Error(result.motion.Describe() +
+                         ": motion cannot separate n from cam1's turn, use "
+                         "the epipolar estimate");
+  }
 
   // Stage 2: least squares over the inliers, of landmarks seen from two
-  // viewpoints at least.
+  // viewpoints at least ...
   std::vector<int> inlier_views(tracks.num_landmarks, 0);
   for (size_t i = 0; i < count; ++i) {
     if (!use[i]) continue;
@@ -633,22 +910,66 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
     use[i] = norm && *norm <= options_.inlier_threshold_px;
     if (use[i]) ++inlier_views[tracks.observations[i].landmark];
   }
-  for (size_t i = 0; i < count; ++i) {
-    if (use[i] && inlier_views[tracks.observations[i].landmark] < 2) {
-      use[i] = false;
+  // ... and under an angle of at least min_triangulation_angle_deg: a
+  // landmark whose rays are parallel has no depth, and the covariance no
+  // rank. The least squares can send a landmark of little parallax off
+  // to thousands of kilometres (a Monte Carlo trial with a lens change
+  // did), so the angles are checked again after each solve, and the solve
+  // repeated without the landmarks that failed (at most 3 rounds).
+  const auto drop_narrow = [&]() {
+    const SequenceBundleState current = StateOf(blocks);
+    const Eigen::Matrix3d R10 = rig_.right_from_left().rotation;
+    const Eigen::Vector3d cam1_in_cam0 =
+        -constants.baseline * R10.transpose() * current.cam1_direction;
+    std::vector<std::vector<Eigen::Vector3d>> rays(tracks.num_landmarks);
+    for (size_t i = 0; i < count; ++i) {
+      if (!use[i]) continue;
+      const StereoTrackObservation& o = tracks.observations[i];
+      const Rigid3d world_from_cam0 =
+          current.cam0_from_world[o.frame].Inverse();
+      const Eigen::Vector3d centre = o.camera == 0
+                                         ? world_from_cam0.translation
+                                         : world_from_cam0 * cam1_in_cam0;
+      rays[o.landmark].push_back(
+          (current.landmarks[o.landmark] - centre).normalized());
     }
+    const double min_cosine =
+        std::cos(options_.min_triangulation_angle_deg * kPi / 180.0);
+    for (int l = 0; l < tracks.num_landmarks; ++l) {
+      bool wide = false;
+      for (size_t a = 0; a < rays[l].size() && !wide; ++a) {
+        for (size_t b = a + 1; b < rays[l].size() && !wide; ++b) {
+          wide = rays[l][a].dot(rays[l][b]) <= min_cosine;
+        }
+      }
+      if (!wide) inlier_views[l] = 0;
+    }
+    int dropped = 0;
+    for (size_t i = 0; i < count; ++i) {
+      if (use[i] && inlier_views[tracks.observations[i].landmark] < 2) {
+        use[i] = false;
+      }
+    }
+    for (int l = 0; l < tracks.num_landmarks; ++l) {
+      if (inlier_views[l] < 2 && blocks.placed[l]) {
+        blocks.placed[l] = false;
+        ++dropped;
+      }
+    }
+    return dropped;
+  };
+  drop_narrow();
+  StageResult stage2;
+  for (int round = 0;; ++round) {
+    stage2 = SolveStage(constants, tracks, use, options_, /*robust=*/false,
+                        options_.max_iterations, /*covariance=*/true, &blocks);
+    if (!stage2.summary.IsSolutionUsable()) {
+      return Status::Error("the bundle's least squares failed: " +
+                           stage2.summary.message);
+    }
+    result.iterations += static_cast<int>(stage2.summary.iterations.size());
+    if (round == 2 || drop_narrow() == 0) break;
   }
-  for (int l = 0; l < tracks.num_landmarks; ++l) {
-    if (inlier_views[l] < 2) blocks.placed[l] = false;
-  }
-  const StageResult stage2 =
-      SolveStage(constants, tracks, use, options_, /*robust=*/false,
-                 options_.max_iterations, /*covariance=*/true, &blocks);
-  if (!stage2.summary.IsSolutionUsable()) {
-    return Status::Error("the bundle's least squares failed: " +
-                         stage2.summary.message);
-  }
-  result.iterations += static_cast<int>(stage2.summary.iterations.size());
   result.num_inliers = std::count(use.begin(), use.end(), true);
   result.num_landmarks = static_cast<int>(
       std::count(blocks.placed.begin(), blocks.placed.end(), true));
@@ -696,6 +1017,7 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
     result.correlation_n_rotation = std::sqrt(std::clamp(explained, 0.0, 1.0));
   }
   result.state = StateOf(blocks);
+  result.motion = ClassifyBundleMotion(result.state, options_);
 
   // The calibration's remaining uncertainty (header).
   double calibration_variance = 0.0;
