@@ -48,7 +48,7 @@ constexpr char kEstimateUsage[] =
     "       rcm estimate --calib RIG.yaml --bag BAG --left-topic T0 "
     "--right-topic T1\n"
     "       rcm estimate --calib RIG.yaml --matches MATCHES.csv\n"
-    "   [--estimator refine|online|window|closed-form] [--window N]\n"
+    "   [--estimator refine|online|window|closed-form|bundle] [--window N]\n"
     "   [--from S --to S --stride K] [--features orb|sift|akaze] [--clahe]\n"
     "   [--per-frame OUT.csv] [--json]\n\n"
     "From images, each pair's keypoints are matched within the band of the\n"
@@ -62,7 +62,10 @@ constexpr char kEstimateUsage[] =
     "stage that finds n\namong outliers, then least squares on the inliers, "
     "whose covariance gives\nsigma_n. It works on any calibrated rig. "
     "closed-form is the paper's baseline;\nit assumes a rectified rig and is "
-    "biased under pixel noise (docs/design.md Sec. 3).\n\n"
+    "biased under pixel noise (docs/design.md Sec. 3).\nbundle (images only) "
+    "tracks landmarks over the pairs and adjusts n, cam1's\nturn and the "
+    "rig's poses together: motion separates n from the turn that\none pair "
+    "cannot; --out adds trajectory.tum.\n\n"
     "sigma_n counts the calibration's uncertainty (the camchain's covariance\n"
     "sidecar, or a drift prior of 0.1 deg, 0.1 mm per axis and 0.3 % in\n"
     "each camera's focal lengths: --drift-prior) and the matches'\n"
@@ -369,6 +372,13 @@ int RunEstimate() {
                WriteFileAtomically(per_frame, EstimatePerFrameCsv(*report))) ||
         !write(plot, WritePng(PlotPerFrame(*report), plot))) {
       return kExitFailure;
+    }
+    if (report->bundle) {
+      const std::string trajectory = (out / "trajectory.tum").string();
+      if (!write(trajectory, WriteFileAtomically(
+                                 trajectory, EstimateTrajectoryTum(*report)))) {
+        return kExitFailure;
+      }
     }
     if (run) {
       const std::string csv = (out / "matches.csv").string();

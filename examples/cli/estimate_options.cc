@@ -41,7 +41,11 @@ DEFINE_string(estimator, "refine",
               "of record); online: the same estimate updated frame by frame "
               "in constant memory; window: over the last --window frames, "
               "restarting when the medium changes; closed-form: the paper's "
-              "baseline (eq. 14, mask, radially weighted mean)");
+              "baseline (eq. 14, mask, radially weighted mean); bundle "
+              "(images only): n, cam1's turn and the trajectory from "
+              "landmarks tracked over the pairs (a bundle adjustment; where "
+              "the motion cannot separate n from the turn, the refine "
+              "estimate with a warning)");
 DEFINE_int32(window, 20,
              "window: frames in the sliding window (w_s; 20 = 1 s at 20 Hz)");
 DEFINE_double(change_threshold, 5.0,
@@ -184,8 +188,9 @@ StatusOr<EstimateCliOptions> EstimateOptionsFromFlags() {
   const std::optional<EstimatorKind> estimator =
       EstimatorFromName(FLAGS_estimator);
   if (!estimator) {
-    return Status::Error("unknown estimator '" + FLAGS_estimator +
-                         "' (available: refine, online, window, closed-form)");
+    return Status::Error(
+        "unknown estimator '" + FLAGS_estimator +
+        "' (available: refine, online, window, closed-form, bundle)");
   }
   const bool refine = *estimator == EstimatorKind::kRefine;
   if (FLAGS_refine_rotation && !refine) {

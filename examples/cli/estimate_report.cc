@@ -34,6 +34,15 @@ std::vector<std::string> EstimatorLines(const RefractiveIndexEstimate& e) {
                     ", scan " + FormatFixed(*e.n_seed, 4) + ", robust stage " +
                     FormatFixed(e.n_robust.value_or(NAN), 5));
   }
+  if (e.bundle) {
+    const BundleSummary& b = *e.bundle;
+    lines.push_back("  bundle     " + std::to_string(b.frames_used) +
+                    " keyframes, " + std::to_string(b.landmarks) +
+                    " landmarks (" + std::to_string(b.tracks) +
+                    " tracked over keyframes), " +
+                    std::to_string(b.observations) + " observations");
+    lines.push_back("  motion     " + b.motion);
+  }
   if (e.air_gap) {
     const AirGapEstimate& gap = *e.air_gap;
     lines.push_back("  air gap    " + FormatFixed(1e3 * gap.left_air_gap, 2) +

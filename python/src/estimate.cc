@@ -68,8 +68,9 @@ RefractiveIndexEstimate Estimate(const py::object& rig_object,
   EstimationOptions options;
   const std::optional<EstimatorKind> kind = EstimatorFromName(estimator);
   if (!kind) {
-    ThrowValueError("unknown estimator '" + estimator +
-                    "' (available: refine, online, window, closed-form)");
+    ThrowValueError(
+        "unknown estimator '" + estimator +
+        "' (available: refine, online, window, closed-form, bundle)");
   }
   options.estimator = *kind;
   ApplyRefinementOptions(kwargs, &options.refinement,

@@ -70,8 +70,9 @@ Sequence MakeSequence(const py::object& rig_object,
   SequenceEstimatorOptions options;
   const std::optional<EstimatorKind> kind = EstimatorFromName(estimator);
   if (!kind) {
-    ThrowValueError("unknown estimator '" + estimator +
-                    "' (available: refine, online, window, closed-form)");
+    ThrowValueError(
+        "unknown estimator '" + estimator +
+        "' (available: refine, online, window, closed-form, bundle)");
   }
   options.estimation.estimator = *kind;
   if (py::isinstance<StereoFrontEndOptions>(front_end)) {

@@ -79,10 +79,23 @@ TEST(EstimateRefractiveIndex, EveryEstimatorExactOnNoiseFreeFrames) {
 TEST(EstimateRefractiveIndex, EstimatorNamesRoundTrip) {
   for (const EstimatorKind kind :
        {EstimatorKind::kRefine, EstimatorKind::kOnline, EstimatorKind::kWindow,
-        EstimatorKind::kClosedForm}) {
+        EstimatorKind::kClosedForm, EstimatorKind::kBundle}) {
     EXPECT_EQ(EstimatorFromName(EstimatorName(kind)), kind);
   }
-  EXPECT_FALSE(EstimatorFromName("bundle").has_value());
+  EXPECT_FALSE(EstimatorFromName("kalman").has_value());
+}
+
+// The bundle needs tracks (images), not matches: one line that says so.
+TEST(EstimateRefractiveIndex, BundleOnMatchesRefusedInOneLine) {
+  const StatusOr<RefractiveIndexEstimate> estimate = EstimateRefractiveIndex(
+      test::AlphasenseIdealRig(),
+      SplitFrames(test::ExactMatches(test::AlphasenseIdealRig(), 1.333, 200)),
+      Options(EstimatorKind::kBundle));
+  ASSERT_FALSE(estimate.ok());
+  EXPECT_EQ(
+      estimate.status().message().rfind(
+          "the bundle estimator needs landmarks tracked over keyframes", 0),
+      0u);
 }
 
 TEST(EstimateRefractiveIndex, RefineOnlyOptionsRefusedElsewhere) {

@@ -11,6 +11,7 @@
 #include "rcm/live/live_pipeline.h"
 #include "rcm/sim/reference_rigs.h"
 #include "rcm/sim/sequence_simulator.h"
+#include "support/test_budget.h"
 
 namespace rcm::sequence_estimator_test {
 namespace {
@@ -184,6 +185,92 @@ TEST(SequenceEstimatorOptions, FrontEndRefinesWhatTheMatchesAreFor) {
   EXPECT_EQ(options.FrontEnd().max_refined_matches, 50);
 }
 
+// The bundle estimator runs in the engine: the pairs are its keyframes.
+// Keyframes 7.5 cm apart (4 Hz), cam1 turned 0.5 deg since the
+// calibration (with the default drift prior, which the bundle's turn
+// absorbs and whose translation sigma_n carries; the focal drift prior's
+// propagation is tested in sequence_bundle_adjustment_test.cc): n within
+// 2e-3 and within 3 sigma, the turn within 0.05 deg, one pose per pair.
+TEST(SequenceEstimator, BundleOverTheRenderedPairs) {
+  const int frames = test::kSanitizerBuild ? 3 : 6;
+  const Eigen::Vector3d turn =
+      0.5 * kDegree * Eigen::Vector3d(0.3, 1.0, 0.2).normalized();
+  SequenceOptions simulation;
+  simulation.media = {{kWater, frames}};
+  simulation.trajectory.frame_rate = 4.0;
+  simulation.cam1_drift.rotation = turn;
+  simulation.render.supersampling = 1;
+  simulation.seed = 11;
+  std::unique_ptr<SequenceSimulator> simulator =
+      SequenceSimulator::Create(AlphasenseFrontRectifiedRig(), simulation)
+          .value();
+  SequenceEstimatorOptions options;
+  options.estimation.estimator = EstimatorKind::kBundle;
+  std::unique_ptr<SequenceEstimator> sequence =
+      SequenceEstimator::Create(
+          AlphasenseFrontRectifiedRig()
+              .WithCalibrationUncertainty(
+                  CalibrationUncertainty::DefaultDriftPrior())
+              .value(),
+          options)
+          .value();
+  for (int i = 0; i < frames; ++i) {
+    const SequenceFrame frame = simulator->Frame(i).value();
+    const StatusOr<SequencePair> pair =
+        sequence->AddPair(frame.left, frame.right, i, frame.t);
+    ASSERT_TRUE(pair.ok()) << pair.status().message();
+    ASSERT_TRUE(pair->continued_tracks.has_value());
+    if (i > 0) {
+      EXPECT_GT(*pair->continued_tracks,
+                static_cast<int>(pair->matches.size()) / 3);
+    }
+  }
+  const StatusOr<RefractiveIndexEstimate> estimate = sequence->Estimate();
+  ASSERT_TRUE(estimate.ok()) << estimate.status().message();
+  ASSERT_EQ(estimate->estimator, "bundle");
+  ASSERT_TRUE(estimate->bundle.has_value());
+  EXPECT_EQ(estimate->bundle->trajectory.size(), static_cast<size_t>(frames));
+  EXPECT_GT(estimate->bundle->tracks, 0);
+  if (!test::ChecksStatistics()) return;
+  EXPECT_LT(std::abs(estimate->n - kWater), 2e-3);
+  EXPECT_LT(std::abs(estimate->n - kWater), 3.0 * estimate->sigma_n);
+  ASSERT_TRUE(estimate->rotation.has_value());
+  EXPECT_LT((estimate->rotation->angle_axis - turn).norm() / kDegree, 0.05);
+}
+
+// Where the bundle refuses (a rig that does not move), the engine gives
+// the refine estimate, the bundle's reason its first warning.
+TEST(SequenceEstimator, BundleFallsBackToRefineForAStillRig) {
+  SequenceOptions simulation;
+  simulation.media = {{kWater, 3}};
+  simulation.render.supersampling = 1;
+  simulation.trajectory.speed = 0.0;
+  simulation.trajectory.sway_amplitude = 0.0;
+  simulation.trajectory.heave_amplitude = 0.0;
+  simulation.trajectory.yaw_amplitude_deg = 0.0;
+  simulation.trajectory.rock_amplitude_deg = 0.0;
+  std::unique_ptr<SequenceSimulator> simulator =
+      SequenceSimulator::Create(AlphasenseFrontRectifiedRig(), simulation)
+          .value();
+  SequenceEstimatorOptions options;
+  options.estimation.estimator = EstimatorKind::kBundle;
+  std::unique_ptr<SequenceEstimator> sequence =
+      SequenceEstimator::Create(RigAsRead(), options).value();
+  for (int i = 0; i < simulator->num_frames(); ++i) {
+    const SequenceFrame frame = simulator->Frame(i).value();
+    ASSERT_TRUE(sequence->AddPair(frame.left, frame.right, i, frame.t).ok());
+  }
+  const StatusOr<RefractiveIndexEstimate> estimate = sequence->Estimate();
+  ASSERT_TRUE(estimate.ok()) << estimate.status().message();
+  EXPECT_EQ(estimate->estimator, "refine");
+  ASSERT_FALSE(estimate->warnings.empty());
+  EXPECT_EQ(estimate->warnings[0].rfind(
+                "the bundle estimator: the rig does not move: ", 0),
+            0u)
+      << estimate->warnings[0];
+  EXPECT_FALSE(estimate->bundle.has_value());
+}
+
 TEST(SequenceEstimator, RefusesBadPairsAndOptions) {
   std::unique_ptr<SequenceEstimator> sequence =
       SequenceEstimator::Create(AlphasenseFrontRectifiedRig(),
@@ -211,6 +298,12 @@ TEST(SequenceEstimator, RefusesBadPairsAndOptions) {
   options.estimation.estimator = EstimatorKind::kWindow;
   EXPECT_FALSE(options.Check().ok());  // refine_rotation: refine only
   EXPECT_TRUE(SequenceEstimatorOptions().Check().ok());
+  // The bundle keeps the pairs.
+  options = SequenceEstimatorOptions();
+  options.estimation.estimator = EstimatorKind::kBundle;
+  EXPECT_TRUE(options.Check().ok());
+  options.keep_frames = false;
+  EXPECT_FALSE(options.Check().ok());
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "rcm/estimation/estimate_json.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
@@ -148,6 +149,13 @@ std::string EstimateJson(const RefractiveIndexEstimate& e, int indent) {
     }
     json["switches"] = switches;
   }
+  if (e.bundle) {
+    json["frames_used"] = e.bundle->frames_used;
+    json["landmarks"] = e.bundle->landmarks;
+    json["tracks"] = e.bundle->tracks;
+    json["observations"] = e.bundle->observations;
+    json["motion"] = e.bundle->motion;
+  }
   if (e.masked) json["masked"] = *e.masked;
   if (e.mask_eta) json["mask_eta"] = JsonNumberOf(e.mask_eta);
   json["warnings"] = e.warnings;
@@ -166,6 +174,29 @@ std::string EstimatePerFrameCsv(const RefractiveIndexEstimate& estimate) {
     out << ",";
     if (std::isfinite(row.sigma_n)) out << row.sigma_n;
     out << "," << (row.medium_switch ? 1 : 0) << "\n";
+  }
+  return out.str();
+}
+
+std::string EstimateTrajectoryTum(const RefractiveIndexEstimate& estimate) {
+  std::ostringstream out;
+  out.precision(17);
+  out << "# timestamp tx ty tz qx qy qz qw (world_from_cam0: the left camera "
+         "in the first keyframe's frame, metres; the frame index where the "
+         "pairs have no time)\n";
+  if (!estimate.bundle) return out.str();
+  for (const BundlePose& pose : estimate.bundle->trajectory) {
+    const Eigen::Quaterniond q(pose.world_from_cam0.rotation);
+    // + 0.0: no "-0" for the first keyframe's inverted identity.
+    const Eigen::Vector3d t =
+        pose.world_from_cam0.translation + Eigen::Vector3d::Zero();
+    if (pose.timestamp) {
+      out << *pose.timestamp;
+    } else {
+      out << pose.frame;
+    }
+    out << " " << t.x() << " " << t.y() << " " << t.z() << " " << q.x() << " "
+        << q.y() << " " << q.z() << " " << q.w() << "\n";
   }
   return out.str();
 }

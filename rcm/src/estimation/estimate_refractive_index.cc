@@ -239,6 +239,8 @@ const char* EstimatorName(EstimatorKind kind) {
       return "window";
     case EstimatorKind::kClosedForm:
       return "closed-form";
+    case EstimatorKind::kBundle:
+      return "bundle";
   }
   return "unknown";
 }
@@ -246,7 +248,7 @@ const char* EstimatorName(EstimatorKind kind) {
 std::optional<EstimatorKind> EstimatorFromName(std::string_view name) {
   for (const EstimatorKind kind :
        {EstimatorKind::kRefine, EstimatorKind::kOnline, EstimatorKind::kWindow,
-        EstimatorKind::kClosedForm}) {
+        EstimatorKind::kClosedForm, EstimatorKind::kBundle}) {
     if (name == EstimatorName(kind)) return kind;
   }
   return std::nullopt;
@@ -268,6 +270,7 @@ Status EstimationOptions::Check() const {
   RCM_RETURN_IF_ERROR(refinement.Check());
   RCM_RETURN_IF_ERROR(window.Check());
   RCM_RETURN_IF_ERROR(closed_form.Check());
+  RCM_RETURN_IF_ERROR(bundle.Check().WithContext("bundle"));
   if (refinement.refine_rotation && estimator != EstimatorKind::kRefine) {
     return Status::Error(
         "refine_rotation works with the refine estimator only");
@@ -285,6 +288,11 @@ StatusOr<RefractiveIndexEstimate> EstimateRefractiveIndex(
     const StereoRig& rig, const std::vector<FrameMatches>& frames,
     const EstimationOptions& options, const EstimationProgress& progress) {
   RCM_RETURN_IF_ERROR(options.Check());
+  if (options.estimator == EstimatorKind::kBundle) {
+    return Status::Error(
+        "the bundle estimator needs landmarks tracked over keyframes: images "
+        "(--left and --right, or a bag), not matches");
+  }
   if (rig.HasThickPort() && options.estimator != EstimatorKind::kRefine) {
     return Status::Error(
         std::string("the rig gives a thick port (an air gap or glass), which "
@@ -306,6 +314,8 @@ StatusOr<RefractiveIndexEstimate> EstimateRefractiveIndex(
     case EstimatorKind::kClosedForm:
       estimate = RunClosedFormEstimator(rig, frames, options, progress);
       break;
+    case EstimatorKind::kBundle:
+      break;  // refused above
   }
   if (!estimate.ok()) return estimate;
   estimate->estimator = EstimatorName(options.estimator);
@@ -318,6 +328,92 @@ StatusOr<RefractiveIndexEstimate> EstimateRefractiveIndex(
   estimate->correspondences = correspondences;
   for (std::string& warning : EstimateWarnings(*estimate)) {
     estimate->warnings.push_back(std::move(warning));
+  }
+  return estimate;
+}
+
+StatusOr<RefractiveIndexEstimate> EstimateRefractiveIndexFromTracks(
+    const StereoRig& rig, const StereoTracks& tracks,
+    const std::vector<KeyframeStamp>& keyframes,
+    const EstimationOptions& options) {
+  RCM_RETURN_IF_ERROR(options.Check());
+  if (options.estimator != EstimatorKind::kBundle) {
+    return Status::Error(std::string("tracks are the bundle estimator's, not "
+                                     "the ") +
+                         EstimatorName(options.estimator) + " estimator's");
+  }
+  if (static_cast<int>(keyframes.size()) != tracks.num_frames) {
+    return Status::Error("the tracks have " +
+                         std::to_string(tracks.num_frames) + " keyframes, " +
+                         std::to_string(keyframes.size()) + " are stamped");
+  }
+  SequenceBundleOptions bundle_options = options.bundle;
+  bundle_options.num_threads = options.refinement.num_threads;
+  StatusOr<SequenceBundleAdjustment> bundle =
+      SequenceBundleAdjustment::Create(rig, bundle_options);
+  if (!bundle.ok()) return bundle.status();
+  StatusOr<SequenceBundleResult> result = bundle->Solve(tracks);
+  if (!result.ok()) return result.status();
+
+  RefractiveIndexEstimate estimate;
+  estimate.estimator = EstimatorName(EstimatorKind::kBundle);
+  estimate.port = rig.HasThickPort() ? "thick" : "thin";
+  estimate.method =
+      "bundle adjustment of landmarks tracked over keyframes (loss " +
+      std::string(RobustLossName(bundle_options.loss)) + " " +
+      FormatFixed(bundle_options.loss_scale_px, 2) + " px, inliers within " +
+      FormatFixed(bundle_options.inlier_threshold_px, 2) + " px)";
+  estimate.n = result->n;
+  estimate.sigma_n = result->sigma_n;
+  estimate.sigma_n_noise = result->sigma_n_noise;
+  estimate.sigma_n_calibration = result->sigma_n_calibration;
+  estimate.sigma_n_systematic = 0.0;
+  estimate.sigma_px = result->pixel_sigma;
+  estimate.inliers = result->num_inliers;
+  estimate.correspondences = result->num_observations;
+  estimate.frames = tracks.num_frames;
+  estimate.iterations = result->iterations;
+  if (bundle_options.refine_rotation) {
+    RotationCorrection rotation;
+    rotation.angle_axis = result->state.cam1_rotation;
+    rotation.sigma = result->rotation_covariance.diagonal().cwiseSqrt();
+    for (int i = 0; i < 3; ++i) {
+      rotation.correlation_with_n[i] =
+          result->n_rotation_covariance[i] /
+          (result->sigma_n_noise * rotation.sigma[i]);
+    }
+    rotation.multiple_correlation_with_n = result->correlation_n_rotation;
+    rotation.with_prior = false;
+    StatusOr<StereoRig> turned = rig.WithCam1Moved(result->state.cam1_rotation);
+    if (turned.ok()) rotation.cam1_from_cam0 = turned->right_from_left();
+    estimate.rotation = rotation;
+  }
+  BundleSummary summary;
+  summary.frames_used = result->num_frames;
+  summary.landmarks = result->num_landmarks;
+  summary.observations = result->num_inliers;
+  summary.motion = result->motion.Describe();
+  summary.correlation_n_rotation = result->correlation_n_rotation;
+  {
+    std::vector<int> first(tracks.num_landmarks, -1);
+    std::vector<bool> tracked(tracks.num_landmarks, false);
+    for (const StereoTrackObservation& o : tracks.observations) {
+      if (!result->state.landmarks[o.landmark].allFinite()) continue;
+      if (first[o.landmark] < 0) {
+        first[o.landmark] = o.frame;
+      } else if (first[o.landmark] != o.frame) {
+        tracked[o.landmark] = true;
+      }
+    }
+    summary.tracks = std::count(tracked.begin(), tracked.end(), true);
+  }
+  for (int k = 0; k < tracks.num_frames; ++k) {
+    summary.trajectory.push_back(
+        {keyframes[k].frame, keyframes[k].timestamp, result->WorldFromCam0(k)});
+  }
+  estimate.bundle = std::move(summary);
+  for (std::string& warning : EstimateWarnings(estimate)) {
+    estimate.warnings.push_back(std::move(warning));
   }
   return estimate;
 }

@@ -1011,6 +1011,7 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
   result.sigma_n_noise = std::sqrt(s2 * stage2.c_nn);
   if (options_.refine_rotation) {
     result.rotation_covariance = s2 * stage2.c_ww;
+    result.n_rotation_covariance = s2 * stage2.c_nw;
     const Eigen::Matrix3d c_ww = stage2.c_ww;
     const double explained =
         stage2.c_nw.dot(c_ww.ldlt().solve(stage2.c_nw)) / stage2.c_nn;

@@ -73,6 +73,12 @@ Status SequenceEstimatorOptions::Check() const {
     return Status::Error("matching passes must be >= 1, not " +
                          std::to_string(max_matching_passes));
   }
+  RCM_RETURN_IF_ERROR(tracker.Check());
+  if (estimation.estimator == EstimatorKind::kBundle && !keep_frames) {
+    return Status::Error(
+        "the bundle estimator needs the pairs kept (keep_frames): it is not "
+        "a live window");
+  }
   return Status::Ok();
 }
 
@@ -89,9 +95,11 @@ StatusOr<std::unique_ptr<SequenceEstimator>> SequenceEstimator::Create(
       SlidingWindowRefractiveIndexEstimator::Create(
           rig, options.WindowRefinement(), options.estimation.window);
   if (!window.ok()) return window.status();
-  return std::unique_ptr<SequenceEstimator>(
+  std::unique_ptr<SequenceEstimator> sequence(
       new SequenceEstimator(rig, options, std::move(*detector),
                             std::move(*front_end), std::move(*window)));
+  RCM_RETURN_IF_ERROR(sequence->ResetTracker());
+  return sequence;
 }
 
 SequenceEstimator::SequenceEstimator(
@@ -109,6 +117,19 @@ double SequenceEstimator::RotationPixels(const Eigen::Vector3d& a,
   const double focal = std::max({rig_.left().fx(), rig_.left().fy(),
                                  rig_.right().fx(), rig_.right().fy()});
   return (a - b).norm() * focal;
+}
+
+Status SequenceEstimator::ResetTracker() {
+  keyframes_.clear();
+  tracker_.reset();
+  if (options_.estimation.estimator != EstimatorKind::kBundle) {
+    return Status::Ok();
+  }
+  StatusOr<StereoTracker> tracker =
+      StereoTracker::Create(rig_, options_.tracker);
+  if (!tracker.ok()) return tracker.status();
+  tracker_ = std::move(*tracker);
+  return Status::Ok();
 }
 
 Status SequenceEstimator::Restart(const Eigen::Vector3d& rotation) {
@@ -130,7 +151,7 @@ Status SequenceEstimator::Restart(const Eigen::Vector3d& rotation) {
   frames_.clear();
   own_rows_.clear();
   medium_first_.reset();
-  return Status::Ok();
+  return ResetTracker();
 }
 
 StatusOr<SequencePair> SequenceEstimator::AddPair(
@@ -169,6 +190,12 @@ StatusOr<SequencePair> SequenceEstimator::AddDetectedPair(
   pair.timestamp = timestamp;
   pair.reacquired = matched->reacquired;
   pair.timings = matched->timings;
+  if (tracker_) {
+    StatusOr<int> continued = tracker_->AddKeyframe(detected, *matched);
+    if (!continued.ok()) return continued.status();
+    keyframes_.push_back({frame, timestamp});
+    pair.continued_tracks = *continued;
+  }
 
   // 2. The window: the pair's own estimate (the next guide), the window's
   // and a change of medium.
@@ -248,9 +275,27 @@ StatusOr<RefractiveIndexEstimate> SequenceEstimator::Estimate() const {
   }
   EstimationOptions options = options_.estimation;
   options.per_frame_estimates = false;  // the pairs' own estimates
+  std::optional<std::string> bundle_refused;
+  if (options.estimator == EstimatorKind::kBundle) {
+    StatusOr<RefractiveIndexEstimate> bundle =
+        EstimateRefractiveIndexFromTracks(rig_, tracker_->tracks(), keyframes_,
+                                          options);
+    if (bundle.ok()) {
+      bundle->per_frame = own_rows_;
+      return bundle;
+    }
+    // The epipolar estimate, with the bundle's reason (header).
+    bundle_refused = bundle.status().message();
+    options.estimator = EstimatorKind::kRefine;
+  }
   StatusOr<RefractiveIndexEstimate> estimate =
       EstimateRefractiveIndex(rig_, since, options);
   if (!estimate.ok()) return estimate;
+  if (bundle_refused) {
+    estimate->warnings.insert(estimate->warnings.begin(),
+                              "the bundle estimator: " + *bundle_refused +
+                                  "; this is the refine estimate");
+  }
   if (options.estimator == EstimatorKind::kRefine) {
     estimate->per_frame = std::move(rows);
   }

@@ -25,6 +25,9 @@
 //   last_frame}, switches [{frame, detected_at_frame, n_before, n_after}]
 //                                                (online, window)
 //   masked, mask_eta                             (closed-form)
+//   frames_used, landmarks (in the solve), tracks (landmarks seen in two
+//   keyframes or more), observations (inlier pixels), motion (one line)
+//                                                (bundle)
 //   warnings      [one line each]
 #ifndef RCM_ESTIMATION_ESTIMATE_JSON_H_
 #define RCM_ESTIMATION_ESTIMATE_JSON_H_
@@ -45,6 +48,13 @@ std::string EstimateJson(const RefractiveIndexEstimate& estimate,
 // The per-frame series as CSV: frame,t,n,sigma_n,switch (empty t, n,
 // sigma_n when unknown; switch 1 on the first frame of a new medium).
 std::string EstimatePerFrameCsv(const RefractiveIndexEstimate& estimate);
+
+// The bundle's trajectory in the TUM format: a comment line, then one line
+// per keyframe, "t tx ty tz qx qy qz qw" (world_from_cam0 in the first
+// keyframe's frame, metres, Hamilton quaternion; t the keyframe's time in
+// seconds, or its frame index without one). Only the comment without a
+// bundle.
+std::string EstimateTrajectoryTum(const RefractiveIndexEstimate& estimate);
 
 }  // namespace rcm
 

@@ -15,6 +15,10 @@
 //                sqrt|u| sqrt|v| > eta, the radially weighted mean eq. 17
 //                (paper_online_estimator.h); biased under pixel noise and
 //                off a rectified rig (a warning says so).
+//   bundle       n, cam1's turn and the trajectory from landmarks tracked
+//                over keyframes (sequence_bundle_adjustment.h): from
+//                images only (EstimateRefractiveIndexFromTracks; the
+//                sequence engine tracks them), not from matches.
 //
 // The per-frame series (RefractiveIndexEstimate::per_frame): online and
 // closed-form the estimate so far, window the window's, refine each frame's
@@ -33,15 +37,17 @@
 #include "rcm/estimation/paper_online_estimator.h"
 #include "rcm/estimation/refinement_options.h"
 #include "rcm/estimation/refractive_index_estimate.h"
+#include "rcm/estimation/sequence_bundle_adjustment.h"
 #include "rcm/estimation/sliding_window_estimator.h"
+#include "rcm/geometry/stereo_tracks.h"
 #include "rcm/stereo/stereo_rig.h"
 #include "rcm/util/status.h"
 
 namespace rcm {
 
-enum class EstimatorKind { kRefine, kOnline, kWindow, kClosedForm };
+enum class EstimatorKind { kRefine, kOnline, kWindow, kClosedForm, kBundle };
 
-// "refine", "online", "window", "closed-form".
+// "refine", "online", "window", "closed-form", "bundle".
 const char* EstimatorName(EstimatorKind kind);
 std::optional<EstimatorKind> EstimatorFromName(std::string_view name);
 
@@ -64,6 +70,8 @@ struct EstimationOptions {
   SlidingWindowOptions window;
   // closed-form: the observability mask.
   PaperOnlineEstimatorOptions closed_form;
+  // bundle: the sequence bundle adjustment's.
+  SequenceBundleOptions bundle;
   // refine: estimate the ports' air gaps with n (a thin port's rig: from
   // zero). Not with refinement.refine_rotation.
   bool estimate_air_gap = false;
@@ -81,11 +89,29 @@ struct EstimationOptions {
 using EstimationProgress = std::function<void(size_t done, size_t total)>;
 
 // Errors: options.Check(); a thick port's rig with another estimator than
-// refine; the estimator's own (too few matches or inliers, n not
-// observable, n pinned at the bound 2, no match through the mask).
+// refine; the bundle (it needs tracks: below); the estimator's own (too
+// few matches or inliers, n not observable, n pinned at the bound 2, no
+// match through the mask).
 StatusOr<RefractiveIndexEstimate> EstimateRefractiveIndex(
     const StereoRig& rig, const std::vector<FrameMatches>& frames,
     const EstimationOptions& options, const EstimationProgress& progress = {});
+
+// The bundle estimator over landmarks tracked across keyframes
+// (StereoTracker), `keyframes[k]` the frame and time of keyframe k: n, the
+// total sigma_n with its noise and calibration parts, cam1's turn
+// (`rotation`, estimated freely: with_prior false) and `bundle` (the
+// trajectory in the first keyframe's frame). Errors: options.Check(),
+// options.estimator not kBundle, a keyframe count that differs from the
+// tracks', the bundle's own (motion that does not help, said in one line;
+// broken tracks; n not observable or pinned at 2).
+struct KeyframeStamp {
+  int64_t frame = 0;
+  std::optional<double> timestamp;
+};
+StatusOr<RefractiveIndexEstimate> EstimateRefractiveIndexFromTracks(
+    const StereoRig& rig, const StereoTracks& tracks,
+    const std::vector<KeyframeStamp>& keyframes,
+    const EstimationOptions& options);
 
 }  // namespace rcm
 

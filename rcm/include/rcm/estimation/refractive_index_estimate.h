@@ -52,10 +52,31 @@ struct WindowSpan {
   int64_t last_frame = 0;
 };
 
+// The bundle estimator's own (sequence_bundle_adjustment.h).
+struct BundlePose {
+  int64_t frame = 0;
+  std::optional<double> timestamp;  // seconds
+  Rigid3d world_from_cam0;          // in the first keyframe's frame, metres
+};
+
+struct BundleSummary {
+  int64_t frames_used = 0;   // keyframes in the solve
+  int64_t landmarks = 0;     // landmarks in the solve
+  int64_t tracks = 0;        // of those, seen in two keyframes or more
+  int64_t observations = 0;  // inlier observations (pixels)
+  // How the rig moved, one line (BundleMotionSummary::Describe).
+  std::string motion;
+  // The multiple correlation of n with cam1's turn the data leave.
+  double correlation_n_rotation = std::numeric_limits<double>::quiet_NaN();
+  // One pose per keyframe: the trajectory (TUM files).
+  std::vector<BundlePose> trajectory;
+};
+
 struct RefractiveIndexEstimate {
   static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-  // "refine", "online", "window" or "closed-form"; "thin" or "thick".
+  // "refine", "online", "window", "closed-form" or "bundle"; "thin" or
+  // "thick".
   std::string estimator;
   std::string port = "thin";
   // One line: the estimator as it ran (loss, thresholds, mask).
@@ -103,6 +124,9 @@ struct RefractiveIndexEstimate {
   // closed-form: matches the observability mask removed, and its eta.
   std::optional<int64_t> masked;
   std::optional<double> mask_eta;
+
+  // bundle: the landmarks, the tracks and the trajectory.
+  std::optional<BundleSummary> bundle;
 
   std::vector<FrameEstimateRow> per_frame;
   // What the uncertainty says of the calibration and the data, one line

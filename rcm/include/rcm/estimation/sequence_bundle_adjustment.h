@@ -207,6 +207,9 @@ struct SequenceBundleResult {
   double sigma_n_calibration = kNaN;
   // Covariance of cam1_rotation from the noise, rad^2 (zero when held).
   Eigen::Matrix3d rotation_covariance = Eigen::Matrix3d::Zero();
+  // Covariance of n with each component of cam1_rotation from the noise
+  // (radians; zero when held).
+  Eigen::Vector3d n_rotation_covariance = Eigen::Vector3d::Zero();
   // Multiple correlation of n with cam1_rotation left by the data (NaN
   // when the rotation is held).
   double correlation_n_rotation = kNaN;

@@ -52,6 +52,7 @@
 #include "rcm/estimation/refractive_index_estimate.h"
 #include "rcm/estimation/sliding_window_estimator.h"
 #include "rcm/frontend/stereo_front_end.h"
+#include "rcm/frontend/stereo_tracker.h"
 #include "rcm/io/stereo_image_source.h"
 #include "rcm/stereo/stereo_rig.h"
 #include "rcm/util/status.h"
@@ -83,6 +84,11 @@ struct SequenceEstimatorOptions {
   // Keep each pair's matches for Estimate() (a live pipeline that reports
   // the window only does not).
   bool keep_frames = true;
+  // The bundle estimator (estimation.estimator kBundle): every pair is a
+  // keyframe of its tracker; its n from the tracks, or, where the bundle
+  // refuses (a rig that does not move, ...), the refine estimate with the
+  // bundle's reason as its first warning.
+  StereoTrackerOptions tracker;
 
   static EstimationOptions DefaultEstimation();
   // The window's refinement: estimation.refinement without refine_rotation
@@ -96,7 +102,7 @@ struct SequenceEstimatorOptions {
   // refining the rest.
   StereoFrontEndOptions FrontEnd() const;
   // Errors: the parts' Check(); window_matches < 0; follow_rotation_px not
-  // > 0; max_matching_passes < 1.
+  // > 0; max_matching_passes < 1; the bundle without keep_frames.
   Status Check() const;
 };
 
@@ -114,6 +120,9 @@ struct SequencePair {
   std::optional<MediumSwitch> medium_switch;  // this pair confirmed one
   bool reacquired = false;  // the front end left the guide's band
   bool followed = false;    // the front end now follows a new rotation
+  // The bundle: of its matches, how many continue a landmark of the
+  // previous pair (StereoTracker::AddKeyframe).
+  std::optional<int> continued_tracks;
   FrontEndTimings timings;
   double estimate_ms = 0.0;  // the window's update
 };
@@ -173,6 +182,8 @@ class SequenceEstimator {
                     const SequenceEstimatorOptions& options,
                     StereoDetector detector, StereoFrontEnd front_end,
                     SlidingWindowRefractiveIndexEstimator window);
+  // A new tracker for the bundle estimator (none for the others).
+  Status ResetTracker();
 
   StereoRig rig_;
   SequenceEstimatorOptions options_;
@@ -189,6 +200,9 @@ class SequenceEstimator {
   std::vector<FrameEstimateRow> own_rows_;  // each kept pair's own
   std::optional<int64_t> medium_first_;
   std::vector<StereoCorrespondence> subset_;  // SpreadSubset's buffer
+  // The bundle's tracker and its keyframes' stamps.
+  std::optional<StereoTracker> tracker_;
+  std::vector<KeyframeStamp> keyframes_;
 };
 
 // The matches the window takes of `all` (SequenceEstimatorOptions::
