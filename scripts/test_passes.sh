@@ -137,6 +137,10 @@ release_only=(
   # [BagStereoSource.*, EstimateImagesCli.FoldersGiveNAndThePictures,
   # EstimateImagesCli.BagWithoutTheTopicsIsOneLine]: a bag against folders
   'EstimateImagesCli.BagGivesTheSameNAsTheFolders'
+  # [SequenceEstimator.BundleFallsBackToRefineForAStillRig, StereoTracker.Bad*,
+  # SequenceBundleAdjustment.*]: the bundle's accuracy on rendered dives
+  'StereoTracker.RenderedDiveGivesTheBundleNTurnAndTrajectory'
+  'SequenceEstimator.BundleOverTheRenderedPairs'
 )
 
 budgeted=(
@@ -152,6 +156,9 @@ budgeted=(
   'WaterRefractiveIndex.*'
   'UnderwaterCandidates.*'
   'UnderwaterModelSelectionOptions.*'
+  'SequenceBundleAdjustment.*'
+  'SequenceBundleOptions.*'
+  'BundleMotion.*'
 )
 
 # ':'-joined patterns, for GTEST_FILTER.

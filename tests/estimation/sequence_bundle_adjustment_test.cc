@@ -288,8 +288,10 @@ TEST(SequenceBundleAdjustment, CalibrationUncertaintyCarriedIntoSigma) {
               std::hypot(result->sigma_n_noise, result->sigma_n_calibration),
               1e-15);
 
-  // The same with only a rotation uncertain: the bundle absorbs it, so it
-  // moves n by rounding only.
+  // The same with only a rotation uncertain: the bundle absorbs it. What
+  // remains is the linear response's third-order remainder of a 0.1
+  // degree move (measured 2e-7), where a held turn of 0.1 degree moves an
+  // epipolar n by 0.01-0.04 (docs/design.md).
   const StereoRig turned_only =
       calibration
           .WithCalibrationUncertainty(
@@ -301,7 +303,7 @@ TEST(SequenceBundleAdjustment, CalibrationUncertaintyCarriedIntoSigma) {
           .Solve(dive.tracks);
   ASSERT_TRUE(absorbed.ok()) << absorbed.status().message();
   EXPECT_EQ(absorbed->propagation_directions, 3);
-  EXPECT_LT(absorbed->sigma_n_calibration, 1e-8);
+  EXPECT_LT(absorbed->sigma_n_calibration, 1e-6);
 }
 
 // The z-scores of n over Monte Carlo trials on `rig`: 4 keyframes of

@@ -11,7 +11,6 @@
 #include "rcm/frontend/stereo_front_end.h"
 #include "rcm/sim/reference_rigs.h"
 #include "rcm/sim/sequence_simulator.h"
-#include "support/test_budget.h"
 
 namespace rcm {
 namespace {
@@ -61,8 +60,8 @@ TrackedDive TrackDive(const StereoRig& calibration, int frames) {
   return dive;
 }
 
-// The issue's rendered dive, shortened to 6 keyframes (40 in
-// benchmarks/bundle_benchmark.cc): n within 2e-3 of the truth and within 3
+// The issue's rendered dive, shortened to 6 keyframes (the issue asks
+// 40; a test's budget is seconds): n within 2e-3 of the truth and within 3
 // of its sigma, the turn within 0.05 degrees, the trajectory within 1 % of
 // its length. Measured: n off by 2.8e-5 (sigma 2.8e-4), the turn by
 // 0.0025 degrees, the trajectory by 0.3 mm over 0.39 m, the pixel noise
@@ -70,7 +69,7 @@ TrackedDive TrackDive(const StereoRig& calibration, int frames) {
 // 4 sigma off: the pyramid offset of stereo_tracker.h).
 TEST(StereoTracker, RenderedDiveGivesTheBundleNTurnAndTrajectory) {
   const StereoRig calibration = AlphasenseFrontRectifiedRig();
-  const int frames = test::kSanitizerBuild ? 3 : 6;
+  const int frames = 6;
   const TrackedDive dive = TrackDive(calibration, frames);
   ASSERT_EQ(dive.tracks.num_frames, frames);
   for (int i = 1; i < frames; ++i) {
@@ -82,7 +81,6 @@ TEST(StereoTracker, RenderedDiveGivesTheBundleNTurnAndTrajectory) {
           .value()
           .Solve(dive.tracks);
   ASSERT_TRUE(result.ok()) << result.status().message();
-  if (!test::ChecksStatistics()) return;
   EXPECT_LT(std::abs(result->n - 1.333), 2e-3);
   EXPECT_LT(std::abs(result->n - 1.333), 3.0 * result->sigma_n)
       << "n " << result->n << " +- " << result->sigma_n;

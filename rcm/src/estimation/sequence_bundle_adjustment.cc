@@ -164,6 +164,10 @@ struct StageResult {
   double c_nn = 0.0;
   Eigen::Vector3d c_nw = Eigen::Vector3d::Zero();
   Eigen::Matrix3d c_ww = Eigen::Matrix3d::Zero();
+  // v = J (J^T J)^-1 e_n, one entry per residual row in the order the
+  // observations were added: n moves by -v . dr when the residuals move
+  // by dr at the solution (the linear response of the least squares).
+  Eigen::VectorXd n_influence;
 };
 
 // The covariance of n and cam1's turn at the solution, (J^T J)^-1's
@@ -229,10 +233,17 @@ void ReducedCovariance(ceres::Problem& problem, Blocks& blocks, bool rotation,
       if (it.col() >= m) s(r - m, it.col() - m) = it.value();
     }
   }
-  std::vector<int> columns;
+  // Each landmark's block and its coupling to p, for the back-substitution
+  // of the covariance's column of n below.
+  struct LandmarkBlock {
+    Eigen::LDLT<Eigen::Matrix3d> factor;
+    std::vector<int> columns;
+    Eigen::MatrixXd h_lp;
+  };
+  std::vector<LandmarkBlock> landmark_blocks(m / 3);
   for (int l = 0; 3 * l < m; ++l) {
     Eigen::Matrix3d h_ll = Eigen::Matrix3d::Zero();
-    columns.clear();
+    std::vector<int>& columns = landmark_blocks[l].columns;
     for (int k = 0; k < 3; ++k) {
       for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(
                h, 3 * l + k);
@@ -248,7 +259,8 @@ void ReducedCovariance(ceres::Problem& problem, Blocks& blocks, bool rotation,
     }
     std::sort(columns.begin(), columns.end());
     columns.erase(std::unique(columns.begin(), columns.end()), columns.end());
-    Eigen::MatrixXd h_lp = Eigen::MatrixXd::Zero(3, columns.size());
+    Eigen::MatrixXd& h_lp = landmark_blocks[l].h_lp;
+    h_lp = Eigen::MatrixXd::Zero(3, columns.size());
     for (int k = 0; k < 3; ++k) {
       for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(
                h, 3 * l + k);
@@ -259,7 +271,8 @@ void ReducedCovariance(ceres::Problem& problem, Blocks& blocks, bool rotation,
         h_lp(k, at - columns.begin()) = it.value();
       }
     }
-    const Eigen::LDLT<Eigen::Matrix3d> landmark(h_ll);
+    Eigen::LDLT<Eigen::Matrix3d>& landmark = landmark_blocks[l].factor;
+    landmark.compute(h_ll);
     if (landmark.info() != Eigen::Success || !landmark.isPositive() ||
         !(landmark.rcond() > 1e-14)) {
       return;  // a landmark without depth: singular
@@ -291,14 +304,26 @@ void ReducedCovariance(ceres::Problem& problem, Blocks& blocks, bool rotation,
     }
     result->c_ww = 0.5 * (result->c_ww + result->c_ww.transpose()).eval();
   }
+  // The whole column c = (J^T J)^-1 e_n: p's part solved above, each
+  // landmark's c_l = -H_ll^-1 H_lp c_p; then v = J c.
+  Eigen::VectorXd column(m + p);
+  column.tail(p) = covariance.col(0);
+  for (int l = 0; 3 * l < m; ++l) {
+    const LandmarkBlock& block = landmark_blocks[l];
+    Eigen::VectorXd c_p(block.columns.size());
+    for (size_t a = 0; a < block.columns.size(); ++a) {
+      c_p[a] = covariance(block.columns[a], 0);
+    }
+    column.segment<3>(3 * l) = -block.factor.solve(block.h_lp * c_p);
+  }
+  result->n_influence = j * column;
   result->covariance_ok = true;
 }
 
 StageResult SolveStage(const RigConstants& constants,
                        const StereoTracks& tracks, const std::vector<bool>& use,
                        const SequenceBundleOptions& options, bool robust,
-                       int max_iterations, bool covariance, Blocks* blocks,
-                       bool gauss_newton = false) {
+                       int max_iterations, bool covariance, Blocks* blocks) {
   ceres::Problem problem;
   bool any_cam1 = false;
   std::vector<bool> pose_used(blocks->poses.size(), false);
@@ -373,10 +398,6 @@ StageResult SolveStage(const RigConstants& constants,
   }
   solver.linear_solver_ordering = ordering;
   solver.max_num_iterations = max_iterations;
-  if (gauss_newton) {
-    // Steps from a solution to the nearby one of a moved rig: undamped.
-    solver.initial_trust_region_radius = 1e16;
-  }
   // The least squares converge to rounding (quadratically: 4-7 iterations
   // from stage 1's solution), so the noise-free bundle recovers its
   // unknowns to 1e-9 (sequence_bundle_adjustment_test.cc). The robust
@@ -397,6 +418,28 @@ StageResult SolveStage(const RigConstants& constants,
                       options.num_threads, &result);
   }
   return result;
+}
+
+// The residual of one observation at `blocks` with `constants` and the
+// translation direction `direction`; false where the port cannot image
+// the landmark.
+bool EvaluateResidual(const RigConstants& constants,
+                      const StereoTrackObservation& o, const Blocks& blocks,
+                      const double* direction, double residual[2]) {
+  const double* pose = blocks.poses[o.frame].data();
+  const double* landmark = blocks.landmarks[o.landmark].data();
+  RCM_LENS_MODEL_SWITCH(
+      constants.models[o.camera],
+      if (o.camera == 0) {
+        return Cam0TrackReprojectionError<LensModel>(
+            constants.cameras[0], o.pixel)(&blocks.n, pose, landmark, residual);
+      } return Cam1TrackReprojectionError<LensModel>(constants.cameras[1],
+                                                     constants.rotation,
+                                                     constants.baseline,
+                                                     o.pixel)(
+          &blocks.n, pose, landmark, blocks.rotation.data(), direction,
+          residual);)
+  return false;
 }
 
 // Residual norm (pixels) of one observation at `blocks`; nullopt where the
@@ -500,8 +543,9 @@ Status SequenceBundleOptions::Check() const {
         "min shared landmarks = " + std::to_string(min_shared_landmarks) +
         " must be at least 6 (the PnP's)");
   }
-  if (max_iterations < 1 || max_propagation_iterations < 1) {
-    return Status::Error("the iteration limits must be at least 1");
+  if (max_iterations < 1) {
+    return Status::Error("max iterations = " + std::to_string(max_iterations) +
+                         " must be at least 1");
   }
   if (!(propagation_eigenvalue_floor >= 0.0 &&
         propagation_eigenvalue_floor < 1.0)) {
@@ -1045,6 +1089,11 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
         held(index[a], index[b]) = joint(a, b);
       }
     }
+    if (stage2.n_influence.size() !=
+        2 * static_cast<Eigen::Index>(result.num_inliers)) {
+      return Status::Error(
+          "the calibration propagation lost the residuals' order");
+    }
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(held);
     const double largest = eigen.eigenvalues().maxCoeff();
     for (int k = 0; k < held.rows(); ++k) {
@@ -1055,7 +1104,8 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
       }
       const Eigen::VectorXd step =
           std::sqrt(lambda) * eigen.eigenvectors().col(k);
-      double moved_n[2];
+      // dr = (r(+k) - r(-k)) / 2 over the inliers, at the solution.
+      Eigen::VectorXd moved_residuals[2];
       for (int sign = 0; sign < 2; ++sign) {
         StatusOr<StereoRig> moved = MovedRig(
             rig_, sign == 0 ? Eigen::VectorXd(step) : Eigen::VectorXd(-step));
@@ -1064,24 +1114,29 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
               "the calibration propagation's moved rig");
         }
         const RigConstants moved_constants = ConstantsOf(*moved);
-        Blocks moved_blocks = blocks;
-        if (!options_.refine_translation_direction) {
-          for (int i = 0; i < 3; ++i) {
-            moved_blocks.direction[i] = moved_constants.direction[i];
+        // A held direction is the moved rig's; a refined one the solution's.
+        const double* direction = options_.refine_translation_direction
+                                      ? blocks.direction.data()
+                                      : moved_constants.direction.data();
+        Eigen::VectorXd& residuals = moved_residuals[sign];
+        residuals.resize(stage2.n_influence.size());
+        Eigen::Index row = 0;
+        for (size_t i = 0; i < count; ++i) {
+          if (!use[i]) continue;
+          double residual[2];
+          if (!EvaluateResidual(moved_constants, tracks.observations[i], blocks,
+                                direction, residual)) {
+            return Status::Error(
+                "the calibration propagation's moved rig cannot image "
+                "landmark " +
+                std::to_string(tracks.observations[i].landmark));
           }
+          residuals[row++] = residual[0];
+          residuals[row++] = residual[1];
         }
-        const StageResult solve = SolveStage(
-            moved_constants, tracks, use, options_, /*robust=*/false,
-            options_.max_propagation_iterations, /*covariance=*/false,
-            &moved_blocks, /*gauss_newton=*/true);
-        if (!solve.summary.IsSolutionUsable()) {
-          return Status::Error(
-              "the calibration propagation's re-solve failed: " +
-              solve.summary.message);
-        }
-        moved_n[sign] = moved_blocks.n;
       }
-      const double dn = 0.5 * (moved_n[0] - moved_n[1]);
+      const double dn = -stage2.n_influence.dot(
+          0.5 * (moved_residuals[0] - moved_residuals[1]));
       calibration_variance += dn * dn;
       ++result.propagation_directions;
     }
