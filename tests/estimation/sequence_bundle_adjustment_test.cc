@@ -126,6 +126,13 @@ StereoRig TurnedTruth() {
   return Calibration().WithCam1Moved(TrueTurn()).value();
 }
 
+// The bundle of `rig` with `options` over `tracks`.
+StatusOr<SequenceBundleResult> Bundle(const StereoRig& rig,
+                                      const SequenceBundleOptions& options,
+                                      const StereoTracks& tracks) {
+  return SequenceBundleAdjustment::Create(rig, options).value().Solve(tracks);
+}
+
 double RotationError(const Rigid3d& a, const Rigid3d& b) {
   return Eigen::AngleAxisd(a.rotation.transpose() * b.rotation).angle();
 }
@@ -218,9 +225,7 @@ TEST(SequenceBundleAdjustment, NoiseFreeThroughThickPorts) {
   const StereoRig truth = calibration.WithCam1Moved(TrueTurn()).value();
   const Dive dive = MakeDive(truth, n, 8, 300, 0.0, 7);
   const StatusOr<SequenceBundleResult> result =
-      SequenceBundleAdjustment::Create(calibration, SequenceBundleOptions())
-          .value()
-          .Solve(dive.tracks);
+      Bundle(calibration, SequenceBundleOptions(), dive.tracks);
   ASSERT_TRUE(result.ok()) << result.status().message();
   EXPECT_NEAR(result->n, n, kExactTolerance);
   EXPECT_LT((result->state.cam1_rotation - TrueTurn()).norm(), kExactTolerance);
@@ -298,9 +303,7 @@ TEST(SequenceBundleAdjustment, CalibrationUncertaintyCarriedIntoSigma) {
               CalibrationUncertainty::DriftPrior(0.1 * kDeg, 0.0))
           .value();
   const StatusOr<SequenceBundleResult> absorbed =
-      SequenceBundleAdjustment::Create(turned_only, options)
-          .value()
-          .Solve(dive.tracks);
+      Bundle(turned_only, options, dive.tracks);
   ASSERT_TRUE(absorbed.ok()) << absorbed.status().message();
   EXPECT_EQ(absorbed->propagation_directions, 3);
   EXPECT_LT(absorbed->sigma_n_calibration, 1e-6);
@@ -431,9 +434,7 @@ TEST(SequenceBundleAdjustment, StaticRigRefusedInOneLine) {
   const Dive dive =
       MakeDive(TurnedTruth(), 1.34, 6, 300, 0.0, 8, Path::kStatic);
   const StatusOr<SequenceBundleResult> result =
-      SequenceBundleAdjustment::Create(Calibration(), SequenceBundleOptions())
-          .value()
-          .Solve(dive.tracks);
+      Bundle(Calibration(), SequenceBundleOptions(), dive.tracks);
   ASSERT_FALSE(result.ok());
   EXPECT_EQ(result.status().message().rfind("the rig does not move: ", 0), 0u)
       << result.status().message();
@@ -443,9 +444,7 @@ TEST(SequenceBundleAdjustment, StaticRigRefusedInOneLine) {
   SequenceBundleOptions options;
   options.allow_degenerate_motion = true;
   const StatusOr<SequenceBundleResult> anyway =
-      SequenceBundleAdjustment::Create(Calibration(), options)
-          .value()
-          .Solve(dive.tracks);
+      Bundle(Calibration(), options, dive.tracks);
   ASSERT_TRUE(anyway.ok()) << anyway.status().message();
   EXPECT_EQ(anyway->motion.kind, BundleMotion::kStatic);
   EXPECT_NEAR(anyway->n, 1.34, kExactTolerance);
@@ -455,9 +454,7 @@ TEST(SequenceBundleAdjustment, AlongTheAxisRefusedInOneLine) {
   const Dive dive =
       MakeDive(TurnedTruth(), 1.34, 6, 300, 0.0, 9, Path::kAlongAxis);
   const StatusOr<SequenceBundleResult> result =
-      SequenceBundleAdjustment::Create(Calibration(), SequenceBundleOptions())
-          .value()
-          .Solve(dive.tracks);
+      Bundle(Calibration(), SequenceBundleOptions(), dive.tracks);
   ASSERT_FALSE(result.ok());
   EXPECT_EQ(result.status().message().rfind(
                 "the rig moves only along its optical axis", 0),
@@ -469,9 +466,7 @@ TEST(SequenceBundleAdjustment, OnePlaneFromOneDistanceRefusedInOneLine) {
   const Dive dive =
       MakeDive(TurnedTruth(), 1.34, 6, 300, 0.0, 10, Path::kOverPlane);
   const StatusOr<SequenceBundleResult> result =
-      SequenceBundleAdjustment::Create(Calibration(), SequenceBundleOptions())
-          .value()
-          .Solve(dive.tracks);
+      Bundle(Calibration(), SequenceBundleOptions(), dive.tracks);
   ASSERT_FALSE(result.ok());
   EXPECT_EQ(result.status().message().rfind(
                 "the rig sees one plane from one distance", 0),
@@ -527,9 +522,7 @@ TEST(SequenceBundleAdjustment, BrokenTrackChainRefused) {
     tracks.observations.push_back(moved);
   }
   const StatusOr<SequenceBundleResult> result =
-      SequenceBundleAdjustment::Create(Calibration(), SequenceBundleOptions())
-          .value()
-          .Solve(tracks);
+      Bundle(Calibration(), SequenceBundleOptions(), tracks);
   ASSERT_FALSE(result.ok());
   EXPECT_NE(result.status().message().find("keyframe 2 sees 0 landmarks"),
             std::string::npos)

@@ -19,6 +19,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 #include <optional>
+#include <tuple>
 #include <utility>
 
 #include "rcm/camera/camera.h"
@@ -39,8 +40,6 @@ constexpr double kInitialReferenceDepth = 2.0;
 // them off by metres on a narrow rig whose cam1 turned a degree (2 px lost
 // keyframes there); a mistracked point is off by tens of pixels.
 constexpr double kPnpThresholdPx = 8.0;
-// n this close to the upper bound is pinned there.
-constexpr double kBoundTolerance = 1e-9;
 // Up to this many keyframes the Schur complement is solved dense.
 constexpr int kMaxDenseSchurFrames = 100;
 
@@ -446,15 +445,13 @@ bool EvaluateResidual(const RigConstants& constants,
 // port cannot image the landmark.
 std::optional<double> ResidualNorm(const RigConstants& constants,
                                    const StereoTrackObservation& o,
-                                   Blocks* blocks) {
-  std::unique_ptr<ceres::CostFunction> cost(CostFor(constants, o));
-  const double* parameters[5] = {&blocks->n, blocks->poses[o.frame].data(),
-                                 blocks->landmarks[o.landmark].data(),
-                                 blocks->rotation.data(),
-                                 blocks->direction.data()};
-  double residuals[2];
-  if (!cost->Evaluate(parameters, residuals, nullptr)) return std::nullopt;
-  return std::hypot(residuals[0], residuals[1]);
+                                   const Blocks& blocks) {
+  double residual[2];
+  if (!EvaluateResidual(constants, o, blocks, blocks.direction.data(),
+                        residual)) {
+    return std::nullopt;
+  }
+  return std::hypot(residual[0], residual[1]);
 }
 
 // The midpoint of two rays (origins, unit directions) when they meet in
@@ -689,20 +686,30 @@ StatusOr<SequenceBundleState> SequenceBundleAdjustment::Initialize(
   double n0 = options_.initial_n;
   Eigen::Vector3d w0 = Eigen::Vector3d::Zero();
   if (options_.epipolar_seed && !rig_.HasThickPort()) {
-    std::vector<std::array<const Eigen::Vector2d*, 2>> seen(
-        static_cast<size_t>(tracks.num_frames) * tracks.num_landmarks,
-        {nullptr, nullptr});
-    std::vector<StereoCorrespondence> pairs;
+    // Each keyframe's left and right observation of one landmark, next to
+    // each other once sorted by (keyframe, landmark, camera).
+    std::vector<const StereoTrackObservation*> sorted;
     for (const StereoTrackObservation& o : tracks.observations) {
-      seen[static_cast<size_t>(o.frame) * tracks.num_landmarks + o.landmark]
-          [o.camera] = &o.pixel;
+      sorted.push_back(&o);
     }
-    for (size_t k = 0; k < seen.size(); ++k) {
-      if (seen[k][0] == nullptr || seen[k][1] == nullptr) continue;
+    std::sort(
+        sorted.begin(), sorted.end(),
+        [](const StereoTrackObservation* a, const StereoTrackObservation* b) {
+          return std::tie(a->frame, a->landmark, a->camera) <
+                 std::tie(b->frame, b->landmark, b->camera);
+        });
+    std::vector<StereoCorrespondence> pairs;
+    for (size_t k = 0; k + 1 < sorted.size(); ++k) {
+      const StereoTrackObservation& left = *sorted[k];
+      const StereoTrackObservation& right = *sorted[k + 1];
+      if (left.camera != 0 || right.camera != 1 || left.frame != right.frame ||
+          left.landmark != right.landmark) {
+        continue;
+      }
       StereoCorrespondence pair;
-      pair.frame = static_cast<int64_t>(k / tracks.num_landmarks);
-      pair.left_pixel = *seen[k][0];
-      pair.right_pixel = *seen[k][1];
+      pair.frame = left.frame;
+      pair.left_pixel = left.pixel;
+      pair.right_pixel = right.pixel;
       pairs.push_back(pair);
     }
     // The calibration as given, without its uncertainty: a free turn.
@@ -920,7 +927,7 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
   for (size_t i = 0; i < count; ++i) {
     use[i] =
         blocks.placed[tracks.observations[i].landmark] &&
-        ResidualNorm(constants, tracks.observations[i], &blocks).has_value();
+        ResidualNorm(constants, tracks.observations[i], blocks).has_value();
   }
 
   SequenceBundleResult result;
@@ -950,7 +957,7 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
   for (size_t i = 0; i < count; ++i) {
     if (!use[i]) continue;
     const std::optional<double> norm =
-        ResidualNorm(constants, tracks.observations[i], &blocks);
+        ResidualNorm(constants, tracks.observations[i], blocks);
     use[i] = norm && *norm <= options_.inlier_threshold_px;
     if (use[i]) ++inlier_views[tracks.observations[i].landmark];
   }
@@ -1038,11 +1045,9 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
                          " inlier residuals for " + std::to_string(unknowns) +
                          " unknowns: too few tracks");
   }
-  if (blocks.n >= RefractiveCamera::kMaxIndex - kBoundTolerance) {
-    return Status::Error(
-        "n is pinned at the upper bound 2, which no medium reaches: the "
-        "tracks do not fit a refractive rig (wrong calibration or tracks)");
-  }
+  // n at the upper bound 2 (the estimators' one rule and message,
+  // refinement_options.h); with sigma_n below, once it is known.
+  RCM_RETURN_IF_ERROR(CheckNotPinnedAtUpperBound(blocks.n));
   if (!stage2.covariance_ok || !(stage2.c_nn > 0.0)) {
     return Status::Error(
         "the bundle's covariance is singular: the tracks do not observe n "
@@ -1144,6 +1149,7 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
   result.sigma_n_calibration = std::sqrt(calibration_variance);
   result.sigma_n = std::sqrt(result.sigma_n_noise * result.sigma_n_noise +
                              calibration_variance);
+  RCM_RETURN_IF_ERROR(CheckNotPinnedAtUpperBound(result.n, result.sigma_n));
   return result;
 }
 

@@ -120,7 +120,6 @@ double SequenceEstimator::RotationPixels(const Eigen::Vector3d& a,
 }
 
 Status SequenceEstimator::ResetTracker() {
-  keyframes_.clear();
   tracker_.reset();
   if (options_.estimation.estimator != EstimatorKind::kBundle) {
     return Status::Ok();
@@ -193,7 +192,6 @@ StatusOr<SequencePair> SequenceEstimator::AddDetectedPair(
   if (tracker_) {
     StatusOr<int> continued = tracker_->AddKeyframe(detected, *matched);
     if (!continued.ok()) return continued.status();
-    keyframes_.push_back({frame, timestamp});
     pair.continued_tracks = *continued;
   }
 
@@ -277,8 +275,13 @@ StatusOr<RefractiveIndexEstimate> SequenceEstimator::Estimate() const {
   options.per_frame_estimates = false;  // the pairs' own estimates
   std::optional<std::string> bundle_refused;
   if (options.estimator == EstimatorKind::kBundle) {
+    // Every kept pair is a keyframe (the bundle keeps them all).
+    std::vector<KeyframeStamp> keyframes;
+    for (const FrameMatches& kept : frames_) {
+      keyframes.push_back({kept.frame, kept.timestamp});
+    }
     StatusOr<RefractiveIndexEstimate> bundle =
-        EstimateRefractiveIndexFromTracks(rig_, tracker_->tracks(), keyframes_,
+        EstimateRefractiveIndexFromTracks(rig_, tracker_->tracks(), keyframes,
                                           options);
     if (bundle.ok()) {
       bundle->per_frame = own_rows_;

@@ -200,9 +200,8 @@ class SequenceEstimator {
   std::vector<FrameEstimateRow> own_rows_;  // each kept pair's own
   std::optional<int64_t> medium_first_;
   std::vector<StereoCorrespondence> subset_;  // SpreadSubset's buffer
-  // The bundle's tracker and its keyframes' stamps.
+  // The bundle's tracker (its keyframes are the kept frames_).
   std::optional<StereoTracker> tracker_;
-  std::vector<KeyframeStamp> keyframes_;
 };
 
 // The matches the window takes of `all` (SequenceEstimatorOptions::
