@@ -185,5 +185,51 @@ TEST(Trajectory, AStillCameraHovers) {
   }
 }
 
+// A loop ends where it began: the last pose is the first, position and
+// orientation, up to the arc-length table's 1e-7 of the perimeter (the
+// tolerance: 1e-6 m on a 5.7 m lap) and rounding of the wobbles' sines.
+// Between, the rig flies the lap at one speed, so the frames are evenly
+// spaced along it and the path is the laps' length.
+TEST(Trajectory, LoopsEndWhereTheyBegan) {
+  TankSceneOptions tank;
+  tank.length = 5.0;
+  tank.width = 5.0;
+  tank.constant_albedo = 0.5;
+  const TankScene scene = TankScene::Create(tank).value();
+  for (const int loops : {1, 2}) {
+    TrajectoryOptions options;
+    options.frames = 61;
+    options.loops = loops;
+    const std::vector<TimedPose> poses =
+        GenerateTrajectory(scene, options).value();
+    const Rigid3d& first = poses.front().world_from_cam0;
+    const Rigid3d& last = poses.back().world_from_cam0;
+    EXPECT_LT((last.translation - first.translation).norm(), 1e-6);
+    EXPECT_LT((last.rotation - first.rotation).norm(), 1e-6);
+    // The middle frame of one lap is across the circle (radius 0.9 m).
+    if (loops == 1) {
+      EXPECT_GT((poses[30].world_from_cam0.translation - first.translation)
+                    .head<2>()
+                    .norm(),
+                1.5);
+    }
+  }
+  TrajectoryOptions fast;
+  fast.frames = 2;
+  fast.frame_rate = 1.0;
+  fast.loops = 1;  // 5.65 m in one second
+  const StatusOr<std::vector<TimedPose>> refused =
+      GenerateTrajectory(scene, fast);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.status().message().find("beyond 5"), std::string::npos)
+      << refused.status().message();
+  TrajectoryOptions bad;
+  bad.loops = -1;
+  EXPECT_NE(bad.Check().message().find("loops"), std::string::npos);
+  bad.loops = 1;
+  bad.frames = 1;
+  EXPECT_NE(bad.Check().message().find("loops"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace rcm::trajectory_test

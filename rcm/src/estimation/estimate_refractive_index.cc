@@ -271,6 +271,11 @@ Status EstimationOptions::Check() const {
   RCM_RETURN_IF_ERROR(window.Check());
   RCM_RETURN_IF_ERROR(closed_form.Check());
   RCM_RETURN_IF_ERROR(bundle.Check().WithContext("bundle"));
+  if (!bundle.refine_n) {
+    return Status::Error(
+        "the bundle's refine_n is false: an estimate of n estimates n (hold n "
+        "with SequenceBundleAdjustment itself, for odometry)");
+  }
   if (refinement.refine_rotation && estimator != EstimatorKind::kRefine) {
     return Status::Error(
         "refine_rotation works with the refine estimator only");

@@ -346,8 +346,12 @@ StageResult SolveStage(const RigConstants& constants,
   }
   StageResult result;
   if (problem.NumResidualBlocks() == 0) return result;
-  problem.SetParameterLowerBound(&blocks->n, 0, RefractiveCamera::kMinIndex);
-  problem.SetParameterUpperBound(&blocks->n, 0, RefractiveCamera::kMaxIndex);
+  if (options.refine_n) {
+    problem.SetParameterLowerBound(&blocks->n, 0, RefractiveCamera::kMinIndex);
+    problem.SetParameterUpperBound(&blocks->n, 0, RefractiveCamera::kMaxIndex);
+  } else {
+    problem.SetParameterBlockConstant(&blocks->n);
+  }
   for (size_t f = 0; f < blocks->poses.size(); ++f) {
     if (!pose_used[f]) continue;
     problem.SetManifold(
@@ -411,7 +415,7 @@ StageResult SolveStage(const RigConstants& constants,
   solver.logging_type = ceres::SILENT;
   ceres::Solve(solver, &problem, &result.summary);
 
-  if (covariance && result.summary.IsSolutionUsable()) {
+  if (covariance && options.refine_n && result.summary.IsSolutionUsable()) {
     ReducedCovariance(problem, *blocks, any_cam1 && options.refine_rotation,
                       any_cam1 && options.refine_translation_direction,
                       options.num_threads, &result);
@@ -722,7 +726,7 @@ StatusOr<SequenceBundleState> SequenceBundleAdjustment::Initialize(
       const StatusOr<RefinementSummary> epipolar =
           RefineRefractiveIndex(*plain, pairs, seed);
       if (epipolar.ok() && epipolar->rotation) {
-        n0 = epipolar->n;
+        if (options_.refine_n) n0 = epipolar->n;
         w0 = epipolar->rotation->angle_axis;
       }
     }
@@ -944,7 +948,7 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
   }
   result.iterations += static_cast<int>(stage1.summary.iterations.size());
   result.motion = ClassifyBundleMotion(StateOf(blocks), options_);
-  if (result.motion.kind != BundleMotion::kMoving &&
+  if (result.motion.kind != BundleMotion::kMoving && options_.refine_n &&
       !options_.allow_degenerate_motion) {
     return Status::Error(result.motion.Describe() +
                          ": motion cannot separate n from cam1's turn, use "
@@ -1035,15 +1039,25 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
     used_frames = static_cast<int>(
         std::count(frame_used.begin(), frame_used.end(), true));
   }
-  const int64_t unknowns = 1 + (options_.refine_rotation ? 3 : 0) +
-                           (options_.refine_translation_direction ? 2 : 0) +
-                           6 * std::max(0, used_frames - 1) +
-                           3 * int64_t{result.num_landmarks};
+  const int64_t unknowns =
+      (options_.refine_n ? 1 : 0) + (options_.refine_rotation ? 3 : 0) +
+      (options_.refine_translation_direction ? 2 : 0) +
+      6 * std::max(0, used_frames - 1) + 3 * int64_t{result.num_landmarks};
   const int64_t residuals = 2 * result.num_inliers;
   if (residuals <= unknowns) {
     return Status::Error("the bundle has " + std::to_string(residuals) +
                          " inlier residuals for " + std::to_string(unknowns) +
                          " unknowns: too few tracks");
+  }
+  result.pixel_sigma = std::sqrt(2.0 * stage2.summary.final_cost /
+                                 static_cast<double>(residuals - unknowns));
+  if (!options_.refine_n) {
+    // n held (the options): the trajectory and the turn, nothing of n.
+    result.n = blocks.n;
+    result.sigma_n = result.sigma_n_noise = result.sigma_n_calibration = 0.0;
+    result.state = StateOf(blocks);
+    result.motion = ClassifyBundleMotion(result.state, options_);
+    return result;
   }
   // n at the upper bound 2 (the estimators' one rule and message,
   // refinement_options.h); with sigma_n below, once it is known.
@@ -1053,8 +1067,6 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
         "the bundle's covariance is singular: the tracks do not observe n "
         "(a rig that does not move, or one plane at one depth)");
   }
-  result.pixel_sigma = std::sqrt(2.0 * stage2.summary.final_cost /
-                                 static_cast<double>(residuals - unknowns));
   const double s2 = result.pixel_sigma * result.pixel_sigma;
   result.n = blocks.n;
   result.sigma_n_noise = std::sqrt(s2 * stage2.c_nn);

@@ -62,6 +62,9 @@ Status TrajectoryOptions::Check() const {
     message << "trajectory height = " << height << " m must be > 0";
   } else if (!finite_nonnegative(speed) || speed > 5.0) {
     message << "trajectory speed = " << speed << " m/s is outside [0, 5]";
+  } else if (loops < 0 || loops > 100 || (loops > 0 && frames < 2)) {
+    message << "trajectory loops = " << loops << " with frames = " << frames
+            << ": loops must be in [0, 100], and a loop needs 2 frames";
   } else if (!std::isfinite(pitch_deg) || pitch_deg < -60.0 ||
              pitch_deg > 80.0) {
     message << "trajectory pitch_deg = " << pitch_deg
@@ -119,11 +122,11 @@ StatusOr<std::vector<TimedPose>> GenerateTrajectory(
   };
   const double start_angle = phase(rng);
   const double direction = std::bernoulli_distribution(0.5)(rng) ? 1.0 : -1.0;
-  const double sway_period = period(6.0, 10.0), sway_phase = phase(rng);
-  const double heave_period = period(4.0, 7.0), heave_phase = phase(rng);
-  const double yaw_period = period(7.0, 12.0), yaw_phase = phase(rng);
-  const double pitch_period = period(3.0, 5.0), pitch_phase = phase(rng);
-  const double roll_period = period(3.5, 6.0), roll_phase = phase(rng);
+  double sway_period = period(6.0, 10.0), sway_phase = phase(rng);
+  double heave_period = period(4.0, 7.0), heave_phase = phase(rng);
+  double yaw_period = period(7.0, 12.0), yaw_phase = phase(rng);
+  double pitch_period = period(3.0, 5.0), pitch_phase = phase(rng);
+  double roll_period = period(3.5, 6.0), roll_phase = phase(rng);
   const auto wave = [](double amplitude, double period, double phase,
                        double t) {
     return amplitude * std::sin(2.0 * M_PI * t / period + phase);
@@ -132,14 +135,30 @@ StatusOr<std::vector<TimedPose>> GenerateTrajectory(
   const std::vector<double> table = ArcLengthTable(a, b);
   const double perimeter = table.back();
   const double start_s = start_angle / (2.0 * M_PI) * perimeter;
+  double speed = options.speed;
+  if (options.loops > 0) {
+    // K laps in the dive's duration, and whole cycles of every wobble.
+    const double duration = (options.frames - 1) / options.frame_rate;
+    speed = options.loops * perimeter / duration;
+    if (speed > 5.0) {
+      std::ostringstream message;
+      message << options.loops << " laps of " << perimeter << " m in "
+              << duration << " s fly at " << speed
+              << " m/s, beyond 5: more frames, or a smaller tank";
+      return Status::Error(message.str());
+    }
+    for (double* period : {&sway_period, &heave_period, &yaw_period,
+                           &pitch_period, &roll_period}) {
+      *period = duration / std::max(1.0, std::round(duration / *period));
+    }
+  }
   const Eigen::Vector2d center(0.5 * scene.length(), 0.5 * scene.width());
 
   std::vector<TimedPose> poses;
   poses.reserve(options.frames);
   for (int i = 0; i < options.frames; ++i) {
     const double t = i / options.frame_rate;
-    const double phi =
-        direction * AngleAtArcLength(table, start_s + options.speed * t);
+    const double phi = direction * AngleAtArcLength(table, start_s + speed * t);
     const Eigen::Vector2d on_path =
         center + Eigen::Vector2d(a * std::cos(phi), b * std::sin(phi));
     const Eigen::Vector2d tangent =

@@ -113,6 +113,12 @@ struct SequenceBundleOptions {
   // rig whose cam1 turned by a degree triangulates landmarks metres off,
   // and 2 of 50 trials ended with n pinned at 2.
   bool epipolar_seed = true;
+  // Estimate n; false holds it at initial_n, for odometry with n known or
+  // assumed (the odometry table of docs/bundle.md: n held at the truth, or
+  // at 1, water ignored). The seed's turn is kept, its n is not, and the
+  // result's n is initial_n with sigma_n 0 (not estimated), no covariance
+  // and no refusal of motion that cannot separate n from the turn.
+  bool refine_n = true;
   // Estimate cam1's rotation change since the calibration (the drift the
   // epipolar estimator cannot tell from n); false holds the camchain's.
   bool refine_rotation = true;

@@ -16,6 +16,13 @@
 //   z = (cos p cos psi, cos p sin psi, -sin p),  x0 = (sin psi, -cos psi, 0),
 //   y0 = z cross x0, then x, y rotated by the roll about z;
 // world_from_cam0 has columns (x, y, z) and translation the camera center.
+//
+// A loop (loops = K >= 1): the frames fly exactly K laps of the ellipse, so
+// that the last frame is where the first was, as a dive that returns to its
+// start (the loop-closure gap of an odometry is its drift). The speed is
+// then K * perimeter * frame_rate / (frames - 1), and each wobble's period
+// is the dive's duration over the whole number of cycles nearest to its
+// drawn period, so that every wobble closes too.
 #ifndef RCM_SIM_TRAJECTORY_H_
 #define RCM_SIM_TRAJECTORY_H_
 
@@ -41,6 +48,9 @@ struct TrajectoryOptions {
   double heave_amplitude = 0.05;    // meters, >= 0
   double yaw_amplitude_deg = 5.0;   // degrees, in [0, 45]
   double rock_amplitude_deg = 1.5;  // degrees of pitch and roll, [0, 20]
+  // 0: an open path at `speed`. K >= 1: K closed laps (above; `speed` is
+  // ignored), at most 100, with frames >= 2.
+  int loops = 0;
   uint64_t seed = 1;  // start point, direction, periods and phases
 
   Status Check() const;
