@@ -68,6 +68,7 @@ constexpr char kSimulateUsage[] =
     "                    [--matches-per-frame 500] [--calib RIG.yaml | --rig "
     "narrow]\n"
     "                    [--extrinsic-drift 0.5,0,0] [--lens-change 0.5,-0.3]\n"
+    "                    [--tank 5,5,3 --loops 1]\n"
     "                    [--board chessboard --cols 9 --rows 6\n"
     "                    --square 0.03 [--board-distance 0.6,2]\n"
     "                    [--board-warp 1,0.5]] [--seed "

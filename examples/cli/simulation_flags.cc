@@ -38,6 +38,13 @@ DEFINE_double(image_noise, 1.5,
 DEFINE_int32(supersampling, 2,
              "rays per pixel along each axis (anti-aliasing), 1-4");
 DEFINE_uint64(seed, 1, "random seed; the outputs depend only on the flags");
+DEFINE_string(tank, "12,8,3",
+              "LENGTH,WIDTH,DEPTH of the pool, meters; the robot circles "
+              "it 1.6 m from the walls (a 5,5,3 pool: a 5.7 m lap)");
+DEFINE_int32(loops, 0,
+             "0: the robot flies on at 0.3 m/s; K >= 1: the frames fly "
+             "exactly K laps, the last frame where the first was (a loop "
+             "dive: an odometry's loop-closure gap is its drift)");
 DEFINE_string(extrinsic_drift, "",
               "RX,RY,RZ[,TX,TY,TZ]: cam1 has moved since the air "
               "calibration by this rotation (angle-axis, degrees, cam1 "
@@ -146,6 +153,20 @@ StatusOr<Simulation> SimulationFromFlags(const std::string& calib,
     return Status::Error("--frame-rate must be in [0.1, 1000] Hz");
   }
   options.trajectory.frame_rate = FLAGS_frame_rate;
+  {
+    const StatusOr<std::vector<double>> tank = ParseNumberList(FLAGS_tank);
+    if (!tank.ok() || tank->size() != 3) {
+      return Status::Error("--tank " + FLAGS_tank +
+                           ": expected LENGTH,WIDTH,DEPTH (meters), e.g. "
+                           "5,5,3");
+    }
+    options.scene.length = (*tank)[0];
+    options.scene.width = (*tank)[1];
+    options.scene.depth = (*tank)[2];
+    RCM_RETURN_IF_ERROR(options.scene.Check().WithContext("--tank"));
+  }
+  options.trajectory.loops = FLAGS_loops;
+  RCM_RETURN_IF_ERROR(options.trajectory.Check().WithContext("--loops"));
   options.render.read_noise = FLAGS_image_noise;
   options.render.supersampling = FLAGS_supersampling;
   options.seed = FLAGS_seed;
@@ -174,6 +195,7 @@ nlohmann::json SimulationFlagsJson(const Simulation& simulation) {
             {"width", options.scene.width},
             {"depth", options.scene.depth}}},
           {"frame_rate", options.trajectory.frame_rate},
+          {"loops", options.trajectory.loops},
           {"image_noise", FLAGS_image_noise},
           {"supersampling", FLAGS_supersampling},
           {"seed", options.seed}};

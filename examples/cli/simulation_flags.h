@@ -23,6 +23,8 @@ DECLARE_double(port_tilt);
 DECLARE_double(image_noise);
 DECLARE_int32(supersampling);
 DECLARE_uint64(seed);
+DECLARE_string(tank);
+DECLARE_int32(loops);
 DECLARE_string(extrinsic_drift);
 
 namespace rcm::cli {

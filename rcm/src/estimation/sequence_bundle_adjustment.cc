@@ -92,14 +92,21 @@ RigConstants ConstantsOf(const StereoRig& rig) {
   return constants;
 }
 
-ceres::CostFunction* CostFor(const RigConstants& constants,
-                             const StereoTrackObservation& observation) {
+// The observation's cost; a cam1 observation's with the translation's
+// direction a block of its own, or held at `held_direction`.
+ceres::CostFunction* CostFor(
+    const RigConstants& constants, const StereoTrackObservation& observation,
+    const std::optional<std::array<double, 3>>& held_direction) {
   const int c = observation.camera;
   RCM_LENS_MODEL_SWITCH(
       constants.models[c],
       if (c == 0) {
         return Cam0TrackReprojectionError<LensModel>::Create(
             constants.cameras[0], observation.pixel);
+      } if (held_direction) {
+        return Cam1HeldDirectionTrackReprojectionError<LensModel>::Create(
+            constants.cameras[1], constants.rotation, constants.baseline,
+            *held_direction, observation.pixel);
       } return Cam1TrackReprojectionError<LensModel>::
           Create(constants.cameras[1], constants.rotation, constants.baseline,
                  observation.pixel);)
@@ -220,58 +227,77 @@ void ReducedCovariance(ceres::Problem& problem, Blocks& blocks, bool rotation,
       jacobian.num_rows, jacobian.num_cols,
       static_cast<int>(jacobian.values.size()), jacobian.rows.data(),
       jacobian.cols.data(), jacobian.values.data());
-  const Eigen::SparseMatrix<double, Eigen::RowMajor> h =
-      (Eigen::SparseMatrix<double, Eigen::RowMajor>(j.transpose()) * j)
-          .pruned();
-  // S, landmark by landmark.
+  // H = J^T J by blocks, row by row of J: each row holds one landmark's
+  // columns (< m) and some of p's. (Eigen's sparse J^T J over all columns
+  // took a minute on 30000 landmarks, single-threaded.)
   const int m = num_landmark_columns;
   Eigen::MatrixXd s = Eigen::MatrixXd::Zero(p, p);
-  for (int r = m; r < m + p; ++r) {
-    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(h, r);
-         it; ++it) {
-      if (it.col() >= m) s(r - m, it.col() - m) = it.value();
-    }
-  }
   // Each landmark's block and its coupling to p, for the back-substitution
   // of the covariance's column of n below.
   struct LandmarkBlock {
+    Eigen::Matrix3d h_ll = Eigen::Matrix3d::Zero();
     Eigen::LDLT<Eigen::Matrix3d> factor;
-    std::vector<int> columns;
+    std::vector<int> columns;  // p's columns it couples to, ascending
     Eigen::MatrixXd h_lp;
   };
   std::vector<LandmarkBlock> landmark_blocks(m / 3);
-  for (int l = 0; 3 * l < m; ++l) {
-    Eigen::Matrix3d h_ll = Eigen::Matrix3d::Zero();
-    std::vector<int>& columns = landmark_blocks[l].columns;
-    for (int k = 0; k < 3; ++k) {
-      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(
-               h, 3 * l + k);
-           it; ++it) {
-        if (it.col() < m) {
-          if (it.col() >= 3 * l && it.col() < 3 * l + 3) {
-            h_ll(k, it.col() - 3 * l) = it.value();
-          }
+  {
+    // Pass 1: each landmark's p columns.
+    for (int r = 0; r < jacobian.num_rows; ++r) {
+      int landmark = -1;
+      for (int k = jacobian.rows[r]; k < jacobian.rows[r + 1]; ++k) {
+        if (jacobian.cols[k] < m) landmark = jacobian.cols[k] / 3;
+      }
+      if (landmark < 0) continue;
+      std::vector<int>& columns = landmark_blocks[landmark].columns;
+      for (int k = jacobian.rows[r]; k < jacobian.rows[r + 1]; ++k) {
+        if (jacobian.cols[k] >= m) columns.push_back(jacobian.cols[k] - m);
+      }
+    }
+    for (LandmarkBlock& block : landmark_blocks) {
+      std::sort(block.columns.begin(), block.columns.end());
+      block.columns.erase(
+          std::unique(block.columns.begin(), block.columns.end()),
+          block.columns.end());
+      block.h_lp = Eigen::MatrixXd::Zero(3, block.columns.size());
+    }
+    // Pass 2: the products of each row's entries.
+    std::vector<std::pair<int, double>> landmark_entries;
+    std::vector<std::pair<int, double>> p_entries;
+    for (int r = 0; r < jacobian.num_rows; ++r) {
+      landmark_entries.clear();
+      p_entries.clear();
+      for (int k = jacobian.rows[r]; k < jacobian.rows[r + 1]; ++k) {
+        const int col = jacobian.cols[k];
+        if (col < m) {
+          landmark_entries.emplace_back(col, jacobian.values[k]);
         } else {
-          columns.push_back(it.col() - m);
+          p_entries.emplace_back(col - m, jacobian.values[k]);
+        }
+      }
+      for (const auto& [a, va] : p_entries) {
+        for (const auto& [b, vb] : p_entries) s(a, b) += va * vb;
+      }
+      if (landmark_entries.empty()) continue;
+      LandmarkBlock& block = landmark_blocks[landmark_entries[0].first / 3];
+      for (const auto& [a, va] : landmark_entries) {
+        for (const auto& [b, vb] : landmark_entries) {
+          block.h_ll(a % 3, b % 3) += va * vb;
+        }
+        for (const auto& [b, vb] : p_entries) {
+          const auto at =
+              std::lower_bound(block.columns.begin(), block.columns.end(), b);
+          block.h_lp(a % 3, at - block.columns.begin()) += va * vb;
         }
       }
     }
-    std::sort(columns.begin(), columns.end());
-    columns.erase(std::unique(columns.begin(), columns.end()), columns.end());
-    Eigen::MatrixXd& h_lp = landmark_blocks[l].h_lp;
-    h_lp = Eigen::MatrixXd::Zero(3, columns.size());
-    for (int k = 0; k < 3; ++k) {
-      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(
-               h, 3 * l + k);
-           it; ++it) {
-        if (it.col() < m) continue;
-        const auto at =
-            std::lower_bound(columns.begin(), columns.end(), it.col() - m);
-        h_lp(k, at - columns.begin()) = it.value();
-      }
-    }
-    Eigen::LDLT<Eigen::Matrix3d>& landmark = landmark_blocks[l].factor;
-    landmark.compute(h_ll);
+  }
+  // S = H_pp - sum_l H_lp^T H_ll^-1 H_lp.
+  for (LandmarkBlock& block : landmark_blocks) {
+    const std::vector<int>& columns = block.columns;
+    const Eigen::MatrixXd& h_lp = block.h_lp;
+    Eigen::LDLT<Eigen::Matrix3d>& landmark = block.factor;
+    landmark.compute(block.h_ll);
     if (landmark.info() != Eigen::Success || !landmark.isPositive() ||
         !(landmark.rcond() > 1e-14)) {
       return;  // a landmark without depth: singular
@@ -325,6 +351,10 @@ StageResult SolveStage(const RigConstants& constants,
                        int max_iterations, bool covariance, Blocks* blocks) {
   ceres::Problem problem;
   bool any_cam1 = false;
+  // A held direction is a constant of the cam1 residuals (a smaller
+  // Jacobian), a refined one their block.
+  std::optional<std::array<double, 3>> held_direction;
+  if (!options.refine_translation_direction) held_direction = blocks->direction;
   std::vector<bool> pose_used(blocks->poses.size(), false);
   for (size_t i = 0; i < tracks.observations.size(); ++i) {
     if (!use[i]) continue;
@@ -334,13 +364,17 @@ StageResult SolveStage(const RigConstants& constants,
     double* pose = blocks->poses[o.frame].data();
     double* landmark = blocks->landmarks[o.landmark].data();
     pose_used[o.frame] = true;
+    ceres::CostFunction* cost = CostFor(constants, o, held_direction);
     if (o.camera == 0) {
-      problem.AddResidualBlock(CostFor(constants, o), loss, &blocks->n, pose,
-                               landmark);
+      problem.AddResidualBlock(cost, loss, &blocks->n, pose, landmark);
+    } else if (held_direction) {
+      any_cam1 = true;
+      problem.AddResidualBlock(cost, loss, &blocks->n, pose, landmark,
+                               blocks->rotation.data());
     } else {
       any_cam1 = true;
-      problem.AddResidualBlock(CostFor(constants, o), loss, &blocks->n, pose,
-                               landmark, blocks->rotation.data(),
+      problem.AddResidualBlock(cost, loss, &blocks->n, pose, landmark,
+                               blocks->rotation.data(),
                                blocks->direction.data());
     }
   }
@@ -367,8 +401,6 @@ StageResult SolveStage(const RigConstants& constants,
     if (options.refine_translation_direction) {
       problem.SetManifold(blocks->direction.data(),
                           new ceres::SphereManifold<3>());
-    } else {
-      problem.SetParameterBlockConstant(blocks->direction.data());
     }
   }
 
@@ -397,7 +429,9 @@ StageResult SolveStage(const RigConstants& constants,
   }
   if (any_cam1) {
     ordering->AddElementToGroup(blocks->rotation.data(), 1);
-    ordering->AddElementToGroup(blocks->direction.data(), 1);
+    if (!held_direction) {
+      ordering->AddElementToGroup(blocks->direction.data(), 1);
+    }
   }
   solver.linear_solver_ordering = ordering;
   solver.max_num_iterations = max_iterations;
@@ -543,6 +577,11 @@ Status SequenceBundleOptions::Check() const {
     return Status::Error(
         "min shared landmarks = " + std::to_string(min_shared_landmarks) +
         " must be at least 6 (the PnP's)");
+  }
+  if (min_landmark_keyframes < 1) {
+    return Status::Error(
+        "min landmark keyframes = " + std::to_string(min_landmark_keyframes) +
+        " must be >= 1");
   }
   if (max_iterations < 1) {
     return Status::Error("max iterations = " + std::to_string(max_iterations) +
@@ -926,6 +965,23 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
   }
   const size_t count = tracks.observations.size();
   std::vector<bool> use(count, false);
+  // Landmarks seen from too few keyframes are left out (the options).
+  if (options_.min_landmark_keyframes > 1) {
+    std::vector<std::pair<int, int>> seen;  // (landmark, keyframe)
+    seen.reserve(count);
+    for (const StereoTrackObservation& o : tracks.observations) {
+      seen.emplace_back(o.landmark, o.frame);
+    }
+    std::sort(seen.begin(), seen.end());
+    seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
+    std::vector<int> keyframes(tracks.num_landmarks, 0);
+    for (const auto& [landmark, frame] : seen) ++keyframes[landmark];
+    for (int l = 0; l < tracks.num_landmarks; ++l) {
+      if (keyframes[l] < options_.min_landmark_keyframes) {
+        blocks.placed[l] = false;
+      }
+    }
+  }
   // The observations of placed landmarks that the initial state can
   // image (Ceres starts from a point where every residual is defined).
   for (size_t i = 0; i < count; ++i) {
