@@ -29,6 +29,7 @@ void BindCorrespondences(pybind11::module_& module);  // correspondences.cc
 void BindEstimators(pybind11::module_& module);       // estimators.cc
 void BindEstimate(pybind11::module_& module);         // estimate.cc
 void BindSequence(pybind11::module_& module);         // sequence.cc
+void BindBundle(pybind11::module_& module);           // bundle.cc
 void BindFrontEnd(pybind11::module_& module);         // frontend.cc
 void BindSimulation(pybind11::module_& module);       // simulation.cc
 void BindCalibration(pybind11::module_& module);      // calibration.cc

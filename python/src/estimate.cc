@@ -6,6 +6,7 @@
 // --json` prints under them.
 #include <pybind11/stl.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <string>
 #include <vector>
@@ -117,6 +118,7 @@ the floor assumed); crlb (Cramer-Rao bound, the calibration exact);
 sigma_px (pixels); n_closed_form; inliers, invalid, correspondences, frames.
 Blocks as dicts (None when absent): calibration, systematic_field,
 consistency, rotation (degrees), focal_scale (percent), air_gap (metres).
+trajectory (bundle): (N, 8) array [t, tx, ty, tz, qx, qy, qz, qw].
 warnings: one line each (a stale calibration, n and the rotation hardly
 separable, ...). per_frame: dict of arrays frame, t, n, sigma_n, switch.
 to_dict() gives the JSON object; to_json() its text.
@@ -151,6 +153,28 @@ to_dict() gives the JSON object; to_json() its text.
                              [](const E& e) { return Key(e, "focal_scale"); })
       .def_property_readonly("air_gap",
                              [](const E& e) { return Key(e, "air_gap"); })
+      .def_property_readonly(
+          "trajectory",
+          [](const E& e) -> py::object {
+            if (!e.bundle) return py::none();
+            const std::vector<BundlePose>& poses = e.bundle->trajectory;
+            DoubleArray array = NewArray(static_cast<int64_t>(poses.size()), 8);
+            double* data = array.mutable_data();
+            for (size_t f = 0; f < poses.size(); ++f) {
+              const Eigen::Quaterniond q(poses[f].world_from_cam0.rotation);
+              const Eigen::Vector3d t =
+                  poses[f].world_from_cam0.translation + Eigen::Vector3d::Zero();
+              const double row[8] = {
+                  poses[f].timestamp ? *poses[f].timestamp
+                                     : static_cast<double>(poses[f].frame),
+                  t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()};
+              std::copy(row, row + 8, data + 8 * f);
+            }
+            return array;
+          },
+          "bundle: (N, 8) array [t, tx, ty, tz, qx, qy, qz, qw] per keyframe "
+          "(trajectory.tum's rows: t the timestamp, or the frame without "
+          "one); None for the other estimators.")
       .def_readonly("warnings", &E::warnings)
       .def_property_readonly("per_frame", &PerFrameArrays)
       .def("to_dict", &EstimateDict,

@@ -21,6 +21,7 @@ PYBIND11_MODULE(_rcm, module) {
   rcm::python::BindEstimate(module);
   rcm::python::BindFrontEnd(module);
   rcm::python::BindSequence(module);
+  rcm::python::BindBundle(module);
   rcm::python::BindSimulation(module);
   rcm::python::BindCalibration(module);
 }

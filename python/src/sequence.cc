@@ -193,9 +193,12 @@ of the prior search range without one; the sliding window takes its matches
 estimate, the window's and a change of medium; when the window's
 self-calibrated rotation of cam1 moves pixels at the focal length by more
 than follow_rotation_px, the front end follows it. estimate() solves the
-final estimate once (estimator: 'refine', 'online', 'window' or
-'closed-form') over the pairs since the last change of medium and returns
-an rcm.Estimate, the same as `rcm estimate --json`.
+final estimate once (estimator: 'refine', 'online', 'window',
+'closed-form' or 'bundle') over the pairs since the last change of medium
+and returns an rcm.Estimate, the same as `rcm estimate --json`. 'bundle'
+tracks every pair's features and solves rcm.SequenceBundleAdjustment over
+them (Estimate.trajectory), or gives the refine estimate with the reason as
+its first warning where motion does not help.
 
 rig: rcm.StereoRig or a reference rig name. front_end: an
 rcm.FrontEndOptions or a dict of its keywords; refinement: an rcm.RefinementOptions or a
