@@ -1,6 +1,7 @@
 #include "rcm/estimation/sequence_bundle_adjustment.h"
 
 #include <ceres/manifold.h>
+#include <ceres/normal_prior.h>
 #include <ceres/ordered_groups.h>
 #include <ceres/problem.h>
 #include <ceres/product_manifold.h>
@@ -119,6 +120,7 @@ struct Blocks {
   double n = 1.333;
   std::array<double, 3> rotation{};
   std::array<double, 3> direction{1.0, 0.0, 0.0};
+  std::array<double, 2> focal{};  // e0, e1
   std::vector<std::array<double, 7>> poses;
   std::vector<std::array<double, 3>> landmarks;
   std::vector<bool> placed;
@@ -131,6 +133,7 @@ Blocks BlocksOf(const SequenceBundleState& state) {
     blocks.rotation[i] = state.cam1_rotation[i];
     blocks.direction[i] = state.cam1_direction[i];
   }
+  blocks.focal = {state.focal_scales[0], state.focal_scales[1]};
   for (const Rigid3d& pose : state.cam0_from_world) {
     const Eigen::Quaterniond q(pose.rotation);
     blocks.poses.push_back({q.w(), q.x(), q.y(), q.z(), pose.translation.x(),
@@ -148,6 +151,7 @@ SequenceBundleState StateOf(const Blocks& blocks) {
   state.n = blocks.n;
   state.cam1_rotation = Eigen::Vector3d(blocks.rotation.data());
   state.cam1_direction = Eigen::Vector3d(blocks.direction.data());
+  state.focal_scales = Eigen::Vector2d(blocks.focal[0], blocks.focal[1]);
   for (const std::array<double, 7>& pose : blocks.poses) {
     Eigen::Quaterniond q(pose[0], pose[1], pose[2], pose[3]);
     q.normalize();
@@ -170,6 +174,12 @@ struct StageResult {
   double c_nn = 0.0;
   Eigen::Vector3d c_nw = Eigen::Vector3d::Zero();
   Eigen::Matrix3d c_ww = Eigen::Matrix3d::Zero();
+  // With the focal scales estimated: their covariance and with n.
+  Eigen::Matrix2d c_ff = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d c_nf = Eigen::Vector2d::Zero();
+  // c_nn with the focal scales held at the solution: the pixel noise's
+  // share; c_nn - c_nn_focal_held is what the focal prior leaves.
+  double c_nn_focal_held = 0.0;
   // v = J (J^T J)^-1 e_n, one entry per residual row in the order the
   // observations were added: n moves by -v . dr when the residuals move
   // by dr at the solution (the linear response of the least squares).
@@ -191,7 +201,8 @@ struct StageResult {
 // at once, and called a Monte Carlo trial with a lens change rank
 // deficient by one whose S is well conditioned.)
 void ReducedCovariance(ceres::Problem& problem, Blocks& blocks, bool rotation,
-                       bool direction, int num_threads, StageResult* result) {
+                       bool direction, bool focal, int num_threads,
+                       StageResult* result) {
   std::vector<double*> order;
   for (size_t l = 0; l < blocks.landmarks.size(); ++l) {
     double* landmark = blocks.landmarks[l].data();
@@ -208,6 +219,11 @@ void ReducedCovariance(ceres::Problem& problem, Blocks& blocks, bool rotation,
   if (direction) {
     order.push_back(blocks.direction.data());
     p += 2;  // the sphere's tangent
+  }
+  const int focal_column = p;
+  if (focal) {
+    order.push_back(blocks.focal.data());
+    p += 2;
   }
   for (size_t f = 1; f < blocks.poses.size(); ++f) {
     double* pose = blocks.poses[f].data();
@@ -314,11 +330,41 @@ void ReducedCovariance(ceres::Problem& problem, Blocks& blocks, bool rotation,
       !(factor.rcond() > 1e-14)) {
     return;
   }
-  const int rows = rotation ? 4 : 1;
-  Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(p, rows);
-  unit(0, 0) = 1.0;
-  for (int k = 1; k < rows; ++k) unit(rotation_column + k - 1, k) = 1.0;
+  // The columns of n, the turn and the focal scales.
+  std::vector<int> columns = {0};
+  if (rotation) {
+    for (int k = 0; k < 3; ++k) columns.push_back(rotation_column + k);
+  }
+  if (focal) {
+    for (int k = 0; k < 2; ++k) columns.push_back(focal_column + k);
+  }
+  Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(p, columns.size());
+  for (size_t k = 0; k < columns.size(); ++k) unit(columns[k], k) = 1.0;
   const Eigen::MatrixXd covariance = factor.solve(unit);
+  if (focal) {
+    // S without the focal scales' rows and columns.
+    std::vector<int> kept;
+    for (int k = 0; k < p; ++k) {
+      if (k != focal_column && k != focal_column + 1) kept.push_back(k);
+    }
+    Eigen::MatrixXd s_held(p - 2, p - 2);
+    for (int a = 0; a < p - 2; ++a) {
+      for (int b = 0; b < p - 2; ++b) s_held(a, b) = s(kept[a], kept[b]);
+    }
+    const Eigen::LDLT<Eigen::MatrixXd> held(s_held);
+    if (held.info() != Eigen::Success || !held.isPositive()) return;
+    Eigen::VectorXd e_n = Eigen::VectorXd::Zero(p - 2);
+    e_n[0] = 1.0;
+    result->c_nn_focal_held = held.solve(e_n)[0];
+    const int f = rotation ? 4 : 1;  // the focal scales' columns in unit
+    for (int a = 0; a < 2; ++a) {
+      result->c_nf[a] = covariance(focal_column + a, 0);
+      for (int b = 0; b < 2; ++b) {
+        result->c_ff(a, b) = covariance(focal_column + a, f + b);
+      }
+    }
+    result->c_ff = 0.5 * (result->c_ff + result->c_ff.transpose()).eval();
+  }
   result->c_nn = covariance(0, 0);
   if (rotation) {
     for (int k = 0; k < 3; ++k) {
@@ -345,10 +391,17 @@ void ReducedCovariance(ceres::Problem& problem, Blocks& blocks, bool rotation,
   result->covariance_ok = true;
 }
 
+// `focal_prior_sigma` > 0: the focal scales estimated under their prior
+// N(0, s_f^2), weighted as a residual of `focal_weight_px` pixels (the
+// pixel noise: ceres::NormalPrior with root information
+// focal_weight_px / s_f), its block added after the observations'; 0:
+// the focal scales held.
 StageResult SolveStage(const RigConstants& constants,
                        const StereoTracks& tracks, const std::vector<bool>& use,
                        const SequenceBundleOptions& options, bool robust,
-                       int max_iterations, bool covariance, Blocks* blocks) {
+                       int max_iterations, bool covariance,
+                       double focal_prior_sigma, double focal_weight_px,
+                       Blocks* blocks) {
   ceres::Problem problem;
   bool any_cam1 = false;
   // A held direction is a constant of the cam1 residuals (a smaller
@@ -365,21 +418,32 @@ StageResult SolveStage(const RigConstants& constants,
     double* landmark = blocks->landmarks[o.landmark].data();
     pose_used[o.frame] = true;
     ceres::CostFunction* cost = CostFor(constants, o, held_direction);
+    double* focal = blocks->focal.data();
     if (o.camera == 0) {
-      problem.AddResidualBlock(cost, loss, &blocks->n, pose, landmark);
+      problem.AddResidualBlock(cost, loss, &blocks->n, pose, landmark, focal);
     } else if (held_direction) {
       any_cam1 = true;
-      problem.AddResidualBlock(cost, loss, &blocks->n, pose, landmark,
+      problem.AddResidualBlock(cost, loss, &blocks->n, pose, landmark, focal,
                                blocks->rotation.data());
     } else {
       any_cam1 = true;
-      problem.AddResidualBlock(cost, loss, &blocks->n, pose, landmark,
+      problem.AddResidualBlock(cost, loss, &blocks->n, pose, landmark, focal,
                                blocks->rotation.data(),
                                blocks->direction.data());
     }
   }
   StageResult result;
   if (problem.NumResidualBlocks() == 0) return result;
+  const bool focal = focal_prior_sigma > 0.0;
+  if (focal) {
+    const ceres::Matrix root_information =
+        focal_weight_px / focal_prior_sigma * ceres::Matrix::Identity(2, 2);
+    problem.AddResidualBlock(
+        new ceres::NormalPrior(root_information, ceres::Vector::Zero(2)),
+        nullptr, blocks->focal.data());
+  } else {
+    problem.SetParameterBlockConstant(blocks->focal.data());
+  }
   if (options.refine_n) {
     problem.SetParameterLowerBound(&blocks->n, 0, RefractiveCamera::kMinIndex);
     problem.SetParameterUpperBound(&blocks->n, 0, RefractiveCamera::kMaxIndex);
@@ -424,6 +488,7 @@ StageResult SolveStage(const RigConstants& constants,
     }
   }
   ordering->AddElementToGroup(&blocks->n, 1);
+  ordering->AddElementToGroup(blocks->focal.data(), 1);
   for (size_t f = 0; f < blocks->poses.size(); ++f) {
     if (pose_used[f]) ordering->AddElementToGroup(blocks->poses[f].data(), 1);
   }
@@ -451,7 +516,7 @@ StageResult SolveStage(const RigConstants& constants,
 
   if (covariance && options.refine_n && result.summary.IsSolutionUsable()) {
     ReducedCovariance(problem, *blocks, any_cam1 && options.refine_rotation,
-                      any_cam1 && options.refine_translation_direction,
+                      any_cam1 && options.refine_translation_direction, focal,
                       options.num_threads, &result);
   }
   return result;
@@ -468,14 +533,15 @@ bool EvaluateResidual(const RigConstants& constants,
   RCM_LENS_MODEL_SWITCH(
       constants.models[o.camera],
       if (o.camera == 0) {
-        return Cam0TrackReprojectionError<LensModel>(
-            constants.cameras[0], o.pixel)(&blocks.n, pose, landmark, residual);
+        return Cam0TrackReprojectionError<LensModel>(constants.cameras[0],
+                                                     o.pixel)(
+            &blocks.n, pose, landmark, blocks.focal.data(), residual);
       } return Cam1TrackReprojectionError<LensModel>(constants.cameras[1],
                                                      constants.rotation,
                                                      constants.baseline,
                                                      o.pixel)(
-          &blocks.n, pose, landmark, blocks.rotation.data(), direction,
-          residual);)
+          &blocks.n, pose, landmark, blocks.focal.data(),
+          blocks.rotation.data(), direction, residual);)
   return false;
 }
 
@@ -994,10 +1060,22 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
   result.num_observations = static_cast<int64_t>(count);
   result.num_frames = tracks.num_frames;
 
+  // The focal scales, estimated under the calibration's focal drift prior
+  // s_f (the options), weighted in pixels of the noise: the loss scale in
+  // stage 1, then the noise stage 1's inliers show.
+  const std::optional<CalibrationUncertainty>& uncertainty =
+      rig_.calibration_uncertainty();
+  const double focal_prior_sigma =
+      options_.self_calibrate_focal && uncertainty
+          ? uncertainty->focal_drift_sigma
+          : 0.0;
+  double focal_weight_px = options_.loss_scale_px;
+
   // Stage 1: robust.
-  const StageResult stage1 =
-      SolveStage(constants, tracks, use, options_, /*robust=*/true,
-                 options_.max_iterations, /*covariance=*/false, &blocks);
+  const StageResult stage1 = SolveStage(
+      constants, tracks, use, options_, /*robust=*/true,
+      options_.max_iterations, /*covariance=*/false, focal_prior_sigma,
+      focal_weight_px, &blocks);
   if (!stage1.summary.IsSolutionUsable()) {
     return Status::Error("the bundle's robust stage failed: " +
                          stage1.summary.message);
@@ -1014,12 +1092,31 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
   // Stage 2: least squares over the inliers, of landmarks seen from two
   // viewpoints at least ...
   std::vector<int> inlier_views(tracks.num_landmarks, 0);
+  double inlier_squares = 0.0;
+  int64_t inliers = 0;
   for (size_t i = 0; i < count; ++i) {
     if (!use[i]) continue;
     const std::optional<double> norm =
         ResidualNorm(constants, tracks.observations[i], blocks);
     use[i] = norm && *norm <= options_.inlier_threshold_px;
-    if (use[i]) ++inlier_views[tracks.observations[i].landmark];
+    if (use[i]) {
+      ++inlier_views[tracks.observations[i].landmark];
+      inlier_squares += *norm * *norm;
+      ++inliers;
+    }
+  }
+  {
+    // The pixel noise they show, per coordinate, over their degrees of
+    // freedom (each landmark takes 3, each keyframe but the first 6).
+    int64_t landmarks = 0;
+    for (int l = 0; l < tracks.num_landmarks; ++l) {
+      landmarks += inlier_views[l] > 0 ? 1 : 0;
+    }
+    const double dof = 2.0 * inliers - 3.0 * landmarks -
+                       6.0 * (tracks.num_frames - 1) - 4.0;
+    if (dof > 0.0 && inlier_squares > 0.0) {
+      focal_weight_px = std::sqrt(inlier_squares / dof);
+    }
   }
   // ... and under an angle of at least min_triangulation_angle_deg: a
   // landmark whose rays are parallel has no depth, and the covariance no
@@ -1073,7 +1170,8 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
   StageResult stage2;
   for (int round = 0;; ++round) {
     stage2 = SolveStage(constants, tracks, use, options_, /*robust=*/false,
-                        options_.max_iterations, /*covariance=*/true, &blocks);
+                        options_.max_iterations, /*covariance=*/true,
+                        focal_prior_sigma, focal_weight_px, &blocks);
     if (!stage2.summary.IsSolutionUsable()) {
       return Status::Error("the bundle's least squares failed: " +
                            stage2.summary.message);
@@ -1105,8 +1203,37 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
                          " inlier residuals for " + std::to_string(unknowns) +
                          " unknowns: too few tracks");
   }
-  result.pixel_sigma = std::sqrt(2.0 * stage2.summary.final_cost /
-                                 static_cast<double>(residuals - unknowns));
+  // The observations' share of the cost: the focal prior's taken out (its
+  // two residuals and the two scales they hold cancel in the count).
+  const auto pixel_sigma = [&]() {
+    const double prior_cost =
+        focal_prior_sigma > 0.0
+            ? 0.5 * std::pow(focal_weight_px / focal_prior_sigma, 2) *
+                  (blocks.focal[0] * blocks.focal[0] +
+                   blocks.focal[1] * blocks.focal[1])
+            : 0.0;
+    return std::sqrt(
+        2.0 * std::max(0.0, stage2.summary.final_cost - prior_cost) /
+        static_cast<double>(residuals - unknowns));
+  };
+  result.pixel_sigma = pixel_sigma();
+  // The focal prior weighs as a residual of the pixel noise: stage 1's
+  // inliers undercount it (their landmarks' degrees of freedom), so the
+  // least squares run once more at the noise they showed, and the
+  // covariance is taken there.
+  if (focal_prior_sigma > 0.0 &&
+      std::abs(result.pixel_sigma / focal_weight_px - 1.0) > 0.01) {
+    focal_weight_px = result.pixel_sigma;
+    stage2 = SolveStage(constants, tracks, use, options_, /*robust=*/false,
+                        options_.max_iterations, /*covariance=*/true,
+                        focal_prior_sigma, focal_weight_px, &blocks);
+    if (!stage2.summary.IsSolutionUsable()) {
+      return Status::Error("the bundle's least squares failed: " +
+                           stage2.summary.message);
+    }
+    result.iterations += static_cast<int>(stage2.summary.iterations.size());
+    result.pixel_sigma = pixel_sigma();
+  }
   if (!options_.refine_n) {
     // n held (the options): the trajectory and the turn, nothing of n.
     result.n = blocks.n;
@@ -1125,7 +1252,19 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
   }
   const double s2 = result.pixel_sigma * result.pixel_sigma;
   result.n = blocks.n;
-  result.sigma_n_noise = std::sqrt(s2 * stage2.c_nn);
+  // With the focal scales estimated, the noise's share is n's variance
+  // with them held, and the rest (what the focal prior leaves) joins the
+  // calibration's share below.
+  const bool focal = focal_prior_sigma > 0.0;
+  result.sigma_n_noise =
+      std::sqrt(s2 * (focal ? stage2.c_nn_focal_held : stage2.c_nn));
+  const double focal_variance =
+      focal ? std::max(0.0, s2 * (stage2.c_nn - stage2.c_nn_focal_held)) : 0.0;
+  if (focal) {
+    result.focal_scales_estimated = true;
+    result.focal_scale_covariance = s2 * stage2.c_ff;
+    result.n_focal_scale_covariance = s2 * stage2.c_nf;
+  }
   if (options_.refine_rotation) {
     result.rotation_covariance = s2 * stage2.c_ww;
     result.n_rotation_covariance = s2 * stage2.c_nw;
@@ -1138,13 +1277,21 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
   result.motion = ClassifyBundleMotion(result.state, options_);
 
   // The calibration's remaining uncertainty (header).
-  double calibration_variance = 0.0;
-  const std::optional<CalibrationUncertainty>& uncertainty =
-      rig_.calibration_uncertainty();
+  double calibration_variance = focal_variance;
   if (options_.propagate_calibration && uncertainty) {
-    const Eigen::MatrixXd joint = uncertainty->JointCovariance();
     const int p_l = rig_.left().num_params();
     const int p_r = rig_.right().num_params();
+    // The focal prior is the bundle's own when it estimates the scales:
+    // taken back out of the lenses' covariances it propagates.
+    const Eigen::MatrixXd joint =
+        focal ? uncertainty
+                    ->WithoutFocalDrift(
+                        Eigen::Map<const Eigen::VectorXd>(
+                            rig_.left().params(), p_l),
+                        Eigen::Map<const Eigen::VectorXd>(
+                            rig_.right().params(), p_r))
+                    .JointCovariance()
+              : uncertainty->JointCovariance();
     // x = [w; dt; left params; right params]: the joint covariance's rows
     // of those that it has (a lens without a covariance is exact; the
     // ports' rows, when given, are held exact here).
@@ -1162,8 +1309,11 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
         held(index[a], index[b]) = joint(a, b);
       }
     }
+    // The observations' rows, then the focal prior's two (which no move of
+    // the rig changes).
+    const Eigen::Index prior_rows = focal ? 2 : 0;
     if (stage2.n_influence.size() !=
-        2 * static_cast<Eigen::Index>(result.num_inliers)) {
+        2 * static_cast<Eigen::Index>(result.num_inliers) + prior_rows) {
       return Status::Error(
           "the calibration propagation lost the residuals' order");
     }
@@ -1192,7 +1342,7 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
                                       ? blocks.direction.data()
                                       : moved_constants.direction.data();
         Eigen::VectorXd& residuals = moved_residuals[sign];
-        residuals.resize(stage2.n_influence.size());
+        residuals = Eigen::VectorXd::Zero(stage2.n_influence.size());
         Eigen::Index row = 0;
         for (size_t i = 0; i < count; ++i) {
           if (!use[i]) continue;

@@ -34,9 +34,20 @@
 // pixel noise s^2 = sum r^2 / (N - p) over the inliers; the rotation's
 // covariance likewise, and `correlation_n_rotation` the multiple
 // correlation of n with w that the data leave (0: motion separates them;
-// near 1: the data cannot tell them apart). sigma_n_calibration carries
-// what the calibration leaves uncertain and the bundle holds (the
-// translation's change dt, the lenses; calibration_uncertainty.h): the
+// near 1: the data cannot tell them apart).
+//
+// Lenses that changed (self_calibrate_focal): with a focal drift prior s_f
+// in the calibration, each camera's focal lengths are scaled by 1 + e_c,
+// e_c unknowns under the prior residual (s / s_f) e_c (s the pixel noise,
+// so that the prior weighs as the pixels do). Paraxially n and a focal
+// length are one unknown (the virtual pinhole n f, paper eq. 9); the
+// rays far off axis and the motion tell them apart. n's variance is then
+// split: s^2 [(J^T J)^-1]_nn with the e_c held is the noise's share, the
+// rest what the prior leaves, counted with the calibration's.
+//
+// sigma_n_calibration carries what the calibration leaves uncertain and
+// the bundle holds (the translation's change dt, the lenses without the
+// focal prior when e_c are estimated; calibration_uncertainty.h): the
 // joint covariance of [w; dt; lenses] is split into its principal
 // directions e_k (eigenvalues l_k), and n's linear response to the rig
 // moved by +- sqrt(l_k) e_k is taken at the solution theta:
@@ -125,6 +136,14 @@ struct SequenceBundleOptions {
   // Estimate the direction of cam1_from_cam0's translation too (its
   // length stays the calibration's: the scale).
   bool refine_translation_direction = false;
+  // Lenses that changed since the calibration: where the rig's calibration
+  // uncertainty has a focal drift prior s_f (CalibrationUncertainty::
+  // focal_drift_sigma > 0, the default of an air camchain), estimate each
+  // camera's focal scale 1 + e_c with the rest, under the prior
+  // N(0, s_f^2) on e_c, as the refine estimator does (batch_refinement.h);
+  // the propagation then holds the lenses without that prior. false: the
+  // focal lengths held, the prior propagated into sigma_n.
+  bool self_calibrate_focal = true;
   // When motion does not help (above): the thresholds, and whether to solve
   // anyway.
   double min_translation_fraction = 0.02;
@@ -175,6 +194,9 @@ struct SequenceBundleState {
   // Unit direction of cam1_from_cam0's translation before the turn (cam1
   // frame): the calibration's t / |t| unless refined.
   Eigen::Vector3d cam1_direction = Eigen::Vector3d::UnitX();
+  // e_c: each camera's focal lengths scaled by 1 + e_c since the
+  // calibration (self_calibrate_focal; zero when held).
+  Eigen::Vector2d focal_scales = Eigen::Vector2d::Zero();
   // One per keyframe; keyframe 0's is the identity (the world frame).
   std::vector<Rigid3d> cam0_from_world;
   // World points, metres; NaN for a landmark that could not be placed.
@@ -230,6 +252,11 @@ struct SequenceBundleResult {
   // Multiple correlation of n with cam1_rotation left by the data (NaN
   // when the rotation is held).
   double correlation_n_rotation = kNaN;
+  // With the focal scales estimated (self_calibrate_focal and a focal
+  // drift prior): their covariance and with n (the noise and the prior).
+  bool focal_scales_estimated = false;
+  Eigen::Matrix2d focal_scale_covariance = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d n_focal_scale_covariance = Eigen::Vector2d::Zero();
   // Pixel noise estimated from the stage-2 residuals.
   double pixel_sigma = kNaN;
   int64_t num_observations = 0;  // given

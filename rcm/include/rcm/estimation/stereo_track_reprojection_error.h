@@ -12,6 +12,11 @@
 //                                                  quaternion, Ceres'
 //                                                  order; metres)
 //   landmark          [X, Y, Z]                    world point, metres
+//   focal_scales      [e0, e1]                     each camera's focal
+//                                                  lengths' change since
+//                                                  the calibration: fx, fy
+//                                                  of camera c scaled by
+//                                                  1 + e_c
 //   cam1_rotation     [w0, w1, w2]                 cam1's turn since the
 //                                                  calibration (rad)
 //   cam1_direction    [u0, u1, u2]                 unit direction of
@@ -73,8 +78,8 @@ namespace track_internal {
 // where the port cannot image P.
 template <typename LensModel, typename T>
 bool ProjectThroughPort(const TrackCameraConstants& constants, const T& n,
-                        const T point[3], const Eigen::Vector2d& pixel,
-                        T* residuals) {
+                        const T& focal_scale, const T point[3],
+                        const Eigen::Vector2d& pixel, T* residuals) {
   T normalized[2];
   if (constants.thin_port) {
     if (!FlatPortRefraction::NormalizedFromPointInWater(
@@ -94,6 +99,9 @@ bool ProjectThroughPort(const TrackCameraConstants& constants, const T& n,
   for (int i = 0; i < LensModel::kNumParams; ++i) {
     lens[i] = T(constants.lens[i]);
   }
+  // Every lens model's parameters begin with fx, fy (lens_models.h).
+  lens[0] *= T(1.0) + focal_scale;
+  lens[1] *= T(1.0) + focal_scale;
   T u;
   T v;
   LensModel::ImgFromCam(lens, normalized[0], normalized[1], &u, &v);
@@ -128,7 +136,8 @@ void PointInCam1(const std::array<double, 9>& rotation, double baseline,
 
 }  // namespace track_internal
 
-// A landmark seen by cam0: blocks (n, cam0_from_world, landmark).
+// A landmark seen by cam0: blocks (n, cam0_from_world, landmark,
+// focal_scales).
 template <typename LensModel>
 struct Cam0TrackReprojectionError {
   Cam0TrackReprojectionError(const TrackCameraConstants& constants,
@@ -137,17 +146,17 @@ struct Cam0TrackReprojectionError {
 
   template <typename T>
   bool operator()(const T* n, const T* cam0_from_world, const T* landmark,
-                  T* residuals) const {
+                  const T* focal_scales, T* residuals) const {
     T p0[3];
     track_internal::PointInCam0(cam0_from_world, landmark, p0);
-    return track_internal::ProjectThroughPort<LensModel>(constants, n[0], p0,
-                                                         pixel, residuals);
+    return track_internal::ProjectThroughPort<LensModel>(
+        constants, n[0], focal_scales[0], p0, pixel, residuals);
   }
 
   static ceres::CostFunction* Create(const TrackCameraConstants& constants,
                                      const Eigen::Vector2d& pixel) {
     return new ceres::AutoDiffCostFunction<Cam0TrackReprojectionError, 2, 1, 7,
-                                           3>(
+                                           3, 2>(
         new Cam0TrackReprojectionError(constants, pixel));
   }
 
@@ -156,7 +165,7 @@ struct Cam0TrackReprojectionError {
 };
 
 // A landmark seen by cam1: blocks (n, cam0_from_world, landmark,
-// cam1_rotation, cam1_direction). `rotation` is the calibration's
+// focal_scales, cam1_rotation, cam1_direction). `rotation` is the calibration's
 // cam1_from_cam0 rotation (row-major 3 x 3 as Eigen stores a transposed
 // matrix: element (i, j) at [3 * i + j]) and `baseline` |t| in metres.
 template <typename LensModel>
@@ -171,15 +180,15 @@ struct Cam1TrackReprojectionError {
 
   template <typename T>
   bool operator()(const T* n, const T* cam0_from_world, const T* landmark,
-                  const T* cam1_rotation, const T* cam1_direction,
-                  T* residuals) const {
+                  const T* focal_scales, const T* cam1_rotation,
+                  const T* cam1_direction, T* residuals) const {
     T p0[3];
     track_internal::PointInCam0(cam0_from_world, landmark, p0);
     T p1[3];
     track_internal::PointInCam1(rotation, baseline, cam1_direction,
                                 cam1_rotation, p0, p1);
-    return track_internal::ProjectThroughPort<LensModel>(constants, n[0], p1,
-                                                         pixel, residuals);
+    return track_internal::ProjectThroughPort<LensModel>(
+        constants, n[0], focal_scales[1], p1, pixel, residuals);
   }
 
   static ceres::CostFunction* Create(const TrackCameraConstants& constants,
@@ -187,7 +196,7 @@ struct Cam1TrackReprojectionError {
                                      double baseline,
                                      const Eigen::Vector2d& pixel) {
     return new ceres::AutoDiffCostFunction<Cam1TrackReprojectionError, 2, 1, 7,
-                                           3, 3, 3>(
+                                           3, 2, 3, 3>(
         new Cam1TrackReprojectionError(constants, rotation, baseline, pixel));
   }
 
@@ -199,8 +208,9 @@ struct Cam1TrackReprojectionError {
 
 // Cam1TrackReprojectionError with the translation's direction held (the
 // calibration's, refine_translation_direction off): blocks (n,
-// cam0_from_world, landmark, cam1_rotation). The same residual, with
-// derivatives over 14 parameters instead of 17 (the bundle's hot path).
+// cam0_from_world, landmark, focal_scales, cam1_rotation). The same
+// residual, with derivatives over 16 parameters instead of 19 (the
+// bundle's hot path).
 template <typename LensModel>
 struct Cam1HeldDirectionTrackReprojectionError {
   Cam1HeldDirectionTrackReprojectionError(
@@ -215,14 +225,15 @@ struct Cam1HeldDirectionTrackReprojectionError {
 
   template <typename T>
   bool operator()(const T* n, const T* cam0_from_world, const T* landmark,
-                  const T* cam1_rotation, T* residuals) const {
+                  const T* focal_scales, const T* cam1_rotation,
+                  T* residuals) const {
     T p0[3];
     track_internal::PointInCam0(cam0_from_world, landmark, p0);
     T p1[3];
     track_internal::PointInCam1(rotation, baseline, direction.data(),
                                 cam1_rotation, p0, p1);
-    return track_internal::ProjectThroughPort<LensModel>(constants, n[0], p1,
-                                                         pixel, residuals);
+    return track_internal::ProjectThroughPort<LensModel>(
+        constants, n[0], focal_scales[1], p1, pixel, residuals);
   }
 
   static ceres::CostFunction* Create(const TrackCameraConstants& constants,
@@ -231,7 +242,7 @@ struct Cam1HeldDirectionTrackReprojectionError {
                                      const std::array<double, 3>& direction,
                                      const Eigen::Vector2d& pixel) {
     return new ceres::AutoDiffCostFunction<
-        Cam1HeldDirectionTrackReprojectionError, 2, 1, 7, 3, 3>(
+        Cam1HeldDirectionTrackReprojectionError, 2, 1, 7, 3, 2, 3>(
         new Cam1HeldDirectionTrackReprojectionError(
             constants, rotation, baseline, direction, pixel));
   }
