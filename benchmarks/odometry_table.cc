@@ -3,7 +3,9 @@
 // 5 m x 5 m pool, back where it began, cam1 turned 0.5 degrees since the
 // calibration; the trajectory error of the bundle adjustment over its
 // tracks with n estimated, held at the truth, held at 1, and with cam1 as
-// calibrated in air (rcm/sim/odometry_study.h).
+// calibrated in air (rcm/sim/odometry_study.h). The rigs carry a camchain
+// file's default uncertainty: a drift prior of 0.1 deg and 0.1 mm, and a
+// focal drift prior of 0.3 %.
 //
 //   build/bin/odometry_table [--frames 60] [--rig alphasense|narrow|both]
 //
@@ -17,6 +19,7 @@
 #include <iostream>
 #include <string>
 
+#include "rcm/io/stereo_rig_file.h"
 #include "rcm/sim/odometry_study.h"
 #include "rcm/sim/reference_rigs.h"
 #include "rcm/util/number_format.h"
@@ -68,9 +71,14 @@ int main(int argc, char** argv) {
                "|---|---|---|---|---|---|---|---|\n";
   for (const std::string rig_name : {"alphasense", "narrow"}) {
     if (which != "both" && which != rig_name) continue;
-    const rcm::StereoRig rig = rig_name == "alphasense"
-                                   ? rcm::AlphasenseFrontRectifiedRig()
-                                   : rcm::NarrowFieldRig();
+    // As a camchain file gives it: the default drift prior (0.1 deg,
+    // 0.1 mm) and focal drift prior (0.3 %).
+    const rcm::StereoRig rig =
+        rcm::WithDefaultCalibrationUncertainty(
+            rig_name == "alphasense" ? rcm::AlphasenseFrontRectifiedRig()
+                                     : rcm::NarrowFieldRig(),
+            rcm::RigFileOptions())
+            .value();
     const auto start = std::chrono::steady_clock::now();
     const rcm::StatusOr<rcm::OdometryStudy> study = rcm::RunOdometryStudy(
         rig, DiveOptions(frames), [&](int done, int total) {

@@ -144,6 +144,9 @@ release_only=(
   # [OdometryStudy.BadOptionsRefusedInOneLine, TrajectoryError.*,
   # SequenceBundleAdjustment.*]: the odometry table's models on renders
   'OdometryStudy.ModelsRankAsThePaperSays'
+  # [EstimateImagesCli.EveryEstimatorRunsOnImages, SequenceEstimator.Bundle*]:
+  # rcm estimate --estimator bundle --out on renders, end to end
+  'EstimateImagesCli.BundleWritesTheTrajectory'
 )
 
 budgeted=(

@@ -65,7 +65,7 @@ constexpr char kEstimateUsage[] =
     "biased under pixel noise (docs/design.md Sec. 3).\nbundle (images only) "
     "tracks landmarks over the pairs and adjusts n, cam1's\nturn and the "
     "rig's poses together: motion separates n from the turn that\none pair "
-    "cannot; --out adds trajectory.tum.\n\n"
+    "cannot; --out adds trajectory.tum and trajectory.png.\n\n"
     "sigma_n counts the calibration's uncertainty (the camchain's covariance\n"
     "sidecar, or a drift prior of 0.1 deg, 0.1 mm per axis and 0.3 % in\n"
     "each camera's focal lengths: --drift-prior) and the matches'\n"
@@ -375,8 +375,10 @@ int RunEstimate() {
     }
     if (report->bundle) {
       const std::string trajectory = (out / "trajectory.tum").string();
+      const std::string picture = (out / "trajectory.png").string();
       if (!write(trajectory, WriteFileAtomically(
-                                 trajectory, EstimateTrajectoryTum(*report)))) {
+                                 trajectory, EstimateTrajectoryTum(*report))) ||
+          !write(picture, WritePng(PlotTrajectory(*report), picture))) {
         return kExitFailure;
       }
     }

@@ -179,9 +179,13 @@ cv::Mat PlotPerFrame(const RefractiveIndexEstimate& e) {
                 FormatFixed(e.sigma_n, 5) + " (" + e.estimator + ")");
   plot.SetXLabel("frame");
   plot.SetYLabel("refractive index n");
+  // The bundle solves the dive once: its per-frame rows are each pair's
+  // own epipolar estimate, with cam1 as the camchain has it.
   const std::string what = e.estimator == "refine"   ? "each frame alone"
                            : e.estimator == "window" ? "window estimate"
-                                                     : "estimate so far";
+                           : e.estimator == "bundle"
+                               ? "each pair alone, cam1 as calibrated"
+                               : "estimate so far";
   if (!x.empty()) {
     plot.AddBand(x, low, high, what + ": 1 sigma", PaletteColor(7), 0.2);
     plot.AddLine(x, n, what, LineStyle{PaletteColor(7)});
@@ -199,6 +203,36 @@ cv::Mat PlotPerFrame(const RefractiveIndexEstimate& e) {
     }
   }
   return plot.Render(1000, 600);
+}
+
+cv::Mat PlotTrajectory(const RefractiveIndexEstimate& e) {
+  std::vector<double> x, z;
+  if (e.bundle) {
+    for (const BundlePose& pose : e.bundle->trajectory) {
+      x.push_back(pose.world_from_cam0.translation.x());
+      z.push_back(pose.world_from_cam0.translation.z());
+    }
+  }
+  LinePlot plot;
+  std::string title =
+      "n = " + FormatFixed(e.n, 5) + " +- " + FormatFixed(e.sigma_n, 5);
+  if (e.rotation) {
+    title += ", cam1 turned " +
+             FormatFixed(e.rotation->angle_axis.norm() * 180.0 / M_PI, 3) +
+             " deg";
+  }
+  plot.SetTitle(title);
+  plot.SetXLabel("x (m, right of the first left camera)");
+  plot.SetYLabel("z (m, ahead of the first left camera)");
+  if (!x.empty()) {
+    plot.AddLine(x, z, "left camera", LineStyle{PaletteColor(0), 2.0});
+    // The first under the last, larger: a loop's both show.
+    plot.AddMarkers({x.front()}, {z.front()}, "first keyframe",
+                    MarkerStyle{PaletteColor(2), MarkerShape::kCircle, 10.0});
+    plot.AddMarkers({x.back()}, {z.back()}, "last keyframe",
+                    MarkerStyle{PaletteColor(3), MarkerShape::kCircle, 6.0});
+  }
+  return plot.Render(900, 800);
 }
 
 }  // namespace rcm::cli

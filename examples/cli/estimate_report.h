@@ -23,6 +23,9 @@ std::vector<std::string> UncertaintyLines(const RefractiveIndexEstimate& e);
 
 // n per frame with its 1-sigma band, and the final estimate.
 cv::Mat PlotPerFrame(const RefractiveIndexEstimate& e);
+// The bundle's trajectory seen from above (x and z of the left camera in
+// the first keyframe's frame), its title n and cam1's turn.
+cv::Mat PlotTrajectory(const RefractiveIndexEstimate& e);
 
 }  // namespace rcm::cli
 

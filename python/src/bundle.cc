@@ -38,31 +38,31 @@ std::vector<OptionField> BundleOptionFields(SequenceBundleOptions* o) {
       [o]() {
         return py::object(py::str(std::string(RobustLossName(o->loss))));
       }};
-  return {DoubleOption("initial_n", &o->initial_n),
-          BoolOption("epipolar_seed", &o->epipolar_seed),
-          BoolOption("refine_n", &o->refine_n),
-          BoolOption("refine_rotation", &o->refine_rotation),
-          BoolOption("refine_translation_direction",
-                     &o->refine_translation_direction),
-          DoubleOption("min_translation_fraction",
-                       &o->min_translation_fraction),
-          DoubleOption("min_rotation_deg", &o->min_rotation_deg),
-          DoubleOption("axial_cone_deg", &o->axial_cone_deg),
-          DoubleOption("plane_thickness", &o->plane_thickness),
-          DoubleOption("plane_distance_spread", &o->plane_distance_spread),
-          BoolOption("allow_degenerate_motion", &o->allow_degenerate_motion),
-          loss,
-          DoubleOption("loss_scale_px", &o->loss_scale_px),
-          DoubleOption("inlier_threshold_px", &o->inlier_threshold_px),
-          DoubleOption("min_triangulation_angle_deg",
-                       &o->min_triangulation_angle_deg),
-          IntOption("min_shared_landmarks", &o->min_shared_landmarks),
-          IntOption("min_landmark_keyframes", &o->min_landmark_keyframes),
-          IntOption("max_iterations", &o->max_iterations),
-          BoolOption("propagate_calibration", &o->propagate_calibration),
-          DoubleOption("propagation_eigenvalue_floor",
-                       &o->propagation_eigenvalue_floor),
-          IntOption("num_threads", &o->num_threads)};
+  return {
+      DoubleOption("initial_n", &o->initial_n),
+      BoolOption("epipolar_seed", &o->epipolar_seed),
+      BoolOption("refine_n", &o->refine_n),
+      BoolOption("refine_rotation", &o->refine_rotation),
+      BoolOption("refine_translation_direction",
+                 &o->refine_translation_direction),
+      DoubleOption("min_translation_fraction", &o->min_translation_fraction),
+      DoubleOption("min_rotation_deg", &o->min_rotation_deg),
+      DoubleOption("axial_cone_deg", &o->axial_cone_deg),
+      DoubleOption("plane_thickness", &o->plane_thickness),
+      DoubleOption("plane_distance_spread", &o->plane_distance_spread),
+      BoolOption("allow_degenerate_motion", &o->allow_degenerate_motion),
+      loss,
+      DoubleOption("loss_scale_px", &o->loss_scale_px),
+      DoubleOption("inlier_threshold_px", &o->inlier_threshold_px),
+      DoubleOption("min_triangulation_angle_deg",
+                   &o->min_triangulation_angle_deg),
+      IntOption("min_shared_landmarks", &o->min_shared_landmarks),
+      IntOption("min_landmark_keyframes", &o->min_landmark_keyframes),
+      IntOption("max_iterations", &o->max_iterations),
+      BoolOption("propagate_calibration", &o->propagate_calibration),
+      DoubleOption("propagation_eigenvalue_floor",
+                   &o->propagation_eigenvalue_floor),
+      IntOption("num_threads", &o->num_threads)};
 }
 
 // The tracks of an (M, 5) array [frame, camera, landmark, u, v]: the first
@@ -168,8 +168,7 @@ void BindBundle(py::module_& module) {
        {"min_rotation_deg", "a rig turning less is checked for degeneracy"},
        {"axial_cone_deg", "moving along the axis within this cone, degrees"},
        {"plane_thickness", "one plane below this thickness over its extent"},
-       {"plane_distance_spread",
-        "seen from one distance within this spread"},
+       {"plane_distance_spread", "seen from one distance within this spread"},
        {"allow_degenerate_motion", "solve where motion does not help"},
        {"loss", "stage 1's robust loss: 'none', 'huber', 'cauchy'"},
        {"loss_scale_px", "its scale, pixels"},
@@ -217,8 +216,7 @@ NaN for a landmark left out; motion: one line; motion_kind: 'moving',
       .def_readonly("correlation_n_rotation",
                     &SequenceBundleResult::correlation_n_rotation)
       .def_readonly("pixel_sigma", &SequenceBundleResult::pixel_sigma)
-      .def_readonly("num_observations",
-                    &SequenceBundleResult::num_observations)
+      .def_readonly("num_observations", &SequenceBundleResult::num_observations)
       .def_readonly("num_inliers", &SequenceBundleResult::num_inliers)
       .def_readonly("num_landmarks", &SequenceBundleResult::num_landmarks)
       .def_readonly("num_frames", &SequenceBundleResult::num_frames)
@@ -234,8 +232,8 @@ NaN for a landmark left out; motion: one line; motion_kind: 'moving',
       .def_property_readonly(
           "landmarks",
           [](const SequenceBundleResult& r) {
-            DoubleArray array = NewArray(
-                static_cast<int64_t>(r.state.landmarks.size()), 3);
+            DoubleArray array =
+                NewArray(static_cast<int64_t>(r.state.landmarks.size()), 3);
             double* data = array.mutable_data();
             for (size_t l = 0; l < r.state.landmarks.size(); ++l) {
               for (int k = 0; k < 3; ++k) {
@@ -306,10 +304,9 @@ or 1 (right), pixels raw; num_frames, num_landmarks default to the largest
 index + 1. Returns an rcm.SequenceBundleResult; ValueError with the
 library's one-line message. The GIL is released while it runs.
 )doc")
-      .def_property_readonly("options",
-                             [](const SequenceBundleAdjustment& self) {
-                               return self.options();
-                             })
+      .def_property_readonly(
+          "options",
+          [](const SequenceBundleAdjustment& self) { return self.options(); })
       .def("__repr__", [](const SequenceBundleAdjustment& self) {
         return std::string("SequenceBundleAdjustment(refine_n=") +
                (self.options().refine_n ? "True" : "False") +
@@ -320,9 +317,9 @@ library's one-line message. The GIL is released while it runs.
   module.def(
       "compare_trajectories",
       [](const py::object& estimated, const py::object& truth) {
-        const TrajectoryError error = ValueOrThrow(CompareTrajectories(
-            PosesFromPython(estimated, "estimated"),
-            PosesFromPython(truth, "truth")));
+        const TrajectoryError error = ValueOrThrow(
+            CompareTrajectories(PosesFromPython(estimated, "estimated"),
+                                PosesFromPython(truth, "truth")));
         py::dict d;
         d["frames"] = error.frames;
         d["ate_m"] = error.ate_m;

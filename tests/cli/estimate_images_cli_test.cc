@@ -119,6 +119,42 @@ TEST(EstimateImagesCli, EveryEstimatorRunsOnImages) {
             std::max(kNTolerance, 5.0 * json["sigma_n"].get<double>()));
 }
 
+// --estimator bundle end to end: 6 rendered pairs 7.5 cm apart (4 Hz), cam1
+// turned half a degree since the camchain; the JSON, the trajectory and its
+// picture. n within the file's 2e-3 (its sigma ~4e-4 with the front end's
+// systematic floor), the turn within 0.05 degrees (the bound).
+TEST(EstimateImagesCli, BundleWritesTheTrajectory) {
+  const std::string dive = Folder("bundle_dive");
+  const RunResult simulated =
+      Rcm({"simulate", "--out", dive, "--frames", "6", "--frame-rate", "4",
+           "--n", std::to_string(kNTrue), "--supersampling", "1",
+           "--extrinsic-drift", "0.14,0.48,0.10", "--seed", "11"});
+  ASSERT_EQ(simulated.exit_code, 0) << simulated.err;
+  const std::string out = Folder("bundle_out");
+  const RunResult result = Rcm(
+      {"estimate", "--calib", dive + "/camchain.yaml", "--left", dive + "/left",
+       "--right", dive + "/right", "--estimator", "bundle", "--out", out});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json json =
+      nlohmann::json::parse(test::ReadWholeFile(out + "/estimate.json"));
+  ASSERT_EQ(json["estimator"].get<std::string>(), "bundle") << json.dump(2);
+  EXPECT_NEAR(json["n"].get<double>(), kNTrue, kNTolerance);
+  EXPECT_EQ(json["frames_used"].get<int>(), 6);
+  EXPECT_GT(json["tracks"].get<int>(), 500);
+  EXPECT_GT(json["sigma_n_systematic"].get<double>(), 0.0);
+  ASSERT_TRUE(json.contains("focal_scale")) << json.dump(2);
+  ASSERT_TRUE(json.contains("rotation")) << json.dump(2);
+  const double turn_error =
+      std::hypot(json["rotation"]["angle_axis_deg"][0].get<double>() - 0.14,
+                 json["rotation"]["angle_axis_deg"][1].get<double>() - 0.48,
+                 json["rotation"]["angle_axis_deg"][2].get<double>() - 0.10);
+  EXPECT_LT(turn_error, 0.05) << json["rotation"].dump();
+  const std::string tum = test::ReadWholeFile(out + "/trajectory.tum");
+  EXPECT_EQ(std::count(tum.begin(), tum.end(), '\n'), 6 + 1);  // + header
+  EXPECT_EQ(ReadImage(out + "/trajectory.png", false).value().size(),
+            cv::Size(900, 800));
+}
+
 TEST(EstimateImagesCli, StrideKeepsFrameNumbers) {
   const std::string per_frame = test::TempFilePath("stride.csv");
   const RunResult result =

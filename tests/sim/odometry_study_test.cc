@@ -77,8 +77,7 @@ TEST(OdometryStudy, BadOptionsRefusedInOneLine) {
   options.bundle.initial_n = 3.0;
   EXPECT_EQ(options.Check().message(),
             "the bundle: initial n = 3.0 is outside [1, 2]");
-  EXPECT_FALSE(
-      RunOdometryStudy(AlphasenseFrontRectifiedRig(), options).ok());
+  EXPECT_FALSE(RunOdometryStudy(AlphasenseFrontRectifiedRig(), options).ok());
 }
 
 }  // namespace

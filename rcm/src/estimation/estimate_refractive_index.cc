@@ -354,6 +354,9 @@ StatusOr<RefractiveIndexEstimate> EstimateRefractiveIndexFromTracks(
   }
   SequenceBundleOptions bundle_options = options.bundle;
   bundle_options.num_threads = options.refinement.num_threads;
+  // The tracks come from the front end: its systematic floor, the one
+  // policy of every estimator (the refinement's, --systematic-px).
+  bundle_options.systematic_px = options.refinement.systematic_px;
   StatusOr<SequenceBundleAdjustment> bundle =
       SequenceBundleAdjustment::Create(rig, bundle_options);
   if (!bundle.ok()) return bundle.status();
@@ -372,8 +375,18 @@ StatusOr<RefractiveIndexEstimate> EstimateRefractiveIndexFromTracks(
   estimate.sigma_n = result->sigma_n;
   estimate.sigma_n_noise = result->sigma_n_noise;
   estimate.sigma_n_calibration = result->sigma_n_calibration;
-  estimate.sigma_n_systematic = 0.0;
+  estimate.sigma_n_systematic = result->sigma_n_systematic;
+  estimate.systematic_px = bundle_options.systematic_px;
   estimate.sigma_px = result->pixel_sigma;
+  if (result->focal_scales_estimated) {
+    FocalScaleCorrection focal;
+    focal.scale = result->state.focal_scales;
+    for (int c = 0; c < 2; ++c) {
+      focal.sigma[c] = std::sqrt(result->focal_scale_covariance(c, c));
+      focal.correlation_with_n[c] = result->correlation_n_focal_scales[c];
+    }
+    estimate.focal = focal;
+  }
   estimate.inliers = result->num_inliers;
   estimate.correspondences = result->num_observations;
   estimate.frames = tracks.num_frames;

@@ -533,9 +533,9 @@ bool EvaluateResidual(const RigConstants& constants,
   RCM_LENS_MODEL_SWITCH(
       constants.models[o.camera],
       if (o.camera == 0) {
-        return Cam0TrackReprojectionError<LensModel>(constants.cameras[0],
-                                                     o.pixel)(
-            &blocks.n, pose, landmark, blocks.focal.data(), residual);
+        return Cam0TrackReprojectionError<LensModel>(
+            constants.cameras[0], o.pixel)(&blocks.n, pose, landmark,
+                                           blocks.focal.data(), residual);
       } return Cam1TrackReprojectionError<LensModel>(constants.cameras[1],
                                                      constants.rotation,
                                                      constants.baseline,
@@ -615,6 +615,10 @@ Status SequenceBundleOptions::Check() const {
   if (!(loss_scale_px > 0.0) || !std::isfinite(loss_scale_px)) {
     return Status::Error("loss scale = " + FormatDouble(loss_scale_px) +
                          " px must be positive and finite");
+  }
+  if (!(systematic_px >= 0.0) || !std::isfinite(systematic_px)) {
+    return Status::Error("systematic = " + FormatDouble(systematic_px) +
+                         " px must be >= 0 and finite");
   }
   if (!(inlier_threshold_px > 0.0)) {
     return Status::Error(
@@ -1065,17 +1069,16 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
   // stage 1, then the noise stage 1's inliers show.
   const std::optional<CalibrationUncertainty>& uncertainty =
       rig_.calibration_uncertainty();
-  const double focal_prior_sigma =
-      options_.self_calibrate_focal && uncertainty
-          ? uncertainty->focal_drift_sigma
-          : 0.0;
+  const double focal_prior_sigma = options_.self_calibrate_focal && uncertainty
+                                       ? uncertainty->focal_drift_sigma
+                                       : 0.0;
   double focal_weight_px = options_.loss_scale_px;
 
   // Stage 1: robust.
-  const StageResult stage1 = SolveStage(
-      constants, tracks, use, options_, /*robust=*/true,
-      options_.max_iterations, /*covariance=*/false, focal_prior_sigma,
-      focal_weight_px, &blocks);
+  const StageResult stage1 =
+      SolveStage(constants, tracks, use, options_, /*robust=*/true,
+                 options_.max_iterations, /*covariance=*/false,
+                 focal_prior_sigma, focal_weight_px, &blocks);
   if (!stage1.summary.IsSolutionUsable()) {
     return Status::Error("the bundle's robust stage failed: " +
                          stage1.summary.message);
@@ -1112,8 +1115,8 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
     for (int l = 0; l < tracks.num_landmarks; ++l) {
       landmarks += inlier_views[l] > 0 ? 1 : 0;
     }
-    const double dof = 2.0 * inliers - 3.0 * landmarks -
-                       6.0 * (tracks.num_frames - 1) - 4.0;
+    const double dof =
+        2.0 * inliers - 3.0 * landmarks - 6.0 * (tracks.num_frames - 1) - 4.0;
     if (dof > 0.0 && inlier_squares > 0.0) {
       focal_weight_px = std::sqrt(inlier_squares / dof);
     }
@@ -1212,9 +1215,9 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
                   (blocks.focal[0] * blocks.focal[0] +
                    blocks.focal[1] * blocks.focal[1])
             : 0.0;
-    return std::sqrt(
-        2.0 * std::max(0.0, stage2.summary.final_cost - prior_cost) /
-        static_cast<double>(residuals - unknowns));
+    return std::sqrt(2.0 *
+                     std::max(0.0, stage2.summary.final_cost - prior_cost) /
+                     static_cast<double>(residuals - unknowns));
   };
   result.pixel_sigma = pixel_sigma();
   // The focal prior weighs as a residual of the pixel noise: stage 1's
@@ -1264,6 +1267,11 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
     result.focal_scales_estimated = true;
     result.focal_scale_covariance = s2 * stage2.c_ff;
     result.n_focal_scale_covariance = s2 * stage2.c_nf;
+    for (int c = 0; c < 2; ++c) {
+      const double product = stage2.c_nn * stage2.c_ff(c, c);
+      result.correlation_n_focal_scales[c] =
+          product > 0.0 ? stage2.c_nf[c] / std::sqrt(product) : 0.0;
+    }
   }
   if (options_.refine_rotation) {
     result.rotation_covariance = s2 * stage2.c_ww;
@@ -1285,11 +1293,10 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
     // taken back out of the lenses' covariances it propagates.
     const Eigen::MatrixXd joint =
         focal ? uncertainty
-                    ->WithoutFocalDrift(
-                        Eigen::Map<const Eigen::VectorXd>(
-                            rig_.left().params(), p_l),
-                        Eigen::Map<const Eigen::VectorXd>(
-                            rig_.right().params(), p_r))
+                    ->WithoutFocalDrift(Eigen::Map<const Eigen::VectorXd>(
+                                            rig_.left().params(), p_l),
+                                        Eigen::Map<const Eigen::VectorXd>(
+                                            rig_.right().params(), p_r))
                     .JointCovariance()
               : uncertainty->JointCovariance();
     // x = [w; dt; left params; right params]: the joint covariance's rows
@@ -1365,8 +1372,39 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
     }
   }
   result.sigma_n_calibration = std::sqrt(calibration_variance);
+
+  // The tracks' systematic floor (header): dn_k = -systematic_px v . phi_k
+  // for each coefficient of each camera's field on u and on v.
+  double systematic_variance = 0.0;
+  if (options_.systematic_px > 0.0) {
+    // sum_i v_i phi_k(x_i, y_i), per camera and pixel coordinate.
+    double sums[2][2][6] = {};
+    const double scale[2][2] = {
+        {2.0 / rig_.left().width(), 2.0 / rig_.left().height()},
+        {2.0 / rig_.right().width(), 2.0 / rig_.right().height()}};
+    Eigen::Index row = 0;
+    for (size_t i = 0; i < count; ++i) {
+      if (!use[i]) continue;
+      const StereoTrackObservation& o = tracks.observations[i];
+      const double x = o.pixel.x() * scale[o.camera][0] - 1.0;
+      const double y = o.pixel.y() * scale[o.camera][1] - 1.0;
+      const double phi[6] = {1.0, x, y, x * x, x * y, y * y};
+      for (int j = 0; j < 2; ++j) {
+        const double v = stage2.n_influence[row++];
+        for (int k = 0; k < 6; ++k) sums[o.camera][j][k] += v * phi[k];
+      }
+    }
+    for (const auto& camera : sums) {
+      for (const auto& coordinate : camera) {
+        for (const double sum : coordinate) {
+          systematic_variance += std::pow(options_.systematic_px * sum, 2);
+        }
+      }
+    }
+  }
+  result.sigma_n_systematic = std::sqrt(systematic_variance);
   result.sigma_n = std::sqrt(result.sigma_n_noise * result.sigma_n_noise +
-                             calibration_variance);
+                             calibration_variance + systematic_variance);
   RCM_RETURN_IF_ERROR(CheckNotPinnedAtUpperBound(result.n, result.sigma_n));
   return result;
 }

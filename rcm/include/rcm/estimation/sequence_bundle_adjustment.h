@@ -29,6 +29,7 @@
 // The uncertainty (docs/design.md Sec. 3's total sigma_n):
 //
 //   sigma_n^2 = sigma_n_noise^2 + sigma_n_calibration^2
+//               + sigma_n_systematic^2
 //
 // sigma_n_noise from the stage-2 covariance (J^T J)^-1 scaled by the
 // pixel noise s^2 = sum r^2 / (N - p) over the inliers; the rotation's
@@ -65,6 +66,23 @@
 // (the turn, the direction when free) absorb their own moves: their dr lies in
 // J's columns to first order, so dn is the third-order remainder (2e-7 for a
 // 0.1 degree turn in the tests).
+//
+// The tracks' systematic floor (systematic_px, the front end's 0.03 px
+// for tracks of images: kFrontEndSystematicPx): the noise model takes the
+// observations' errors as independent, so that their effect on n falls as
+// 1 / sqrt(N), but a matcher's errors are smooth over the image too
+// (lighting, sub-pixel interpolation; calibration_propagation.h). As for
+// the refine estimator, each camera's residuals in u and in v get a field
+//
+//   r += sum_k c_k phi_k(x, y),  phi = (1, x, y, x^2, x y, y^2),
+//   c_k ~ N(0, systematic_px^2),
+//
+// (x, y) the pixel scaled to [-1, 1] over the image, held at c = 0 and
+// carried into sigma_n by the same linear response: dn_k =
+// -systematic_px v . phi_k, sigma_n_systematic^2 = sum_k dn_k^2 over the
+// 24 coefficients. On a rendered 40-pair loop of a narrow rig the bundle
+// was 4 of its noise sigmas off without it (rare mismatches along the
+// stereo band, radially stretched match noise).
 //
 // When motion does not help. Motion separates n from the turn through the
 // parallax of the landmarks between keyframes; three dives give the
@@ -175,6 +193,10 @@ struct SequenceBundleOptions {
   int max_iterations = 100;
   // Carry the calibration's remaining uncertainty into sigma_n (above).
   bool propagate_calibration = true;
+  // The tracks' systematic floor, pixels per coefficient (above); 0: their
+  // errors independent (exact or simulated tracks). EstimateRefractive
+  // IndexFromTracks sets the refinement's (the front end's 0.03 px).
+  double systematic_px = 0.0;
   // Principal directions of the calibration's covariance below this
   // fraction of its largest eigenvalue are dropped from the propagation.
   double propagation_eigenvalue_floor = 1e-12;
@@ -244,6 +266,7 @@ struct SequenceBundleResult {
   double sigma_n = kNaN;
   double sigma_n_noise = kNaN;
   double sigma_n_calibration = kNaN;
+  double sigma_n_systematic = kNaN;  // 0 without a floor
   // Covariance of cam1_rotation from the noise, rad^2 (zero when held).
   Eigen::Matrix3d rotation_covariance = Eigen::Matrix3d::Zero();
   // Covariance of n with each component of cam1_rotation from the noise
@@ -257,6 +280,7 @@ struct SequenceBundleResult {
   bool focal_scales_estimated = false;
   Eigen::Matrix2d focal_scale_covariance = Eigen::Matrix2d::Zero();
   Eigen::Vector2d n_focal_scale_covariance = Eigen::Vector2d::Zero();
+  Eigen::Vector2d correlation_n_focal_scales = Eigen::Vector2d::Zero();
   // Pixel noise estimated from the stage-2 residuals.
   double pixel_sigma = kNaN;
   int64_t num_observations = 0;  // given

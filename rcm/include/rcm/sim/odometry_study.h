@@ -40,12 +40,20 @@ struct OdometryStudyOptions {
   StereoFrontEndOptions front_end;
   StereoTrackerOptions tracker;
   // The bundle's options of the "estimated" row; the other rows change
-  // refine_n, initial_n and refine_rotation only.
-  SequenceBundleOptions bundle;
+  // refine_n, initial_n and refine_rotation only. By default the tracks'
+  // systematic floor is the front end's (kFrontEndSystematicPx), as
+  // `rcm estimate --estimator bundle` gives it.
+  SequenceBundleOptions bundle = FrontEndBundleOptions();
   int num_threads = 2;  // detection, the bundle, the refine estimate
 
   // Errors: the parts' Check(); a dive of more than one medium.
   Status Check() const;
+
+  static SequenceBundleOptions FrontEndBundleOptions() {
+    SequenceBundleOptions options;
+    options.systematic_px = kFrontEndSystematicPx;
+    return options;
+  }
 };
 
 enum class OdometryModel { kEstimated, kNAtTruth, kWaterIgnored, kStaleRig };
