@@ -163,6 +163,7 @@ budgeted=(
   'UnderwaterCandidates.*'
   'UnderwaterModelSelectionOptions.*'
   'SequenceBundleAdjustment.*'
+  'EstimateRefractiveIndexFromTracks.*'
   'SequenceBundleOptions.*'
   'BundleMotion.*'
 )

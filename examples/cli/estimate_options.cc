@@ -48,6 +48,8 @@ DEFINE_string(estimator, "refine",
               "estimate with a warning)");
 DEFINE_int32(window, 20,
              "window: frames in the sliding window (w_s; 20 = 1 s at 20 Hz)");
+DEFINE_int32(bundle_window, 0,
+             "bundle: adjust the last this many pairs (0: the whole dive)");
 DEFINE_double(change_threshold, 5.0,
               "window: a frame whose own n differs from the window's by more "
               "than this many combined sigmas is inconsistent; two in a row "
@@ -207,6 +209,7 @@ StatusOr<EstimateCliOptions> EstimateOptionsFromFlags() {
   estimation.estimator = *estimator;
   estimation.estimate_air_gap = FLAGS_estimate_air_gap;
   estimation.window.SetWindowFrames(FLAGS_window);
+  estimation.bundle_window = FLAGS_bundle_window;
   estimation.window.change_threshold = FLAGS_change_threshold;
   if (const Status status = estimation.window.Check(); !status.ok()) {
     return status.WithContext("--window/--change-threshold");

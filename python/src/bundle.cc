@@ -45,6 +45,7 @@ std::vector<OptionField> BundleOptionFields(SequenceBundleOptions* o) {
       BoolOption("refine_rotation", &o->refine_rotation),
       BoolOption("refine_translation_direction",
                  &o->refine_translation_direction),
+      BoolOption("self_calibrate_focal", &o->self_calibrate_focal),
       DoubleOption("min_translation_fraction", &o->min_translation_fraction),
       DoubleOption("min_rotation_deg", &o->min_rotation_deg),
       DoubleOption("axial_cone_deg", &o->axial_cone_deg),
@@ -60,6 +61,7 @@ std::vector<OptionField> BundleOptionFields(SequenceBundleOptions* o) {
       IntOption("min_landmark_keyframes", &o->min_landmark_keyframes),
       IntOption("max_iterations", &o->max_iterations),
       BoolOption("propagate_calibration", &o->propagate_calibration),
+      DoubleOption("systematic_px", &o->systematic_px),
       DoubleOption("propagation_eigenvalue_floor",
                    &o->propagation_eigenvalue_floor),
       IntOption("num_threads", &o->num_threads)};
@@ -163,6 +165,9 @@ void BindBundle(py::module_& module) {
        {"refine_translation_direction",
         "estimate the direction of cam1's translation (its length is the "
         "scale)"},
+       {"self_calibrate_focal",
+        "estimate each lens's focal scale under the camchain's focal drift "
+        "prior"},
        {"min_translation_fraction",
         "static below this fraction of the landmarks' distance"},
        {"min_rotation_deg", "a rig turning less is checked for degeneracy"},
@@ -179,6 +184,9 @@ void BindBundle(py::module_& module) {
        {"max_iterations", "Ceres iterations per stage"},
        {"propagate_calibration",
         "carry the camchain's uncertainty into sigma_n"},
+       {"systematic_px",
+        "the tracks' systematic floor per field coefficient, pixels (0.03 "
+        "for the front end's tracks)"},
        {"propagation_eigenvalue_floor",
         "calibration directions below this fraction are dropped"},
        {"num_threads", "threads of Ceres and of the covariance"}});
@@ -186,8 +194,11 @@ void BindBundle(py::module_& module) {
   py::class_<SequenceBundleResult>(module, "SequenceBundleResult", R"doc(
 The sequence bundle adjustment's solution (C++ SequenceBundleResult).
 
-n, sigma_n (total, 1 sigma) and its parts sigma_n_noise and
-sigma_n_calibration (0 where n was held); cam1_rotation (3,): the turn since
+n, sigma_n (total, 1 sigma) and its parts sigma_n_noise,
+sigma_n_calibration and sigma_n_systematic (0 where n was held);
+focal_scales (2,): each lens's focal lengths' relative change e_c (None
+unless estimated under a focal drift prior) and focal_scale_covariance
+(2, 2); cam1_rotation (3,): the turn since
 the calibration (angle-axis, radians, cam1 frame); rotation_covariance
 (3, 3), radians^2; correlation_n_rotation: what the data leave of n's
 correlation with the turn (0: motion separates them); pixel_sigma (pixels);
@@ -201,6 +212,18 @@ NaN for a landmark left out; motion: one line; motion_kind: 'moving',
       .def_readonly("sigma_n_noise", &SequenceBundleResult::sigma_n_noise)
       .def_readonly("sigma_n_calibration",
                     &SequenceBundleResult::sigma_n_calibration)
+      .def_readonly("sigma_n_systematic",
+                    &SequenceBundleResult::sigma_n_systematic)
+      .def_property_readonly("focal_scales",
+                             [](const SequenceBundleResult& r) -> py::object {
+                               if (!r.focal_scales_estimated) return py::none();
+                               return ToNumpy(r.state.focal_scales);
+                             })
+      .def_property_readonly("focal_scale_covariance",
+                             [](const SequenceBundleResult& r) -> py::object {
+                               if (!r.focal_scales_estimated) return py::none();
+                               return ToNumpy(r.focal_scale_covariance);
+                             })
       .def_property_readonly("cam1_rotation",
                              [](const SequenceBundleResult& r) {
                                return ToNumpy(r.state.cam1_rotation);

@@ -89,6 +89,8 @@ def test_noise_free_tracks_give_n_turn_and_trajectory_exactly(rig):
     assert result.motion_kind == "moving"
     assert result.landmarks.shape[1] == 3
     assert result.sigma_n > 0.0 and result.rotation_covariance.shape == (3, 3)
+    # A rig made in code has no focal drift prior: the lenses are held.
+    assert result.focal_scales is None and result.sigma_n_systematic == 0.0
 
 
 def test_held_n_is_odometry(rig):
@@ -114,6 +116,8 @@ def test_options_and_bad_input(rig):
     options = rcm.SequenceBundleOptions(refine_n=False, initial_n=1.34)
     assert options.refine_n is False and options.initial_n == 1.34
     assert options.to_dict()["min_landmark_keyframes"] == 2
+    assert options.to_dict()["self_calibrate_focal"] is True
+    assert options.to_dict()["systematic_px"] == 0.0
     ba = rcm.SequenceBundleAdjustment(rig, options=options)
     assert ba.options.initial_n == 1.34
     with pytest.raises(TypeError) as error:

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "rcm/camera/refractive_camera.h"
+#include "rcm/estimation/estimate_refractive_index.h"
 #include "rcm/geometry/calibration_uncertainty.h"
 #include "support/test_budget.h"
 #include "support/test_rigs.h"
@@ -285,6 +286,48 @@ TEST(SequenceBundleAdjustment, NoiseFreeThroughThickPorts) {
   }
 }
 
+// A port whose air gap the calibration knows to 1 mm (an underwater
+// calibration's port covariance): sigma_n_calibration is n's linear
+// response to the gap moved by +-1 mm, which re-solving the bundle with the
+// gap moved confirms: the same central difference to 1 % (the re-solve's
+// third-order remainder; measured 0.04 %).
+TEST(SequenceBundleAdjustment, PortUncertaintyCarriedIntoSigma) {
+  const double n = 1.34;
+  FlatPort port;
+  port.air_gap = 0.008;
+  port.glass_thickness = 0.01;
+  const StereoRig calibration = Calibration().WithPorts(port, port).value();
+  const Dive dive = MakeDive(calibration.WithCam1Moved(TrueTurn()).value(), n,
+                             8, 300, 0.0, 7);
+  CalibrationUncertainty uncertainty =
+      CalibrationUncertainty::DriftPrior(0.0, 0.0);
+  uncertainty.port_covariance = Eigen::MatrixXd::Zero(6, 6);
+  uncertainty.port_covariance(0, 0) = 1e-6;  // the left air gap: 1 mm
+  const StereoRig uncertain =
+      calibration.WithCalibrationUncertainty(uncertainty).value();
+  const SequenceBundleOptions options;
+  const StatusOr<SequenceBundleResult> result =
+      Bundle(uncertain, options, dive.tracks);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  EXPECT_NEAR(result->n, n, kExactTolerance);
+  EXPECT_EQ(result->propagation_directions, 1);
+  // n re-solved with the left gap 1 mm wider and 1 mm narrower: the
+  // response curves (+1.000e-3 and -1.293e-3), and the propagation's
+  // central difference is their mean slope.
+  double moved_n[2];
+  for (int sign = 0; sign < 2; ++sign) {
+    FlatPort moved_port = port;
+    moved_port.air_gap += sign == 0 ? 0.001 : -0.001;
+    const StatusOr<SequenceBundleResult> moved = Bundle(
+        calibration.WithPorts(moved_port, port).value(), options, dive.tracks);
+    ASSERT_TRUE(moved.ok()) << moved.status().message();
+    moved_n[sign] = moved->n;
+  }
+  const double dn = 0.5 * std::abs(moved_n[0] - moved_n[1]);
+  EXPECT_GT(dn, 1e-4);  // the gap matters
+  EXPECT_NEAR(result->sigma_n_calibration, dn, 0.01 * dn) << "re-solved " << dn;
+}
+
 // 0.5 px of pixel noise: n within 4 of its reported noise sigma (a 6e-5
 // chance for an honest sigma), and the estimated pixel noise within 5 % of
 // the truth (~60k residuals: its relative standard error is ~0.3 %, the
@@ -494,6 +537,45 @@ TEST(SequenceBundleAdjustment, SigmaHonestUnderASystematicField) {
     EXPECT_GT(sd, 0.8);
     EXPECT_LT(sd, 1.3);
   }
+}
+
+// The engine's bundle over the last keyframes only (bundle_window): the
+// trajectory is the window's, in its first keyframe's frame, stamped with
+// the window's frames; noise-free, n to 1e-9 as over the whole dive.
+TEST(EstimateRefractiveIndexFromTracks, WindowAdjustsTheLastKeyframes) {
+  const double n = 1.34;
+  const Dive dive = MakeDive(TurnedTruth(), n, 8, 300, 0.0, 1);
+  std::vector<KeyframeStamp> stamps;
+  for (int k = 0; k < 8; ++k) stamps.push_back({10 + k, 0.25 * k});
+  EstimationOptions options;
+  options.estimator = EstimatorKind::kBundle;
+  options.bundle_window = 5;
+  const StatusOr<RefractiveIndexEstimate> estimate =
+      EstimateRefractiveIndexFromTracks(Calibration(), dive.tracks, stamps,
+                                        options);
+  ASSERT_TRUE(estimate.ok()) << estimate.status().message();
+  EXPECT_NEAR(estimate->n, n, kExactTolerance);
+  ASSERT_TRUE(estimate->bundle.has_value());
+  EXPECT_EQ(estimate->bundle->frames_used, 5);
+  ASSERT_EQ(estimate->bundle->trajectory.size(), 5u);
+  EXPECT_EQ(estimate->bundle->trajectory.front().frame, 13);
+  EXPECT_EQ(estimate->bundle->trajectory.back().timestamp, 0.25 * 7);
+  // Pose k of the window is keyframe 3 + k seen from keyframe 3.
+  for (int k = 0; k < 5; ++k) {
+    const Rigid3d truth =
+        dive.cam0_from_world[3] * dive.cam0_from_world[3 + k].Inverse();
+    EXPECT_LT((estimate->bundle->trajectory[k].world_from_cam0.translation -
+               truth.translation)
+                  .norm(),
+              kExactTolerance)
+        << "window keyframe " << k;
+  }
+  options.bundle_window = 1;
+  EXPECT_EQ(EstimateRefractiveIndexFromTracks(Calibration(), dive.tracks,
+                                              stamps, options)
+                .status()
+                .message(),
+            "bundle window = 1 keyframes must be 0 (every keyframe) or >= 2");
 }
 
 TEST(SequenceBundleAdjustment, SolvedFromTheTruthStaysThere) {

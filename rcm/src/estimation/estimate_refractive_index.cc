@@ -271,6 +271,10 @@ Status EstimationOptions::Check() const {
   RCM_RETURN_IF_ERROR(window.Check());
   RCM_RETURN_IF_ERROR(closed_form.Check());
   RCM_RETURN_IF_ERROR(bundle.Check().WithContext("bundle"));
+  if (bundle_window < 0 || bundle_window == 1) {
+    return Status::Error("bundle window = " + std::to_string(bundle_window) +
+                         " keyframes must be 0 (every keyframe) or >= 2");
+  }
   if (!bundle.refine_n) {
     return Status::Error(
         "the bundle's refine_n is false: an estimate of n estimates n (hold n "
@@ -352,6 +356,19 @@ StatusOr<RefractiveIndexEstimate> EstimateRefractiveIndexFromTracks(
                          std::to_string(tracks.num_frames) + " keyframes, " +
                          std::to_string(keyframes.size()) + " are stamped");
   }
+  // A window of the last keyframes (the options), or every one.
+  const StereoTracks* adjusted = &tracks;
+  std::vector<KeyframeStamp> window_keyframes;
+  StatusOr<StereoTracks> window = Status::Error("not windowed");
+  if (options.bundle_window > 0 && options.bundle_window < tracks.num_frames) {
+    const int first = tracks.num_frames - options.bundle_window;
+    window = TracksInWindow(tracks, first, options.bundle_window);
+    if (!window.ok()) return window.status();
+    adjusted = &*window;
+    window_keyframes.assign(keyframes.begin() + first, keyframes.end());
+  }
+  const std::vector<KeyframeStamp>& stamps =
+      adjusted == &tracks ? keyframes : window_keyframes;
   SequenceBundleOptions bundle_options = options.bundle;
   bundle_options.num_threads = options.refinement.num_threads;
   // The tracks come from the front end: its systematic floor, the one
@@ -360,7 +377,7 @@ StatusOr<RefractiveIndexEstimate> EstimateRefractiveIndexFromTracks(
   StatusOr<SequenceBundleAdjustment> bundle =
       SequenceBundleAdjustment::Create(rig, bundle_options);
   if (!bundle.ok()) return bundle.status();
-  StatusOr<SequenceBundleResult> result = bundle->Solve(tracks);
+  StatusOr<SequenceBundleResult> result = bundle->Solve(*adjusted);
   if (!result.ok()) return result.status();
 
   RefractiveIndexEstimate estimate;
@@ -389,7 +406,7 @@ StatusOr<RefractiveIndexEstimate> EstimateRefractiveIndexFromTracks(
   }
   estimate.inliers = result->num_inliers;
   estimate.correspondences = result->num_observations;
-  estimate.frames = tracks.num_frames;
+  estimate.frames = adjusted->num_frames;
   estimate.iterations = result->iterations;
   if (bundle_options.refine_rotation) {
     RotationCorrection rotation;
@@ -397,8 +414,7 @@ StatusOr<RefractiveIndexEstimate> EstimateRefractiveIndexFromTracks(
     rotation.sigma = result->rotation_covariance.diagonal().cwiseSqrt();
     for (int i = 0; i < 3; ++i) {
       rotation.correlation_with_n[i] =
-          result->n_rotation_covariance[i] /
-          (result->sigma_n_noise * rotation.sigma[i]);
+          result->correlation_n_rotation_components[i];
     }
     rotation.multiple_correlation_with_n = result->correlation_n_rotation;
     rotation.with_prior = false;
@@ -413,9 +429,9 @@ StatusOr<RefractiveIndexEstimate> EstimateRefractiveIndexFromTracks(
   summary.motion = result->motion.Describe();
   summary.correlation_n_rotation = result->correlation_n_rotation;
   {
-    std::vector<int> first(tracks.num_landmarks, -1);
-    std::vector<bool> tracked(tracks.num_landmarks, false);
-    for (const StereoTrackObservation& o : tracks.observations) {
+    std::vector<int> first(adjusted->num_landmarks, -1);
+    std::vector<bool> tracked(adjusted->num_landmarks, false);
+    for (const StereoTrackObservation& o : adjusted->observations) {
       if (!result->state.landmarks[o.landmark].allFinite()) continue;
       if (first[o.landmark] < 0) {
         first[o.landmark] = o.frame;
@@ -425,9 +441,9 @@ StatusOr<RefractiveIndexEstimate> EstimateRefractiveIndexFromTracks(
     }
     summary.tracks = std::count(tracked.begin(), tracked.end(), true);
   }
-  for (int k = 0; k < tracks.num_frames; ++k) {
+  for (int k = 0; k < adjusted->num_frames; ++k) {
     summary.trajectory.push_back(
-        {keyframes[k].frame, keyframes[k].timestamp, result->WorldFromCam0(k)});
+        {stamps[k].frame, stamps[k].timestamp, result->WorldFromCam0(k)});
   }
   estimate.bundle = std::move(summary);
   for (std::string& warning : EstimateWarnings(estimate)) {

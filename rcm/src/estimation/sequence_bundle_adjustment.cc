@@ -583,6 +583,7 @@ StatusOr<StereoRig> MovedRig(const StereoRig& rig,
                              const Eigen::VectorXd& delta) {
   const int p_l = rig.left().num_params();
   const int p_r = rig.right().num_params();
+  const int q = 6 + p_l + p_r;  // the ports' parameters, when delta has them
   std::vector<double> left(rig.left().params(), rig.left().params() + p_l);
   std::vector<double> right(rig.right().params(), rig.right().params() + p_r);
   for (int i = 0; i < p_l && 6 + i < delta.size(); ++i) left[i] += delta[6 + i];
@@ -599,9 +600,22 @@ StatusOr<StereoRig> MovedRig(const StereoRig& rig,
   StatusOr<StereoRig> moved =
       lenses->WithCam1Moved(delta.segment<3>(0), delta.segment<3>(3));
   if (!moved.ok()) return moved.status();
-  if (rig.ports())
-    return moved->WithPorts(rig.ports()->left, rig.ports()->right);
-  return moved;
+  if (!rig.ports()) return moved;
+  // q = [d_l, a_l, b_l, d_r, a_r, b_r]: each side's air gap and the tilt
+  // (N_x / N_z, N_y / N_z) of its normal (calibration_uncertainty.h).
+  std::array<FlatPort, 2> ports = {rig.ports()->left, rig.ports()->right};
+  if (delta.size() >= q + CalibrationUncertainty::kNumPortParams) {
+    for (int c = 0; c < 2; ++c) {
+      FlatPort& port = ports[c];
+      port.air_gap += delta[q + 3 * c];
+      const Eigen::Vector2d tilt =
+          Eigen::Vector2d(port.normal.x() / port.normal.z(),
+                          port.normal.y() / port.normal.z()) +
+          delta.segment<2>(q + 3 * c + 1);
+      port.normal = Eigen::Vector3d(tilt.x(), tilt.y(), 1.0).normalized();
+    }
+  }
+  return moved->WithPorts(ports[0], ports[1]);
 }
 
 }  // namespace
@@ -1280,6 +1294,11 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
     const double explained =
         stage2.c_nw.dot(c_ww.ldlt().solve(stage2.c_nw)) / stage2.c_nn;
     result.correlation_n_rotation = std::sqrt(std::clamp(explained, 0.0, 1.0));
+    for (int i = 0; i < 3; ++i) {
+      const double product = stage2.c_nn * stage2.c_ww(i, i);
+      result.correlation_n_rotation_components[i] =
+          product > 0.0 ? stage2.c_nw[i] / std::sqrt(product) : 0.0;
+    }
   }
   result.state = StateOf(blocks);
   result.motion = ClassifyBundleMotion(result.state, options_);
@@ -1299,9 +1318,10 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
                                             rig_.right().params(), p_r))
                     .JointCovariance()
               : uncertainty->JointCovariance();
-    // x = [w; dt; left params; right params]: the joint covariance's rows
-    // of those that it has (a lens without a covariance is exact; the
-    // ports' rows, when given, are held exact here).
+    // x = [w; dt; left params; right params; q]: the joint covariance's
+    // rows of those that it has (a lens without a covariance is exact; the
+    // ports' q of a thick port's rig, as the refine estimator's
+    // propagation has them).
     std::vector<int> index;
     for (int i = 0; i < 6; ++i) index.push_back(i);
     if (uncertainty->left_lens_covariance.size() > 0) {
@@ -1310,7 +1330,19 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
     if (uncertainty->right_lens_covariance.size() > 0) {
       for (int i = 0; i < p_r; ++i) index.push_back(6 + p_l + i);
     }
-    Eigen::MatrixXd held = Eigen::MatrixXd::Zero(6 + p_l + p_r, 6 + p_l + p_r);
+    const bool ports =
+        uncertainty->port_covariance.size() > 0 && rig_.HasThickPort() &&
+        joint.rows() ==
+            static_cast<Eigen::Index>(index.size() +
+                                      CalibrationUncertainty::kNumPortParams);
+    const int size =
+        6 + p_l + p_r + (ports ? CalibrationUncertainty::kNumPortParams : 0);
+    if (ports) {
+      for (int k = 0; k < CalibrationUncertainty::kNumPortParams; ++k) {
+        index.push_back(6 + p_l + p_r + k);
+      }
+    }
+    Eigen::MatrixXd held = Eigen::MatrixXd::Zero(size, size);
     for (size_t a = 0; a < index.size(); ++a) {
       for (size_t b = 0; b < index.size(); ++b) {
         held(index[a], index[b]) = joint(a, b);

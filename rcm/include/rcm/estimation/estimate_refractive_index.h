@@ -70,8 +70,10 @@ struct EstimationOptions {
   SlidingWindowOptions window;
   // closed-form: the observability mask.
   PaperOnlineEstimatorOptions closed_form;
-  // bundle: the sequence bundle adjustment's.
+  // bundle: the sequence bundle adjustment's, and the keyframes it adjusts:
+  // the last bundle_window of them (TracksInWindow), 0 every keyframe.
   SequenceBundleOptions bundle;
+  int bundle_window = 0;
   // refine: estimate the ports' air gaps with n (a thin port's rig: from
   // zero). Not with refinement.refine_rotation.
   bool estimate_air_gap = false;

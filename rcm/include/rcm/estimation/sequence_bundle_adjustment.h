@@ -48,8 +48,9 @@
 //
 // sigma_n_calibration carries what the calibration leaves uncertain and
 // the bundle holds (the translation's change dt, the lenses without the
-// focal prior when e_c are estimated; calibration_uncertainty.h): the
-// joint covariance of [w; dt; lenses] is split into its principal
+// focal prior when e_c are estimated, a thick port's air gaps and tilts
+// when the covariance has them; calibration_uncertainty.h): the joint
+// covariance of [w; dt; lenses; ports] is split into its principal
 // directions e_k (eigenvalues l_k), and n's linear response to the rig
 // moved by +- sqrt(l_k) e_k is taken at the solution theta:
 //
@@ -275,6 +276,9 @@ struct SequenceBundleResult {
   // Multiple correlation of n with cam1_rotation left by the data (NaN
   // when the rotation is held).
   double correlation_n_rotation = kNaN;
+  // The correlation of n with each component of cam1_rotation (zero when
+  // held).
+  Eigen::Vector3d correlation_n_rotation_components = Eigen::Vector3d::Zero();
   // With the focal scales estimated (self_calibrate_focal and a focal
   // drift prior): their covariance and with n (the noise and the prior).
   bool focal_scales_estimated = false;

@@ -32,6 +32,17 @@ struct StereoTracks {
   Status Check() const;
 };
 
+// The tracks of keyframes [first, first + count), renumbered: keyframe f
+// becomes f - first, and the landmarks seen there are numbered in the
+// order of their first observation in the window. `landmark_ids`
+// (optional) receives, per new landmark, its index in `tracks`: a bundle
+// over a window of the dive (sequence_bundle_adjustment.h). Errors: a
+// window outside the tracks or of fewer than 2 keyframes, or one in which
+// no landmark is seen.
+StatusOr<StereoTracks> TracksInWindow(const StereoTracks& tracks, int first,
+                                      int count,
+                                      std::vector<int>* landmark_ids = nullptr);
+
 }  // namespace rcm
 
 #endif  // RCM_GEOMETRY_STEREO_TRACKS_H_
