@@ -762,7 +762,9 @@ BENCHMARK(BM_EndToEnd_RcmProcess)
 // pairs of a loop dive (a 5 m x 5 m pool at 4 Hz, 14 cm and up to 10 deg
 // between pairs, cam1 turned 0.5 deg since the calibration), PNG folders
 // as a user has them. Counters: the process's wall clock (fastest and
-// median of 3) and the n it printed. 2026-12-06: 5.8-6.0 s, n 1.33321.
+// median of 3) and the n it printed. 2026-12-06: 5.8-6.0 s, n 1.33321;
+// with the focal scales estimated and the systematic floor, 7.1-7.2 s,
+// n 1.33311 (7.6-8.2 s in a slow phase of the machine).
 constexpr int kBundlePairs = 40;
 
 void BM_EndToEnd_RcmBundleProcess(benchmark::State& state) {
