@@ -671,6 +671,22 @@ BENCHMARK(BM_EndToEnd_Engine)
     ->Iterations(3)
     ->UseRealTime();
 
+// The rcm executable next to this benchmark's, or empty.
+std::filesystem::path RcmNextToThisBenchmark() {
+  const std::filesystem::path rcm =
+      std::filesystem::read_symlink("/proc/self/exe").parent_path() / "rcm";
+  return std::filesystem::exists(rcm) ? rcm : std::filesystem::path();
+}
+
+// A new temporary folder `prefix`<pid> with empty left/ and right/.
+std::filesystem::path PairFolders(const std::string& prefix) {
+  const std::filesystem::path folder = std::filesystem::temp_directory_path() /
+                                       (prefix + std::to_string(getpid()));
+  std::filesystem::create_directories(folder / "left");
+  std::filesystem::create_directories(folder / "right");
+  return folder;
+}
+
 // The whole `rcm estimate --calib camchain.yaml --left L --right R --json`
 // process (the executable next to this benchmark) on the 10 pairs written
 // as PNG folders, wall time per run, and its ratio to one run of the
@@ -678,18 +694,12 @@ BENCHMARK(BM_EndToEnd_Engine)
 // (x_straightforward: how many times as fast the whole process is).
 void BM_EndToEnd_RcmProcess(benchmark::State& state) {
   const Sequence& data = Data();
-  const std::filesystem::path self =
-      std::filesystem::read_symlink("/proc/self/exe");
-  const std::filesystem::path rcm = self.parent_path() / "rcm";
-  if (!std::filesystem::exists(rcm)) {
+  const std::filesystem::path rcm = RcmNextToThisBenchmark();
+  if (rcm.empty()) {
     state.SkipWithError("the rcm executable is not next to the benchmark");
     return;
   }
-  const std::filesystem::path folder =
-      std::filesystem::temp_directory_path() /
-      ("rcm_process_benchmark_" + std::to_string(getpid()));
-  std::filesystem::create_directories(folder / "left");
-  std::filesystem::create_directories(folder / "right");
+  const std::filesystem::path folder = PairFolders("rcm_process_benchmark_");
   for (int i = 0; i < kPairs; ++i) {
     char name[32];
     std::snprintf(name, sizeof(name), "%06d.png", i);
@@ -768,18 +778,12 @@ BENCHMARK(BM_EndToEnd_RcmProcess)
 constexpr int kBundlePairs = 40;
 
 void BM_EndToEnd_RcmBundleProcess(benchmark::State& state) {
-  const std::filesystem::path self =
-      std::filesystem::read_symlink("/proc/self/exe");
-  const std::filesystem::path rcm = self.parent_path() / "rcm";
-  if (!std::filesystem::exists(rcm)) {
+  const std::filesystem::path rcm = RcmNextToThisBenchmark();
+  if (rcm.empty()) {
     state.SkipWithError("the rcm executable is not next to the benchmark");
     return;
   }
-  const std::filesystem::path folder =
-      std::filesystem::temp_directory_path() /
-      ("rcm_bundle_benchmark_" + std::to_string(getpid()));
-  std::filesystem::create_directories(folder / "left");
-  std::filesystem::create_directories(folder / "right");
+  const std::filesystem::path folder = PairFolders("rcm_bundle_benchmark_");
   const StereoRig rig = AlphasenseFrontRectifiedRig();
   SequenceOptions options;
   options.media = {MediaSegment{kTrueN, kBundlePairs}};

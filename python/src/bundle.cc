@@ -21,23 +21,7 @@ namespace rcm::python {
 namespace {
 
 std::vector<OptionField> BundleOptionFields(SequenceBundleOptions* o) {
-  OptionField loss{
-      "loss",
-      [o](const py::handle& value) {
-        if (!py::isinstance<py::str>(value)) {
-          ThrowTypeError("loss must be a str ('none', 'huber', 'cauchy')");
-        }
-        const std::string name = value.cast<std::string>();
-        const std::optional<RobustLoss> loss = RobustLossFromName(name);
-        if (!loss) {
-          ThrowValueError("unknown loss '" + name +
-                          "' (available: none, huber, cauchy)");
-        }
-        o->loss = *loss;
-      },
-      [o]() {
-        return py::object(py::str(std::string(RobustLossName(o->loss))));
-      }};
+  const OptionField loss = LossOption("loss", &o->loss);
   return {
       DoubleOption("initial_n", &o->initial_n),
       BoolOption("epipolar_seed", &o->epipolar_seed),
@@ -108,12 +92,7 @@ StereoTracks TracksFromPython(const py::handle& object,
 DoubleArray PosesToNumpy(const std::vector<Rigid3d>& poses) {
   DoubleArray array = NewArray(static_cast<int64_t>(poses.size()), 7);
   double* data = array.mutable_data();
-  for (size_t f = 0; f < poses.size(); ++f) {
-    const Eigen::Quaterniond q(poses[f].rotation);
-    const Eigen::Vector3d t = poses[f].translation + Eigen::Vector3d::Zero();
-    const double row[7] = {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()};
-    std::copy(row, row + 7, data + 7 * f);
-  }
+  for (size_t f = 0; f < poses.size(); ++f) TumRow(poses[f], data + 7 * f);
   return array;
 }
 

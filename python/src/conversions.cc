@@ -1,5 +1,7 @@
 #include "conversions.h"
 
+#include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <sstream>
@@ -168,6 +170,13 @@ Eigen::Matrix4d Matrix4FromPython(const py::handle& object,
     for (int c = 0; c < 4; ++c) matrix(r, c) = rows.data()[4 * r + c];
   }
   return matrix;
+}
+
+void TumRow(const Rigid3d& pose, double row[7]) {
+  const Eigen::Quaterniond q(pose.rotation);
+  const Eigen::Vector3d t = pose.translation + Eigen::Vector3d::Zero();
+  const double values[7] = {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()};
+  std::copy(values, values + 7, row);
 }
 
 DoubleArray NewArray(int64_t rows, int cols, bool single) {

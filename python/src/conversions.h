@@ -61,6 +61,9 @@ int IntFromPython(const py::handle& object, const std::string& name);
 // One finite number (ValueError for NaN/inf, TypeError for a non-number).
 double FiniteDouble(const py::handle& object, const std::string& name);
 
+// A pose as a TUM row [tx, ty, tz, qx, qy, qz, qw] (+ 0.0: no "-0").
+void TumRow(const Rigid3d& pose, double row[7]);
+
 // A new float64 array of shape (rows, cols), or (cols,) when `single`.
 DoubleArray NewArray(int64_t rows, int cols, bool single = false);
 // A copy of an Eigen value: a 1-D array for a compile-time column vector,

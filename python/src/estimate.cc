@@ -161,14 +161,10 @@ to_dict() gives the JSON object; to_json() its text.
             DoubleArray array = NewArray(static_cast<int64_t>(poses.size()), 8);
             double* data = array.mutable_data();
             for (size_t f = 0; f < poses.size(); ++f) {
-              const Eigen::Quaterniond q(poses[f].world_from_cam0.rotation);
-              const Eigen::Vector3d t =
-                  poses[f].world_from_cam0.translation + Eigen::Vector3d::Zero();
-              const double row[8] = {
-                  poses[f].timestamp ? *poses[f].timestamp
-                                     : static_cast<double>(poses[f].frame),
-                  t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()};
-              std::copy(row, row + 8, data + 8 * f);
+              data[8 * f] = poses[f].timestamp
+                                ? *poses[f].timestamp
+                                : static_cast<double>(poses[f].frame);
+              TumRow(poses[f].world_from_cam0, data + 8 * f + 1);
             }
             return array;
           },

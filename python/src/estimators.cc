@@ -26,23 +26,7 @@ namespace rcm::python {
 
 // The keywords of RefinementOptions, named as its fields.
 std::vector<OptionField> RefinementOptionFields(RefinementOptions* o) {
-  OptionField loss{
-      "loss",
-      [o](const py::handle& value) {
-        if (!py::isinstance<py::str>(value)) {
-          ThrowTypeError("loss must be a str ('none', 'huber', 'cauchy')");
-        }
-        const std::string name = value.cast<std::string>();
-        const std::optional<RobustLoss> loss = RobustLossFromName(name);
-        if (!loss) {
-          ThrowValueError("unknown loss '" + name +
-                          "' (available: none, huber, cauchy)");
-        }
-        o->loss = *loss;
-      },
-      [o]() {
-        return py::object(py::str(std::string(RobustLossName(o->loss))));
-      }};
+  const OptionField loss = LossOption("loss", &o->loss);
   // A prior on n: None, a medium ('fresh', 'sea', 'N:SIGMA'; medium_prior.h)
   // or a pair (n, sigma).
   OptionField n_prior{

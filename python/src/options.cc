@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "errors.h"
+#include "rcm/estimation/refinement_options.h"
 
 namespace rcm::python {
 
@@ -44,6 +45,26 @@ OptionField IntOption(const std::string& name, int* field) {
             *field = static_cast<int>(number);
           },
           [field]() { return py::object(py::int_(*field)); }};
+}
+
+OptionField LossOption(const std::string& name, RobustLoss* field) {
+  return {
+      name,
+      [name, field](const py::handle& value) {
+        if (!py::isinstance<py::str>(value)) {
+          ThrowTypeError(name + " must be a str ('none', 'huber', 'cauchy')");
+        }
+        const std::string text = value.cast<std::string>();
+        const std::optional<RobustLoss> loss = RobustLossFromName(text);
+        if (!loss) {
+          ThrowValueError("unknown " + name + " '" + text +
+                          "' (available: none, huber, cauchy)");
+        }
+        *field = *loss;
+      },
+      [field]() {
+        return py::object(py::str(std::string(RobustLossName(*field))));
+      }};
 }
 
 OptionField DoubleOption(const std::string& name, double* field,

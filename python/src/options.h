@@ -15,6 +15,7 @@
 #include "errors.h"
 
 namespace rcm {
+enum class RobustLoss;
 struct RefinementOptions;
 struct StereoFrontEndOptions;
 }  // namespace rcm
@@ -33,6 +34,9 @@ struct OptionField {
 OptionField BoolOption(const std::string& name, bool* field);
 // An int (not a bool, not a float).
 OptionField IntOption(const std::string& name, int* field);
+// A robust loss by its name: 'none', 'huber' or 'cauchy' (TypeError for
+// another type, ValueError for another name).
+OptionField LossOption(const std::string& name, RobustLoss* field);
 // A real number (int or float; inf allowed where `allow_inf`).
 OptionField DoubleOption(const std::string& name, double* field,
                          bool allow_inf = false);

@@ -1185,7 +1185,8 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
   };
   drop_narrow();
   StageResult stage2;
-  for (int round = 0;; ++round) {
+  // Stage 2's least squares over the current inliers, with the covariance.
+  const auto solve_least_squares = [&]() {
     stage2 = SolveStage(constants, tracks, use, options_, /*robust=*/false,
                         options_.max_iterations, /*covariance=*/true,
                         focal_prior_sigma, focal_weight_px, &blocks);
@@ -1194,6 +1195,10 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
                            stage2.summary.message);
     }
     result.iterations += static_cast<int>(stage2.summary.iterations.size());
+    return Status::Ok();
+  };
+  for (int round = 0;; ++round) {
+    RCM_RETURN_IF_ERROR(solve_least_squares());
     if (round == 2 || drop_narrow() == 0) break;
   }
   result.num_inliers = std::count(use.begin(), use.end(), true);
@@ -1241,14 +1246,7 @@ StatusOr<SequenceBundleResult> SequenceBundleAdjustment::Solve(
   if (focal_prior_sigma > 0.0 &&
       std::abs(result.pixel_sigma / focal_weight_px - 1.0) > 0.01) {
     focal_weight_px = result.pixel_sigma;
-    stage2 = SolveStage(constants, tracks, use, options_, /*robust=*/false,
-                        options_.max_iterations, /*covariance=*/true,
-                        focal_prior_sigma, focal_weight_px, &blocks);
-    if (!stage2.summary.IsSolutionUsable()) {
-      return Status::Error("the bundle's least squares failed: " +
-                           stage2.summary.message);
-    }
-    result.iterations += static_cast<int>(stage2.summary.iterations.size());
+    RCM_RETURN_IF_ERROR(solve_least_squares());
     result.pixel_sigma = pixel_sigma();
   }
   if (!options_.refine_n) {
