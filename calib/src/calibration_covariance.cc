@@ -36,14 +36,15 @@ CalibrationCovarianceFile AirCalibrationCovariance(
   // The lenses may change between the air and the water.
   file.drift_focal_sigma =
       1e-2 * CalibrationUncertainty::kDefaultFocalDriftPercent;
-  file.cameras.resize(2);
+  file.cameras.resize(calibration.num_cameras);
   const CameraCalibration* cameras[2] = {&calibration.cam0, &calibration.cam1};
-  for (int c = 0; c < 2; ++c) {
+  for (int c = 0; c < calibration.num_cameras; ++c) {
     const int size = cameras[c]->camera.num_params();
     const double scale = LeaveOutScale(cross_validation, c);
     file.cameras[c].intrinsics_covariance =
         scale * scale * cameras[c]->covariance.topLeftCorner(size, size);
   }
+  if (calibration.num_cameras == 1) return file;
   const double scale = LeaveOutScale(cross_validation, 2);
   file.cameras[1].from_previous_covariance =
       scale * scale * calibration.extrinsics_covariance;

@@ -395,21 +395,23 @@ CalibrationReport SummarizeCalibration(
     const CalibrationReportOptions& options) {
   const Status valid = options.Check();
   CHECK(valid.ok()) << valid.message();
+  const int num_cameras = calibration.num_cameras;
   CheckSize(cam0_size);
-  CheckSize(cam1_size);
+  if (num_cameras == 2) CheckSize(cam1_size);
   CHECK_EQ(calibration.cam0_from_target.size(), views.size())
       << "cam0_from_target has one entry per input view";
   const ImageSize sizes[2] = {cam0_size, cam1_size};
   const CameraCalibration* cameras[2] = {&calibration.cam0, &calibration.cam1};
 
   CalibrationReport report;
+  report.num_cameras = num_cameras;
   const int num_views = static_cast<int>(views.size());
   report.views.resize(views.size());
   std::vector<std::array<double, 2>> view_ssr(views.size(), {0.0, 0.0});
   double ssr[2] = {0.0, 0.0};
   double inlier_ssr[2] = {0.0, 0.0};
   for (const CornerResidual& corner : calibration.corners) {
-    CHECK(corner.camera == 0 || corner.camera == 1) << corner.camera;
+    CHECK(corner.camera >= 0 && corner.camera < num_cameras) << corner.camera;
     CHECK(corner.view >= 0 && corner.view < num_views) << corner.view;
     const int c = corner.camera;
     const double squared = corner.residual.squaredNorm();
@@ -426,7 +428,7 @@ CalibrationReport SummarizeCalibration(
     }
   }
 
-  for (int c = 0; c < 2; ++c) {
+  for (int c = 0; c < num_cameras; ++c) {
     CalibrationReport::CameraStats& stats = report.cameras[c];
     const int inliers = stats.corners - stats.outliers;
     stats.rms_px = stats.corners > 0 ? std::sqrt(ssr[c] / stats.corners) : kNaN;
@@ -484,7 +486,8 @@ CalibrationReport SummarizeCalibration(
                        " or more recommended); add views of the target at " +
                        "other distances, positions and tilts");
   }
-  if (report.num_stereo_views_used < options.min_stereo_views) {
+  if (num_cameras == 2 &&
+      report.num_stereo_views_used < options.min_stereo_views) {
     warnings.push_back(
         "only " + std::to_string(report.num_stereo_views_used) +
         " used views show the target in both cameras (" +
@@ -494,7 +497,7 @@ CalibrationReport SummarizeCalibration(
   }
   const std::string grid = std::to_string(options.coverage_cols) + "x" +
                            std::to_string(options.coverage_rows);
-  for (int c = 0; c < 2; ++c) {
+  for (int c = 0; c < num_cameras; ++c) {
     const CalibrationReport::CameraStats& stats = report.cameras[c];
     if (stats.coverage < options.min_coverage) {
       warnings.push_back(CameraName(c) + ": corners cover " +
@@ -502,7 +505,7 @@ CalibrationReport SummarizeCalibration(
                          " grid); add views near the corners and edges");
     }
   }
-  for (int c = 0; c < 2; ++c) {
+  for (int c = 0; c < num_cameras; ++c) {
     const CalibrationReport::CameraStats& stats = report.cameras[c];
     if (stats.intrinsics_only_uncertainty_p95_px > options.max_uncertainty_px) {
       warnings.push_back(
@@ -518,12 +521,14 @@ CalibrationReport SummarizeCalibration(
   for (const CalibrationReport::View& view : report.views) {
     if (!view.flagged) continue;
     std::string line = "view " + std::to_string(view.view);
-    if (!view.left_name.empty() || !view.right_name.empty()) {
+    if (num_cameras == 1 && !view.left_name.empty()) {
+      line += " (" + view.left_name + ")";
+    } else if (!view.left_name.empty() || !view.right_name.empty()) {
       line += " (" + view.left_name + ", " + view.right_name + ")";
     }
     line += ":";
     bool first = true;
-    for (int c = 0; c < 2; ++c) {
+    for (int c = 0; c < num_cameras; ++c) {
       const CalibrationReport::CameraStats& stats = report.cameras[c];
       if (!(view.rms_px[c] > stats.view_rms_limit_px)) continue;
       const std::string outliers =
@@ -1045,6 +1050,8 @@ cv::Mat DrawMeanFramesUncertainty(const StereoCalibration& calibration,
 
 cv::Mat DrawPerViewRms(const CalibrationReport& report) {
   constexpr double kCameraOffset = 0.15;
+  // One camera: its markers on the view's number.
+  const double offset = report.num_cameras == 2 ? kCameraOffset : 0.0;
   LinePlot plot;
   const int num_views = static_cast<int>(report.views.size());
   int flagged = 0;
@@ -1054,13 +1061,12 @@ cv::Mat DrawPerViewRms(const CalibrationReport& report) {
   double top = 0.0;
   for (const CalibrationReport::View& view : report.views) {
     x.push_back(view.view);
-    for (int c = 0; c < 2; ++c) {
+    for (int c = 0; c < report.num_cameras; ++c) {
       const double value = view.used ? view.rms_px[c] : kNaN;
       rms[c].push_back(value);
       if (Finite(value)) top = std::max(top, value);
       if (view.flagged && value > report.cameras[c].view_rms_limit_px) {
-        flagged_x.push_back(view.view +
-                            (c == 0 ? -kCameraOffset : kCameraOffset));
+        flagged_x.push_back(view.view + (c == 0 ? -offset : offset));
         flagged_y.push_back(value);
       }
     }
@@ -1070,7 +1076,7 @@ cv::Mat DrawPerViewRms(const CalibrationReport& report) {
       unused_y.push_back(0.0);
     }
   }
-  for (int c = 0; c < 2; ++c) {
+  for (int c = 0; c < report.num_cameras; ++c) {
     const double limit = report.cameras[c].view_rms_limit_px;
     if (Finite(limit)) top = std::max(top, limit);
   }
@@ -1085,7 +1091,7 @@ cv::Mat DrawPerViewRms(const CalibrationReport& report) {
   plot.SetXRange(-0.5 - 0.02 * span, span - 0.5 + 0.02 * span);
   plot.SetYRange(0.0, top > 0.0 ? 1.12 * top : 1.0);
   plot.SetLegendPosition(LegendPosition::kBelow);
-  for (int c = 0; c < 2; ++c) {
+  for (int c = 0; c < report.num_cameras; ++c) {
     MarkerStyle style;
     style.color = PaletteColor(c);
     style.shape = c == 0 ? MarkerShape::kCircle : MarkerShape::kSquare;
@@ -1094,13 +1100,12 @@ cv::Mat DrawPerViewRms(const CalibrationReport& report) {
       // cam0 a little left of the view's number, cam1 right, so that equal
       // values do not hide each other.
       std::vector<double> shifted = x;
-      for (double& value : shifted)
-        value += c == 0 ? -kCameraOffset : kCameraOffset;
+      for (double& value : shifted) value += c == 0 ? -offset : offset;
       plot.AddMarkers(shifted, rms[c], c == 0 ? "cam0 (left)" : "cam1 (right)",
                       style);
     }
   }
-  for (int c = 0; c < 2; ++c) {
+  for (int c = 0; c < report.num_cameras; ++c) {
     const CalibrationReport::CameraStats& stats = report.cameras[c];
     LineStyle overall;
     overall.color = PaletteColor(c);
@@ -1200,7 +1205,7 @@ Status WriteCalibrationReport(const std::string& directory,
     }
     return WritePng(image, path);
   };
-  for (int c = 0; c < 2; ++c) {
+  for (int c = 0; c < calibration.num_cameras; ++c) {
     const std::string suffix = "_cam" + std::to_string(c) + ".png";
     RCM_RETURN_IF_ERROR(write_png("residuals" + suffix, [&] {
       return DrawResidualField(calibration, c, sizes[c], 0.0,

@@ -7,6 +7,8 @@
 #include <thread>
 #include <utility>
 
+#include "air_calibration.h"
+
 namespace rcm::calib {
 namespace {
 
@@ -19,13 +21,13 @@ struct Quantity {
 };
 
 // The quantities of a calibration, in ParameterSpread order: the board's
-// bowl last when the warp is estimated.
+// bowl last when the warp is estimated; one camera: cam0's and the bowl.
 std::vector<Quantity> Quantities(const StereoCalibration& c) {
   static const char* const kNames[2][4] = {
       {"cam0 fx", "cam0 fy", "cam0 cx", "cam0 cy"},
       {"cam1 fx", "cam1 fy", "cam1 cx", "cam1 cy"}};
   std::vector<Quantity> quantities;
-  for (int camera = 0; camera < 2; ++camera) {
+  for (int camera = 0; camera < c.num_cameras; ++camera) {
     const CameraCalibration& cc = camera == 0 ? c.cam0 : c.cam1;
     const double values[4] = {cc.camera.fx(), cc.camera.fy(), cc.camera.cx(),
                               cc.camera.cy()};
@@ -33,7 +35,9 @@ std::vector<Quantity> Quantities(const StereoCalibration& c) {
       quantities.push_back({kNames[camera][i], "px", values[i], cc.sigma[i]});
     }
   }
-  quantities.push_back({"baseline", "m", c.baseline, c.baseline_sigma});
+  if (c.num_cameras == 2) {
+    quantities.push_back({"baseline", "m", c.baseline, c.baseline_sigma});
+  }
   if (c.board_warp_estimated) {
     quantities.push_back(
         {"board bowl", "m", c.BoardBowl(), c.BoardBowlSigma()});
@@ -69,6 +73,9 @@ StatusOr<CrossValidation> CrossValidateStereo(
   StereoCalibrationOptions fold_options = calibration_options;
   fold_options.compute_covariance = false;
   fold_options.num_threads = 1;
+  // The cameras of the full calibration: one, or the pair.
+  std::vector<ImageSize> sizes = {cam0_size, cam1_size};
+  sizes.resize(full.num_cameras);
   std::vector<std::optional<std::vector<Quantity>>> fold_estimates(groups);
   std::mutex mutex;
   int next = 0;
@@ -86,7 +93,7 @@ StatusOr<CrossValidation> CrossValidateStereo(
         if (v % groups != k) subset.push_back(views[v]);
       }
       const StatusOr<StereoCalibration> calibration =
-          CalibrateStereo(target, subset, cam0_size, cam1_size, fold_options);
+          internal::CalibrateInAir(target, subset, sizes, fold_options);
       const std::lock_guard<std::mutex> lock(mutex);
       if (calibration.ok()) fold_estimates[k] = Quantities(*calibration);
       ++done;

@@ -44,7 +44,7 @@ bool ProjectFromReference(LensModelId model, const T* lens,
 }
 
 const Camera& CameraOf(const StereoCalibration& calibration, int camera) {
-  CHECK(camera == 0 || camera == 1) << camera;
+  CHECK(camera >= 0 && camera < calibration.num_cameras) << camera;
   return camera == 0 ? calibration.cam0.camera : calibration.cam1.camera;
 }
 

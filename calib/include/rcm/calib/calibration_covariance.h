@@ -31,7 +31,8 @@ namespace rcm::calib {
 
 // The sidecar of an air calibration: medium "air", the default drift
 // prior (CalibrationUncertainty::kDefaultDriftDegrees, ...Millimeters),
-// the lens and extrinsics covariances scaled as above.
+// the lens and extrinsics covariances scaled as above (one camera,
+// CalibrateMono's: cam0's lens block only).
 CalibrationCovarianceFile AirCalibrationCovariance(
     const StereoCalibration& calibration,
     const std::optional<CrossValidation>& cross_validation);

@@ -140,6 +140,10 @@ struct CalibrationReport {
   };
 
   std::vector<View> views;  // one per input view
+  // 1 for a one-camera calibration (StereoCalibration::num_cameras): then
+  // cameras[1] is unset and each view's second entries are 0 corners and a
+  // NaN RMS.
+  int num_cameras = 2;
   CameraStats cameras[2];
   int num_views_used = 0;
   int num_stereo_views_used = 0;  // used, with corners in both cameras
@@ -151,7 +155,8 @@ struct CalibrationReport {
 // The numbers and warnings of a calibration. `views` are the views the
 // calibration was made from (calibration.cam0_from_target has one entry
 // per view; CHECKed, as are corner view indices in range, positive image
-// sizes and options.Check()). Deterministic; no I/O.
+// sizes and options.Check()). One camera: cam1_size is not used, and no
+// warning counts stereo views. Deterministic; no I/O.
 CalibrationReport SummarizeCalibration(
     const StereoCalibration& calibration, const std::vector<StereoView>& views,
     const ImageSize& cam0_size, const ImageSize& cam1_size,
@@ -228,6 +233,7 @@ cv::Mat DrawPerViewRms(const CalibrationReport& report);
 //   intrinsics_only_uncertainty_cam0.png, ..._cam1.png
 //                                             DrawProjectionUncertainty
 //   per_view_rms.png                          DrawPerViewRms
+//   (one camera: the cam0 files only; cam1_size is not used)
 //   per_view.csv  view,left,right,corners0,corners1,outliers0,outliers1,
 //                 rms0_px,rms1_px,used,flagged
 //                 (one row per view; names quoted when they hold a comma or

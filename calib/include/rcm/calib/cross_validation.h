@@ -50,11 +50,13 @@ struct CrossValidation {
   // bowl (StereoCalibration::BoardBowl) when the full calibration
   // estimated the warp: a bow that differs from view to view (a hand-held
   // board) shows as a leave-out spread well above its covariance sigma.
+  // One camera: cam0's four and the bowl.
   std::vector<ParameterSpread> parameters;
 };
 
 // Runs the folds with the options of the full calibration `full`
-// (CalibrateStereo of the same inputs), calibration_options.num_threads
+// (CalibrateStereo of the same inputs, or CalibrateMono's: then each fold
+// is one too and cam1_size is not used), calibration_options.num_threads
 // folds at a time, each solved on one thread. `progress`, when set, is
 // called after each fold with (done, total), from one thread at a time. Fails when fewer than 2 folds
 // succeed (e.g. 3 views split 3 ways leave too few per camera).

@@ -49,7 +49,7 @@ inline constexpr double kInfiniteDistance =
     std::numeric_limits<double>::infinity();
 
 // The points the mean-frames method holds fixed for pixel q0 of `camera`
-// (0 or 1) at `distance` [m] (> 0, or kInfiniteDistance): p_i per used
+// (0 or 1; 0 of one camera) at `distance` [m] (> 0, or kInfiniteDistance): p_i per used
 // view, homogeneous (w = 0 at infinity), in the layout of the views of
 // calibration.full_covariance.pose_offset.
 struct MeanFramesPoint {

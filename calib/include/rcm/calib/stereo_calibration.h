@@ -39,6 +39,10 @@
 // (dense: ~40 poses of 6), is kept too (StereoCalibration::
 // full_covariance) for the projection uncertainty through the board poses
 // (projection_uncertainty.h).
+//
+// One camera (CalibrateMono, mono_calibration.h) is this problem without
+// cam1 and the extrinsics; its result is a StereoCalibration with
+// num_cameras 1.
 #ifndef RCM_CALIB_STEREO_CALIBRATION_H_
 #define RCM_CALIB_STEREO_CALIBRATION_H_
 
@@ -119,7 +123,8 @@ struct CameraCalibration {
 // sigma^2 (J^T J)^-1, in the raw parameters Ceres estimates: the lenses
 // ([fx, fy, cx, cy, d...], num_params each), cam1_from_cam0 and each used
 // view's cam0_from_target as [angle-axis (rad), translation (m)], and the
-// warp [m] when estimated. Empty when the covariance was not computed.
+// warp [m] when estimated. Empty when the covariance was not computed. One
+// camera: lens_offset[1] and extrinsics_offset are -1 (no such block).
 struct FullCovariance {
   Eigen::MatrixXd matrix;
   std::array<int, 2> lens_offset{};
@@ -145,6 +150,11 @@ struct StereoCalibration {
   StereoCalibration(const Camera& cam0, const Camera& cam1)
       : cam0(cam0), cam1(cam1) {}
 
+  // 2 for a pair (CalibrateStereo); 1 for one camera (CalibrateMono): then
+  // cam1 is a copy of cam0, cam1_from_cam0 the identity, the baseline and
+  // the extrinsics' covariance zero and num_stereo_views 0, none of them a
+  // measurement, and every corner is cam0's.
+  int num_cameras = 2;
   CameraCalibration cam0;
   CameraCalibration cam1;
   Rigid3d cam1_from_cam0;
