@@ -1,4 +1,5 @@
-// rcm calibrate: air stereo calibration from images of a target.
+// rcm calibrate: air calibration of a stereo rig, or of one camera (--left
+// alone), from images of a target.
 #include <gflags/gflags.h>
 #include <unistd.h>
 
@@ -30,6 +31,7 @@
 #include "rcm/calib/calibration_report.h"
 #include "rcm/calib/calibration_target.h"
 #include "rcm/calib/cross_validation.h"
+#include "rcm/calib/mono_calibration.h"
 #include "rcm/calib/projection_uncertainty.h"
 #include "rcm/calib/stereo_calibration.h"
 #include "rcm/calib/target_detector.h"
@@ -70,13 +72,16 @@ using calib::StereoCalibration;
 using calib::StereoView;
 
 constexpr char kCalibrateUsage[] =
-    "rcm calibrate: calibrate a stereo rig in air from images of a target,\n"
-    "or refine it under water\n\n"
+    "rcm calibrate: calibrate a stereo rig (or one camera) in air from images\n"
+    "of a target, or refine it under water\n\n"
     "usage:\n"
     "  rcm calibrate --left DIR --right DIR --board chessboard --cols 9 "
     "--rows 6\n"
     "      --square 0.025 [--model radtan|equidistant|rational|ds|eucm]\n"
     "      --out camchain.yaml\n"
+    "  rcm calibrate --left DIR --board chessboard --cols 9 --rows 6 "
+    "--square 0.025\n"
+    "      --out camera.yaml                      (one camera)\n"
     "  rcm calibrate --bag FILE.bag --left-topic T0 --right-topic T1 "
     "--target april.yaml\n"
     "      --model equidistant --out camchain.yaml\n\n"
@@ -89,6 +94,9 @@ constexpr char kCalibrateUsage[] =
     "uncertainty over each image (mrcal's mean-frames method, through the\n"
     "board poses, at --uncertainty-distance, default infinity; and the\n"
     "intrinsics-only figure), per-view RMS, calibration.json.\n"
+    "--left alone (or --corners with --left only) calibrates one camera the\n"
+    "same way, without the extrinsics, and writes a camchain with cam0 only\n"
+    "(the stereo subcommands refuse it: they need a pair).\n"
     "--out names the camchain file (.yaml) or a folder that gets\n"
     "camchain.yaml and report/; camchain-covariance.yaml beside the camchain\n"
     "tells rcm estimate how well it is known.\n\n"
@@ -131,13 +139,33 @@ nlohmann::json CameraJson(const calib::CameraCalibration& calibration) {
   return json;
 }
 
+// cam1_from_cam0 of a pair: its matrix, baseline and sigmas.
+nlohmann::json ExtrinsicsJson(const StereoCalibration& calibration) {
+  nlohmann::json json = {{"matrix", {}},
+                         {"baseline", calibration.baseline},
+                         {"baseline_sigma", calibration.baseline_sigma}};
+  const Eigen::Matrix4d matrix = calibration.cam1_from_cam0.ToMatrix();
+  for (int r = 0; r < 4; ++r) {
+    json["matrix"].push_back(
+        {matrix(r, 0), matrix(r, 1), matrix(r, 2), matrix(r, 3)});
+  }
+  std::vector<double> sigma6;
+  for (int i = 0; i < 6; ++i) {
+    sigma6.push_back(std::sqrt(calibration.extrinsics_covariance(i, i)));
+  }
+  json["sigma_rotation_rad"] = {sigma6[0], sigma6[1], sigma6[2]};
+  json["sigma_translation_m"] = {sigma6[3], sigma6[4], sigma6[5]};
+  return json;
+}
+
 int RunCalibrate();
 
 }  // namespace
 
 extern const Subcommand kCalibrateCommand = {
     "calibrate",
-    "air stereo calibration from target images (folders or a ROS1 bag)",
+    "air calibration of a stereo rig or one camera from target images "
+    "(folders or a ROS1 bag)",
     kCalibrateUsage,
     {__FILE__, kImageInputFlagsSource, kCalibrationInputFlagsSource,
      kTargetFlagsSource, kLensModelFlagSource, kUnderwaterFlagsSource,
@@ -158,8 +186,9 @@ int RunCalibrate() {
   }
   if (!ImageInputGiven()) {
     PrintError(command,
-               "no images: give --left DIR --right DIR, --pairs FILE or --bag "
-               "FILE with --left-topic/--right-topic");
+               "no images: give --left DIR --right DIR (--left DIR alone: one "
+               "camera), --pairs FILE or --bag FILE with "
+               "--left-topic/--right-topic");
     return kExitUsage;
   }
   const StatusOr<LensModelId> model = LensModelFromFlag(LensModelId::kRadTan);
@@ -241,7 +270,7 @@ int RunCalibrate() {
   // What is being calibrated, with the report on stdout; stderr keeps to
   // warnings and the error.
   StatusOr<CalibrationInput> input = ReadCalibrationInput(
-      *target, /*allow_left_only=*/false, paths,
+      *target, /*allow_left_only=*/true, paths,
       [&target](const std::string& description) {
         if (!FLAGS_json) {
           std::cout << "rcm calibrate: " << description << "; target "
@@ -254,14 +283,21 @@ int RunCalibrate() {
   }
   const Detections* detections = &input->detections;
   const std::vector<StereoView>& views = detections->views;
-  if (const Status status = CheckDetections(*detections, false); !status.ok()) {
+  // --left alone (folders or a corners file): one camera.
+  const bool one_camera = FLAGS_right.empty() && FLAGS_pairs.empty() &&
+                          FLAGS_bag.empty() && !detections->sizes[1];
+  const int num_cameras = one_camera ? 1 : 2;
+  if (const Status status = CheckDetections(*detections, one_camera);
+      !status.ok()) {
     PrintError(command, status.message());
     return kExitFailure;
   }
   const int stereo = detections->stereo;
   const int left_only = detections->left_only;
   const int right_only = detections->right_only;
-  const ImageSize sizes[2] = {*detections->sizes[0], *detections->sizes[1]};
+  // One camera: its size stands for cam1's, which the library ignores.
+  const ImageSize sizes[2] = {*detections->sizes[0],
+                              *detections->sizes[one_camera ? 0 : 1]};
   for (const std::string& warning : detections->warnings) {
     PrintWarning(command, warning);
   }
@@ -269,7 +305,9 @@ int RunCalibrate() {
   Progress solving("rcm calibrate: bundle adjustment", 2);
   solving.Update(1);
   const StatusOr<StereoCalibration> calibration =
-      calib::CalibrateStereo(*target, views, sizes[0], sizes[1], options);
+      one_camera
+          ? calib::CalibrateMono(*target, views, sizes[0], options)
+          : calib::CalibrateStereo(*target, views, sizes[0], sizes[1], options);
   solving.Update(2);
   if (!calibration.ok()) {
     PrintError(command, calibration.status().message());
@@ -326,7 +364,11 @@ int RunCalibrate() {
   // The rig file is the product: written last, after the report, so that a
   // camchain on disk always comes with its report.
   Camchain camchain;
-  {
+  if (one_camera) {
+    camchain.cameras.push_back(
+        CamchainCamera{calibration->cam0.camera, std::nullopt, std::nullopt,
+                       std::nullopt, std::vector<int>(), std::string()});
+  } else {
     StatusOr<StereoRig> rig =
         StereoRig::Create(calibration->cam0.camera, calibration->cam1.camera,
                           calibration->cam1_from_cam0);
@@ -347,11 +389,14 @@ int RunCalibrate() {
   json["report"] = paths.report;
   json["target"] = calib::DescribeTarget(*target);
   json["source"] = input->description;
+  json["cameras"] = num_cameras;
   json["pairs"] = views.size() + detections->unreadable;
   json["unreadable_pairs"] = detections->unreadable;
-  json["stereo_views"] = stereo;
-  json["left_only_views"] = left_only;
-  json["right_only_views"] = right_only;
+  if (!one_camera) {
+    json["stereo_views"] = stereo;
+    json["left_only_views"] = left_only;
+    json["right_only_views"] = right_only;
+  }
   json["views_used"] = calibration->num_views_used;
   json["corners"] = calibration->num_inliers + calibration->num_outliers;
   json["outliers"] = calibration->num_outliers;
@@ -360,27 +405,14 @@ int RunCalibrate() {
   json["pixel_sigma"] = calibration->pixel_sigma;
   json["initial_rms_px"] = calibration->initial_rms_px;
   json["cam0"] = CameraJson(calibration->cam0);
-  json["cam1"] = CameraJson(calibration->cam1);
-  json["cam1_from_cam0"] = {{"matrix", {}},
-                            {"baseline", calibration->baseline},
-                            {"baseline_sigma", calibration->baseline_sigma}};
-  const Eigen::Matrix4d matrix = calibration->cam1_from_cam0.ToMatrix();
-  for (int r = 0; r < 4; ++r) {
-    json["cam1_from_cam0"]["matrix"].push_back(
-        {matrix(r, 0), matrix(r, 1), matrix(r, 2), matrix(r, 3)});
+  if (!one_camera) {
+    json["cam1"] = CameraJson(calibration->cam1);
+    json["cam1_from_cam0"] = ExtrinsicsJson(*calibration);
   }
-  std::vector<double> sigma6;
-  for (int i = 0; i < 6; ++i) {
-    sigma6.push_back(std::sqrt(calibration->extrinsics_covariance(i, i)));
-  }
-  json["cam1_from_cam0"]["sigma_rotation_rad"] = {sigma6[0], sigma6[1],
-                                                  sigma6[2]};
-  json["cam1_from_cam0"]["sigma_translation_m"] = {sigma6[3], sigma6[4],
-                                                   sigma6[5]};
   json["board_flatness"] = BoardFlatnessJson(
       calibration->board_warp_estimated, calibration->board_warp,
       calibration->board_warp_covariance, jackknife("board bowl"));
-  for (int c = 0; c < 2; ++c) {
+  for (int c = 0; c < num_cameras; ++c) {
     const calib::CalibrationReport::CameraStats& s = report.cameras[c];
     json["coverage"]["cam" + std::to_string(c)] = s.coverage;
     // mrcal's mean-frames figure at the stated distance, and the
@@ -441,8 +473,11 @@ int RunCalibrate() {
     std::cout << json.dump(2) << std::endl;
     return kExitOk;
   }
-  std::printf("%d views used (%d stereo), %d corners, %d outliers\n",
-              calibration->num_views_used, calibration->num_stereo_views,
+  const std::string kind =
+      one_camera ? "one camera"
+                 : std::to_string(calibration->num_stereo_views) + " stereo";
+  std::printf("%d views used (%s), %d corners, %d outliers\n",
+              calibration->num_views_used, kind.c_str(),
               calibration->num_inliers + calibration->num_outliers,
               calibration->num_outliers);
   std::printf("rms %.4f px (inliers %.4f px), pixel noise %.4f px per axis\n",
@@ -450,7 +485,7 @@ int RunCalibrate() {
               calibration->pixel_sigma);
   std::printf("+- covariance sigma%s\n",
               cross_validation ? " (leave-out sigma)" : "");
-  for (int c = 0; c < 2; ++c) {
+  for (int c = 0; c < num_cameras; ++c) {
     const calib::CameraCalibration& cc =
         c == 0 ? calibration->cam0 : calibration->cam1;
     const std::string cam = "cam" + std::to_string(c);
@@ -475,16 +510,18 @@ int RunCalibrate() {
       std::printf("     distortion [%s]\n", distortion.c_str());
     }
   }
-  std::printf(
-      "baseline %s mm, rotation %.4f deg\n",
-      WithSigma(1e3 * calibration->baseline, 1e3 * calibration->baseline_sigma,
-                3,
-                jackknife("baseline")
-                    ? std::optional<double>(1e3 * *jackknife("baseline"))
-                    : std::nullopt)
-          .c_str(),
-      calibration->cam1_from_cam0.RotationAngle() * 180.0 / M_PI);
-  for (int c = 0; c < 2; ++c) {
+  if (!one_camera) {
+    std::printf(
+        "baseline %s mm, rotation %.4f deg\n",
+        WithSigma(1e3 * calibration->baseline,
+                  1e3 * calibration->baseline_sigma, 3,
+                  jackknife("baseline")
+                      ? std::optional<double>(1e3 * *jackknife("baseline"))
+                      : std::nullopt)
+            .c_str(),
+        calibration->cam1_from_cam0.RotationAngle() * 180.0 / M_PI);
+  }
+  for (int c = 0; c < num_cameras; ++c) {
     const calib::CalibrationReport::CameraStats& s = report.cameras[c];
     std::printf(
         "cam%d projection uncertainty at %s: median %.3f, 95 %% %.3f px "

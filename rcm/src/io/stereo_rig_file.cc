@@ -50,6 +50,12 @@ StatusOr<StereoRig> ReadCamchainRig(const std::string& path,
                                     const RigFileOptions& options) {
   const StatusOr<Camchain> camchain = ParseCamchain(text, path);
   if (!camchain.ok()) return camchain.status();
+  if (camchain->cameras.size() == 1) {
+    // A one-camera calibration (rcm calibrate --left alone).
+    return Status::Error(path +
+                         " has one camera (cam0); a stereo rig needs two: "
+                         "calibrate the pair with --left and --right");
+  }
   int indices[2];
   const std::string* names[2] = {&left, &right};
   for (int i = 0; i < 2; ++i) {

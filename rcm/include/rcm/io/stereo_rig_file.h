@@ -3,7 +3,9 @@
 //
 //   rig.yaml                 a Kalibr camchain (camchain.h); `left` and
 //                            `right` name two of its cameras ("cam0",
-//                            "cam1", ...), cam0/cam1 by default;
+//                            "cam1", ...), cam0/cam1 by default; a
+//                            camchain of one camera (rcm calibrate
+//                            --left alone) is an error that says so;
 //   left.yaml,right.yaml     the ROS camera_info files of the left and the
 //                            right camera (camera_info.h), in that order;
 //                            `left` and `right` must keep their defaults.
