@@ -147,6 +147,11 @@ release_only=(
   # [EstimateImagesCli.EveryEstimatorRunsOnImages, SequenceEstimator.Bundle*]:
   # rcm estimate --estimator bundle --out on renders, end to end
   'EstimateImagesCli.BundleWritesTheTrajectory'
+  # [MonoCalibration.*, CalibrateMonoCli.CornersFileOfOneCamera...]: one
+  # camera's Monte Carlo, and against cv::calibrateCamera on real images
+  'MonoCalibration.MonteCarloSigmaIsHonest'
+  'MonoCalibrationOpenCvSample.LeftImagesEqualCalibrateCamera'
+  'CalibrateMonoCli.OpenCvSampleLeftImagesEqualCalibrateCamera'
 )
 
 budgeted=(

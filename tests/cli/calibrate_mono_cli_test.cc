@@ -8,16 +8,19 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <random>
 #include <string>
 #include <vector>
 
 #include "calib/opencv_calibrate_camera.h"
+#include "calib/synthetic_target_views.h"
 #include "cli/cli_runner.h"
 #include "rcm/calib/calibration_target.h"
 #include "rcm/calib/corners_file.h"
 #include "rcm/io/calibration_covariance_file.h"
 #include "rcm/io/camchain.h"
 #include "support/temp_file.h"
+#include "support/test_rigs.h"
 
 namespace rcm::calibrate_mono_cli_test {
 namespace {
@@ -159,6 +162,52 @@ TEST(CalibrateMonoCli, OpenCvSampleLeftImagesEqualCalibrateCamera) {
     EXPECT_NEAR(again.cameras[0].camera.params()[i], camera.params()[i],
                 1e-9 * std::max(1.0, std::abs(camera.params()[i])));
   }
+}
+
+// The one-camera path end to end without images (cheap enough for the
+// sanitizers): a corners file of synthetic views of one camera, --left
+// naming its rows, the leave-out folds on.
+TEST(CalibrateMonoCli, CornersFileOfOneCameraGivesCamchainSidecarAndReport) {
+  const Camera truth = rcm::test::EurocRadtanCamera();
+  const calib::CalibrationTarget board =
+      calib::MakeCheckerboardTarget(9, 6, 0.04).value();
+  const std::vector<Eigen::Vector3d> points = calib::TargetPoints(board);
+  std::mt19937 rng(3);
+  std::vector<calib::CornersFileImage> images;
+  for (const Rigid3d& pose : calib::test::BoardPoses(truth, board, 8, 7)) {
+    images.push_back(
+        {"cam/" + std::to_string(images.size()) + ".png",
+         calib::test::ObserveTargetWith(truth, calib::test::InAir(truth), pose,
+                                        points, 0.1, &rng)});
+  }
+  const std::string out = test::TempFilePath("out");
+  fs::remove_all(out);
+  fs::create_directories(out);
+  ASSERT_TRUE(calib::WriteCornersFile(out + "/corners.vnl", images,
+                                      calib::NumTargetPoints(board))
+                  .ok());
+  const RunResult result =
+      Rcm({"calibrate", "--corners", out + "/corners.vnl", "--left", "cam/*",
+           "--image-size", "752,480", "--board", "chessboard", "--cols", "9",
+           "--rows", "6", "--square", "0.04", "--folds", "2", "--out",
+           out + "/one.yaml"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("8 views used (one camera)"), std::string::npos)
+      << result.out;
+  EXPECT_NE(result.out.find("board flatness: bowl "), std::string::npos)
+      << result.out;
+  const Camchain camchain = ReadCamchain(out + "/one.yaml").value();
+  ASSERT_EQ(camchain.cameras.size(), 1u);
+  // 0.1 px of noise on 8 views: the focal lengths within 1 %.
+  EXPECT_NEAR(camchain.cameras[0].camera.fx() / truth.fx(), 1.0, 1e-2);
+  EXPECT_EQ(
+      ReadCalibrationCovariance(out + "/one-covariance.yaml")->cameras.size(),
+      1u);
+  const nlohmann::json json = nlohmann::json::parse(
+      test::ReadWholeFile(out + "/one-report/calibration.json"));
+  EXPECT_EQ(json["cameras"], 1);
+  EXPECT_EQ(json["cross_validation"]["folds"], 2);
+  EXPECT_TRUE(fs::exists(out + "/one-report/per_view_rms.png"));
 }
 
 TEST(CalibrateMonoCli, BadInputIsOneLine) {
