@@ -172,6 +172,16 @@ void ExpectCamchainsBitwiseEqual(const Camchain& a, const Camchain& b) {
         EXPECT_TRUE(BitwiseEqual(ca.port->normal[k], cb.port->normal[k]));
       }
     }
+    ASSERT_EQ(ca.dome.has_value(), cb.dome.has_value());
+    if (ca.dome.has_value()) {
+      EXPECT_TRUE(BitwiseEqual(ca.dome->inner_radius, cb.dome->inner_radius));
+      EXPECT_TRUE(BitwiseEqual(ca.dome->thickness, cb.dome->thickness));
+      EXPECT_TRUE(BitwiseEqual(ca.dome->glass_index, cb.dome->glass_index));
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_TRUE(
+            BitwiseEqual(ca.dome->decentering[k], cb.dome->decentering[k]));
+      }
+    }
   }
 }
 
@@ -568,6 +578,79 @@ TEST(Camchain, RejectsBadPortBlocks) {
   EXPECT_THAT(
       with_port("{air_gap: 0.01, glass_thickness: 0.0, glass_index: 3}"),
       HasSubstr("glass_index = 3 is outside [1, 2]"));
+}
+
+TEST(Camchain, DomePortBlockRoundTrips) {
+  Camchain camchain;
+  camchain.cameras.push_back(
+      MakeEntry(MakeCamera(LensModelId::kPinhole, 400.0, {}), std::nullopt));
+  DomePort dome;
+  dome.inner_radius = 0.04355;
+  dome.thickness = 0.00375;
+  dome.glass_index = 1.495;
+  dome.decentering = Eigen::Vector3d(0.0001, -0.00005, 0.0072);
+  camchain.cameras[0].dome = dome;
+  const std::string text = FormatCamchain(camchain);
+  EXPECT_NE(text.find("  port:\n"
+                      "    decentering: [0.0001, -5.0e-05, 0.0072]\n"
+                      "    glass_index: 1.495\n"
+                      "    inner_radius: 0.04355\n"
+                      "    thickness: 0.00375\n"
+                      "    type: dome\n"),
+            std::string::npos)
+      << text;
+  const StatusOr<Camchain> parsed = ParseCamchain(text, "rig.yaml");
+  ASSERT_TRUE(parsed.ok()) << parsed.status().message();
+  ExpectCamchainsBitwiseEqual(*parsed, camchain);
+  EXPECT_FALSE(parsed->cameras[0].port.has_value());
+}
+
+TEST(Camchain, DomeGivenByItsRadii) {
+  const std::string text = ReplaceOnce(
+      kMinimal, "  resolution: [720, 540]\ncam1:\n",
+      "  resolution: [720, 540]\n  port: {type: dome, inner_radius: 0.04355, "
+      "outer_radius: 0.0473}\ncam1:\n");
+  const StatusOr<Camchain> parsed = ParseCamchain(text, "rig.yaml");
+  ASSERT_TRUE(parsed.ok()) << parsed.status().message();
+  ASSERT_TRUE(parsed->cameras[0].dome.has_value());
+  EXPECT_NEAR(parsed->cameras[0].dome->thickness, 0.00375, 1e-15);
+  EXPECT_EQ(parsed->cameras[0].dome->glass_index, 1.49);
+  EXPECT_TRUE(parsed->cameras[0].dome->IsCentred());
+}
+
+TEST(Camchain, RejectsBadDomeBlocks) {
+  const auto with_port = [](const std::string& port) {
+    return ParseError(
+        ReplaceOnce(kMinimal, "  resolution: [720, 540]\ncam1:\n",
+                    "  resolution: [720, 540]\n  port: " + port + "\ncam1:\n"));
+  };
+  EXPECT_THAT(with_port("{type: globe, inner_radius: 0.05}"),
+              HasSubstr("cam0.port.type: unknown port type 'globe'"));
+  EXPECT_THAT(with_port("{type: dome, thickness: 0.005}"),
+              HasSubstr("cam0.port: missing key 'inner_radius'"));
+  EXPECT_THAT(with_port("{type: dome, inner_radius: 0.05}"),
+              HasSubstr("cam0.port: missing key 'thickness'"));
+  EXPECT_THAT(with_port("{type: dome, inner_radius: 0.05, thickness: 0.005, "
+                        "air_gap: 0.01}"),
+              HasSubstr("cam0.port.air_gap: unknown key (a dome port has"));
+  EXPECT_THAT(
+      with_port("{type: dome, inner_radius: 0.04355, outer_radius: 0.0473, "
+                "thickness: 0.005}"),
+      HasSubstr("not the 0.005 m given"));
+  EXPECT_THAT(with_port("{type: dome, inner_radius: 0.04355, thickness: "
+                        "0.00375, decentering: [0, 0, 0.05]}"),
+              HasSubstr("outside the inner sphere"));
+  EXPECT_THAT(with_port("{type: dome, inner_radius: 43.55, thickness: 3.75}"),
+              HasSubstr("millimetres given as metres"));
+}
+
+TEST(Camchain, DomeCameraIsRefusedByTheStereoRig) {
+  Camchain camchain = CamchainFromStereoRig(test::AlphasenseRealisticRig());
+  camchain.cameras[1].dome = DomePort();
+  const StatusOr<StereoRig> rig = StereoRigFromCamchain(camchain, 0, 1);
+  ASSERT_FALSE(rig.ok());
+  EXPECT_THAT(rig.status().message(),
+              HasSubstr("cam1 looks through a dome port"));
 }
 
 TEST(Camchain, NoneModelMayOmitCoefficients) {

@@ -42,39 +42,103 @@ const YAML::Node* Find(const YamlEntries& entries, std::string_view key) {
   return entry == nullptr ? nullptr : &entry->value;
 }
 
+// A number of a port block: `required` or left as it is when absent.
+Status ReadPortNumber(const YamlReader& reader, const YamlEntries& entries,
+                      const std::string& field, const char* key, bool required,
+                      double* value) {
+  const YAML::Node* item = Find(entries, key);
+  if (item == nullptr) {
+    return required ? reader.MissingKey(field, key) : Status::Ok();
+  }
+  const StatusOr<double> read = reader.Number(*item, field + "." + key);
+  if (!read.ok()) return read.status();
+  *value = *read;
+  return Status::Ok();
+}
+
+// The keys a port block of `type` may have; the first unknown one is an
+// error (a misspelt key would silently give a default).
+Status CheckPortKeys(const YamlReader& reader, const YamlEntries& entries,
+                     const std::string& field,
+                     const std::vector<std::string_view>& keys,
+                     const char* listing) {
+  for (const auto& [key, entry] : entries) {
+    if (std::find(keys.begin(), keys.end(), key) == keys.end()) {
+      return reader.Error(entry.key, field + "." + key,
+                          std::string("unknown key (") + listing + ")");
+    }
+  }
+  return Status::Ok();
+}
+
+// The `port` block of type dome (dome_port_geometry.h): inner_radius and
+// thickness (or outer_radius, or both when they agree) required,
+// glass_index and decentering optional (1.49, the centred dome).
+StatusOr<DomePort> ReadDomePort(const YamlReader& reader,
+                                const YAML::Node& node,
+                                const YamlEntries& entries,
+                                const std::string& field) {
+  RCM_RETURN_IF_ERROR(CheckPortKeys(
+      reader, entries, field,
+      {"type", "inner_radius", "outer_radius", "thickness", "glass_index",
+       "decentering"},
+      "a dome port has type, inner_radius, thickness or outer_radius, "
+      "glass_index, decentering"));
+  DomePort dome;
+  RCM_RETURN_IF_ERROR(ReadPortNumber(reader, entries, field, "inner_radius",
+                                     true, &dome.inner_radius));
+  double thickness = -1.0;
+  double outer_radius = -1.0;
+  RCM_RETURN_IF_ERROR(
+      ReadPortNumber(reader, entries, field, "thickness", false, &thickness));
+  RCM_RETURN_IF_ERROR(ReadPortNumber(reader, entries, field, "outer_radius",
+                                     false, &outer_radius));
+  if (Find(entries, "outer_radius") != nullptr) {
+    const StatusOr<double> from_radii =
+        DomeThicknessFromRadii(dome.inner_radius, outer_radius, thickness);
+    if (!from_radii.ok()) {
+      return reader.Error(node, field, from_radii.status().message());
+    }
+    // Written with the thickness, the thickness keeps its bits.
+    dome.thickness = thickness >= 0.0 ? thickness : *from_radii;
+  } else if (Find(entries, "thickness") != nullptr) {
+    dome.thickness = thickness;
+  } else {
+    return reader.MissingKey(field, "thickness");
+  }
+  RCM_RETURN_IF_ERROR(ReadPortNumber(reader, entries, field, "glass_index",
+                                     false, &dome.glass_index));
+  if (const YAML::Node* item = Find(entries, "decentering")) {
+    const StatusOr<std::vector<double>> centre =
+        reader.NumberList(*item, field + ".decentering", 3);
+    if (!centre.ok()) return centre.status();
+    dome.decentering =
+        Eigen::Vector3d((*centre)[0], (*centre)[1], (*centre)[2]);
+  }
+  if (const Status status = dome.Check(); !status.ok()) {
+    return reader.Error(node, field, status.message());
+  }
+  return dome;
+}
+
 // The `port` block of a camera (flat_port_geometry.h): air_gap and
 // glass_thickness required, glass_index and normal optional; a normal
 // that is not of unit length is normalized. An unknown key is an error here (a
 // misspelt key of a port would silently give the thin port).
-StatusOr<FlatPort> ReadPort(const YamlReader& reader, const YAML::Node& node,
-                            const std::string& field) {
-  if (!node.IsMap()) {
-    return reader.Error(node, field,
-                        "expected a map {air_gap, glass_thickness, "
-                        "glass_index, normal}, got " +
-                            DescribeYamlNode(node));
-  }
-  const StatusOr<YamlEntries> entries = reader.Entries(node, field);
-  if (!entries.ok()) return entries.status();
-  for (const auto& [key, entry] : *entries) {
-    if (key != "air_gap" && key != "glass_thickness" && key != "glass_index" &&
-        key != "normal") {
-      return reader.Error(entry.key, field + "." + key,
-                          "unknown key (a port has air_gap, "
-                          "glass_thickness, glass_index, normal)");
-    }
-  }
+StatusOr<FlatPort> ReadFlatPort(const YamlReader& reader,
+                                const YAML::Node& node,
+                                const YamlEntries& entries_in,
+                                const std::string& field) {
+  const YamlEntries* entries = &entries_in;
+  RCM_RETURN_IF_ERROR(CheckPortKeys(
+      reader, *entries, field,
+      {"type", "air_gap", "glass_thickness", "glass_index", "normal"},
+      "a port has air_gap, glass_thickness, glass_index, normal; a dome "
+      "has type: dome"));
   FlatPort port;
   const auto number = [&](const char* key, bool required,
                           double* value) -> Status {
-    const YAML::Node* item = Find(*entries, key);
-    if (item == nullptr) {
-      return required ? reader.MissingKey(field, key) : Status::Ok();
-    }
-    const StatusOr<double> read = reader.Number(*item, field + "." + key);
-    if (!read.ok()) return read.status();
-    *value = *read;
-    return Status::Ok();
+    return ReadPortNumber(reader, *entries, field, key, required, value);
   };
   RCM_RETURN_IF_ERROR(number("air_gap", true, &port.air_gap));
   RCM_RETURN_IF_ERROR(number("glass_thickness", true, &port.glass_thickness));
@@ -91,6 +155,42 @@ StatusOr<FlatPort> ReadPort(const YamlReader& reader, const YAML::Node& node,
   // A unit normal read back from a file rcm wrote stays bit-exact.
   if (std::abs(port.normal.norm() - 1.0) > 1e-12) port.normal.stableNormalize();
   return port;
+}
+
+// A camera's `port` block: a flat port (the default type) or a dome.
+Status ReadPort(const YamlReader& reader, const YAML::Node& node,
+                const std::string& field, CamchainCamera* camera) {
+  if (!node.IsMap()) {
+    return reader.Error(node, field,
+                        "expected a map {air_gap, glass_thickness, "
+                        "glass_index, normal} or a dome {type: dome, "
+                        "inner_radius, thickness, glass_index, decentering}, "
+                        "got " +
+                            DescribeYamlNode(node));
+  }
+  const StatusOr<YamlEntries> entries = reader.Entries(node, field);
+  if (!entries.ok()) return entries.status();
+  std::string type = "flat";
+  if (const YAML::Node* item = Find(*entries, "type")) {
+    const StatusOr<std::string> read = reader.String(*item, field + ".type");
+    if (!read.ok()) return read.status();
+    type = *read;
+  }
+  if (type == "dome") {
+    StatusOr<DomePort> dome = ReadDomePort(reader, node, *entries, field);
+    if (!dome.ok()) return dome.status();
+    camera->dome = *dome;
+    return Status::Ok();
+  }
+  if (type != "flat") {
+    return reader.Error(
+        *Find(*entries, "type"), field + ".type",
+        "unknown port type '" + type + "' (supported: flat, dome)");
+  }
+  StatusOr<FlatPort> port = ReadFlatPort(reader, node, *entries, field);
+  if (!port.ok()) return port.status();
+  camera->port = *port;
+  return Status::Ok();
 }
 
 StatusOr<CamchainCamera> ParseCamera(const YamlReader& reader, int index,
@@ -278,9 +378,7 @@ StatusOr<CamchainCamera> ParseCamera(const YamlReader& reader, int index,
     result.timeshift_cam_imu = *shift;
   }
   if (const YAML::Node* value = Find(*entries, "port")) {
-    const StatusOr<FlatPort> port = ReadPort(reader, *value, field("port"));
-    if (!port.ok()) return port.status();
-    result.port = *port;
+    RCM_RETURN_IF_ERROR(ReadPort(reader, *value, field("port"), &result));
   }
   return result;
 }
@@ -518,7 +616,20 @@ void AppendCamera(const std::string& name, const CamchainCamera& entry,
   AppendListField(
       "resolution",
       {std::to_string(camera.width()), std::to_string(camera.height())}, out);
-  if (entry.port.has_value()) {
+  if (entry.dome.has_value()) {
+    // Sorted keys; a map holding a list is written in block style.
+    const DomePort& dome = *entry.dome;
+    *out += "  port:\n";
+    *out += "    decentering: ";
+    AppendFlowList(FloatItems({dome.decentering.x(), dome.decentering.y(),
+                               dome.decentering.z()}),
+                   6, out);
+    *out += '\n';
+    *out += "    glass_index: " + YamlFloat(dome.glass_index) + "\n";
+    *out += "    inner_radius: " + YamlFloat(dome.inner_radius) + "\n";
+    *out += "    thickness: " + YamlFloat(dome.thickness) + "\n";
+    *out += "    type: dome\n";
+  } else if (entry.port.has_value()) {
     // Sorted keys; a map holding a list is written in block style.
     const FlatPort& port = *entry.port;
     *out += "  port:\n";
@@ -632,6 +743,19 @@ StatusOr<StereoRig> StereoRigFromCamchain(const Camchain& camchain,
   if (left_index == right_index) {
     return Status::Error("left and right are the same camera (cam" +
                          std::to_string(left_index) + ")");
+  }
+  for (int index : {left_index, right_index}) {
+    if (camchain.cameras[index].dome.has_value()) {
+      // The stereo tools model flat ports; a dome's rig is handled by the
+      // dome tools (rcm calibrate --underwater --port dome, rcm
+      // dome-check), which read the camchain's cameras themselves.
+      return Status::Error(
+          "cam" + std::to_string(index) +
+          " looks through a dome port, which this stereo tool does not "
+          "model (it handles flat ports); use the dome tools (rcm calibrate "
+          "--underwater --port dome, rcm dome-check, rcm undistort "
+          "--reference-depth)");
+    }
   }
   // high_from_low = T(high) * ... * T(low + 1).
   const int low = std::min(left_index, right_index);

@@ -22,6 +22,12 @@
 //       glass_index: 1.49             #   meters (flat_port_geometry.h);
 //       glass_thickness: 0.006        #   normal optional, default [0, 0, 1],
 //       normal: [0.0, 0.0, 1.0]       #   glass_index optional, default 1.49
+//     port:                           # or a dome port (dome_port_geometry.h):
+//       decentering: [0.0, 0.0, 0.0072]  # the dome's centre in the camera
+//       glass_index: 1.495            #   frame, meters (default 0: centred)
+//       inner_radius: 0.04355         #   meters
+//       thickness: 0.00375            #   or outer_radius: 0.0473 (or both,
+//       type: dome                    #   when they agree to 1 micrometre)
 //   cam1:
 //     T_cn_cnm1:                  # required on cam1 and later, absent on
 //     - [...]                     # cam0: maps cam(n-1) points into cam(n),
@@ -55,6 +61,7 @@
 #include <vector>
 
 #include "rcm/camera/camera.h"
+#include "rcm/camera/dome_port_geometry.h"
 #include "rcm/camera/flat_port_geometry.h"
 #include "rcm/geometry/rigid3d.h"
 #include "rcm/stereo/stereo_rig.h"
@@ -77,6 +84,9 @@ struct CamchainCamera {
   // The housing's flat port in front of this camera (rcm's extension of
   // Kalibr's format, see above); absent = the paper's thin port.
   std::optional<FlatPort> port = std::nullopt;
+  // The dome port in front of this camera (a `port` block of type dome);
+  // never set together with `port`.
+  std::optional<DomePort> dome = std::nullopt;
 };
 
 struct Camchain {
@@ -111,7 +121,8 @@ Status WriteCamchain(const std::string& path, const Camchain& camchain);
 // cameras, in either order (left 1, right 0 gives the inverse of left 0,
 // right 1). The cameras' port blocks become the rig's ports (a camera
 // without one has the thin port). Fails on an index out of range, equal
-// indices, a missing T_cn_cnm1 and a zero baseline.
+// indices, a camera behind a dome port (the stereo rig models flat ports),
+// a missing T_cn_cnm1 and a zero baseline.
 StatusOr<StereoRig> StereoRigFromCamchain(const Camchain& camchain,
                                           int left_index, int right_index);
 
