@@ -1,0 +1,165 @@
+// Underwater calibration through dome ports: where each dome's centre
+// sits relative to its camera (the decentering), and optionally the
+// water's index n, from views of a planar target under water, with the
+// air calibration's lenses (and a stereo rig's extrinsics) held.
+//
+// Unknowns: per camera c the decentering C_c (the dome's centre in the
+// camera frame, meters, dome_port_geometry.h), one pose cam0_from_target_v
+// per view, the board's warp w (two numbers shared by all views,
+// board_warp.h; held at 0 for a flat board) and, with estimate_n, n.
+// Residuals (dome_reprojection_error.h), for every corner j camera c saw
+// in view v at pixel u:
+//   e = pi(lens_c, dome(n, C_c, R_c (R_v X_j(w) + t_v) + t_c)) - u,
+// (R_c, t_c) = cam_c_from_cam0 of the air calibration (identity for cam0).
+// Fit: Huber solves with outlier rounds, then least squares over the
+// inliers (board_bundle_adjustment.h, as the air calibration).
+//
+// Observability. A decentered dome bends a ray by an amount that depends
+// on how far the ray is from the dome's centre and on the distance to the
+// scene: the lateral decentering (C_x, C_y) turns the image by ~|C| / Z
+// and is seen at once; the axial one (C_z) changes the magnification with
+// the distance, like n does, so C_z and n are strongly correlated and n
+// through a dome is weakly observable: views at several distances
+// separate them. Both are reported: sigma_n and the correlation of n with
+// each decentering component.
+//
+// Uncertainty. cov = sigma^2 (J^T J)^-1 at the solution, sigma^2 =
+// SSR / (2 m - p) over the m inlier corners and p unknowns. Real boards
+// are rarely flat, so two candidate models are fitted, the board flat and
+// bowed (when estimate_board_warp), as the flat-port path does
+// (underwater_model_selection.h): with d_v = ln(s_flat(v) / s_bowed(v)),
+// s(v) the view's SSR, the evidence against the flat board is
+// mean(d) / (sd(d) / sqrt(V)) over the V views (in-sample: the bow adds
+// two unknowns to thousands of corners, so its own fit improvement per
+// view is ~2 / (2 m_v) and the statistic measures whether the views
+// agree that the board bows). The chosen model is the bowed one when the
+// evidence exceeds evidence_sigmas, else the flat one; when both remain
+// plausible each decentering component's sigma is widened by the spread
+// b^2 = max(0, (C_bowed - C_flat)^2 - |s_bowed^2 - s_flat^2|) (the
+// Hausman correction of nested fits), and n's likewise.
+#ifndef RCM_CALIB_DOME_CALIBRATION_H_
+#define RCM_CALIB_DOME_CALIBRATION_H_
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rcm/calib/calibration_target.h"
+#include "rcm/calib/stereo_calibration.h"
+#include "rcm/calib/target_observation.h"
+#include "rcm/calib/underwater_calibration.h"
+#include "rcm/camera/camera.h"
+#include "rcm/camera/dome_port_geometry.h"
+#include "rcm/geometry/rigid3d.h"
+#include "rcm/util/status.h"
+
+namespace rcm::calib {
+
+struct DomeCalibrationOptions {
+  // Estimate n with the decentering; otherwise n is held at `n`.
+  bool estimate_n = false;
+  // The medium's index, held or the start, [1, 2] (fresh water 1.333, sea
+  // water 1.34).
+  double n = 1.333;
+  // Fit the bowed board beside the flat one (see the header); off: the
+  // board is flat.
+  bool estimate_board_warp = true;
+  // Evidence (t statistic over the views) above which the flat board is
+  // ruled out.
+  double evidence_sigmas = 3.0;
+  // Huber loss scale [px] of the robust solves.
+  double huber_px = 1.0;
+  // Corners beyond outlier_sigmas robust standard deviations, and at least
+  // min_outlier_threshold_px, are dropped (as the air calibration).
+  double outlier_sigmas = 5.0;
+  double min_outlier_threshold_px = 2.0;
+  int max_outlier_rounds = 3;
+  // Ceres iterations per solve.
+  int max_num_iterations = 200;
+  // Fewest corners a camera must see in a view for it to be used.
+  int min_corners_per_view = 6;
+  // Also fit a conventional lens model freely to the underwater corners
+  // (no dome): its RMS beside the dome model's shows which describes the
+  // images better.
+  bool fit_conventional_model = true;
+  int num_threads = 2;
+
+  Status Check() const;
+};
+
+// One camera looking through its dome.
+struct DomeCameraInput {
+  Camera camera;  // the air calibration's lens, held
+  // The dome's glass (radii, index); its decentering is the start.
+  DomePort dome;
+};
+
+// One candidate model's fit.
+struct DomeCandidate {
+  std::string name;  // "flat board", "bowed board"
+  bool board_warp = false;
+  std::vector<Eigen::Vector3d> decentering;  // per camera, meters
+  std::vector<Eigen::Vector3d> decentering_sigma;
+  double n = 0.0;
+  double sigma_n = 0.0;  // 0 when n is held
+  double rms_px = 0.0;
+  double pixel_sigma = 0.0;
+  double evidence = 0.0;  // against it, in sigmas (0 for the best)
+  bool plausible = true;
+};
+
+struct DomeCalibration {
+  int num_cameras = 0;
+  // Per camera: the decentering [m], its covariance (noise, of the chosen
+  // model) and its total sigma (noise and model spread), and the spread
+  // alone.
+  std::vector<Eigen::Vector3d> decentering;
+  std::vector<Eigen::Matrix3d> decentering_covariance;
+  std::vector<Eigen::Vector3d> decentering_sigma;
+  std::vector<Eigen::Vector3d> decentering_sigma_model;
+  // n: estimated or held, its total sigma (0 when held), the spread part,
+  // and its correlation with each camera's decentering components.
+  bool n_estimated = false;
+  double n = 0.0;
+  double sigma_n = 0.0;
+  double sigma_n_model = 0.0;
+  std::vector<Eigen::Vector3d> correlation_n_decentering;
+  // The board's warp [m] when the chosen model bows it.
+  bool board_warp_estimated = false;
+  Eigen::Vector2d board_warp = Eigen::Vector2d::Zero();
+  Eigen::Vector2d board_warp_sigma = Eigen::Vector2d::Zero();
+  // Both candidates and the one chosen (index into candidates).
+  std::vector<DomeCandidate> candidates;
+  int chosen = 0;
+  std::string rule;  // the rule's outcome, one line
+
+  // Per input view: cam0_from_target, nullopt when not used.
+  std::vector<std::optional<Rigid3d>> cam0_from_target;
+  std::vector<CornerResidual> corners;  // of the chosen model
+  double rms_px = 0.0;                  // all corners that project
+  double inlier_rms_px = 0.0;           // inliers
+  std::vector<double> rms_px_per_camera;
+  double pixel_sigma = 0.0;
+  int num_views_used = 0;
+  int num_inliers = 0;
+  int num_outliers = 0;
+  int num_parameters = 0;
+
+  // The conventional fit (the air model's lens free, no dome) of the same
+  // corners, per camera for one camera, of the pair for two.
+  ConventionalFit conventional;
+};
+
+// Errors: cameras not 1 or 2, a dome that fails Check, options that fail
+// Check, fewer than 3 usable views, every solve failing. With one camera
+// only the views' `left` observations are used; with two,
+// `cam1_from_cam0` is the air calibration's extrinsics.
+StatusOr<DomeCalibration> CalibrateDome(
+    const std::vector<StereoView>& views,
+    const std::vector<DomeCameraInput>& cameras, const Rigid3d& cam1_from_cam0,
+    const CalibrationTarget& target, const DomeCalibrationOptions& options);
+
+}  // namespace rcm::calib
+
+#endif  // RCM_CALIB_DOME_CALIBRATION_H_
