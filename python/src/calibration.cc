@@ -1,6 +1,6 @@
-// Calibration (rcm::calib): targets, stereo calibration in air and the
-// underwater refinement, from images (NumPy arrays or files) or from corner
-// observations; and the target renderer for synthetic views.
+// Calibration (rcm::calib): targets, stereo and one-camera calibration in
+// air and the underwater refinement, from images (NumPy arrays or files) or
+// from corner observations; and the target renderer for synthetic views.
 #include <pybind11/stl.h>
 
 #include <cmath>
@@ -10,6 +10,7 @@
 #include "errors.h"
 #include "options.h"
 #include "rcm/calib/calibration_target.h"
+#include "rcm/calib/mono_calibration.h"
 #include "rcm/calib/stereo_calibration.h"
 #include "rcm/calib/target_detector.h"
 #include "rcm/calib/target_image.h"
@@ -39,14 +40,18 @@ cv::Mat ImageOrFile(const py::handle& item, const std::string& name,
   return ReadOrThrow(path, ReadImage(path, /*grayscale=*/true));
 }
 
-// Detects the target in every pair (GIL released), with the image sizes.
+// Detects the target in every pair (GIL released), with the image sizes;
+// `right` None: in the left images only (one camera).
 struct Detections {
   std::vector<StereoView> views;
   ImageSize sizes[2];
 };
 
 Detections Detect(const CalibrationTarget& target, const py::sequence& left,
-                  const py::sequence& right) {
+                  const py::object& right_images) {
+  const int num_cameras = right_images.is_none() ? 1 : 2;
+  const py::sequence right =
+      num_cameras == 2 ? py::sequence(right_images) : left;
   if (py::len(left) != py::len(right)) {
     ThrowValueError("left_images and right_images differ in length (" +
                     std::to_string(py::len(left)) + " and " +
@@ -57,7 +62,7 @@ Detections Detect(const CalibrationTarget& target, const py::sequence& left,
   std::vector<cv::Mat> images[2];
   Detections detections;
   for (size_t i = 0; i < py::len(left); ++i) {
-    for (int side = 0; side < 2; ++side) {
+    for (int side = 0; side < num_cameras; ++side) {
       const std::string name = std::string(side ? "right" : "left") +
                                "_images[" + std::to_string(i) + "]";
       const cv::Mat image = ImageOrFile((side ? right : left)[i], name, &keep);
@@ -75,10 +80,15 @@ Detections Detect(const CalibrationTarget& target, const py::sequence& left,
   {
     py::gil_scoped_release release;
     for (size_t i = 0; i < images[0].size(); ++i) {
-      StereoView view =
-          calib::DetectTargetPair(images[0][i], images[1][i], target);
+      StereoView view;
+      if (num_cameras == 2) {
+        view = calib::DetectTargetPair(images[0][i], images[1][i], target);
+        view.right_name = "right " + std::to_string(i);
+      } else {
+        view.left = calib::DetectTarget(images[0][i], target);
+        if (!view.left) view.note = "no target found";
+      }
       view.left_name = "left " + std::to_string(i);
-      view.right_name = "right " + std::to_string(i);
       detections.views.push_back(std::move(view));
     }
   }
@@ -115,33 +125,45 @@ std::optional<TargetObservation> ObservationFrom(const py::handle& item,
   return observation;
 }
 
+// ObservationFrom, its point ids checked against the target's
+// (`view_name` names the view in the message).
+std::optional<TargetObservation> TargetObservationFrom(
+    const py::handle& item, const std::string& name,
+    const std::string& view_name, int num_points) {
+  std::optional<TargetObservation> observation = ObservationFrom(item, name);
+  if (!observation) return observation;
+  for (const int id : observation->point_ids) {
+    if (id < 0 || id >= num_points) {
+      ThrowValueError(view_name + ": point id " + std::to_string(id) +
+                      " outside [0, " + std::to_string(num_points) + ")");
+    }
+  }
+  return observation;
+}
+
+// The views of corner observations: per view (left, right) of a pair, or
+// (one camera) the left alone.
 std::vector<StereoView> ViewsFromCorners(const CalibrationTarget& target,
-                                         const py::sequence& views) {
+                                         const py::sequence& views,
+                                         bool one_camera = false) {
   const int num_points = calib::NumTargetPoints(target);
   std::vector<StereoView> result;
   for (size_t v = 0; v < py::len(views); ++v) {
-    const py::tuple pair = py::reinterpret_borrow<py::object>(views[v]);
-    if (pair.size() != 2) {
-      ThrowValueError("views[" + std::to_string(v) +
-                      "] must be (left corners, right corners)");
-    }
+    const std::string name = "views[" + std::to_string(v) + "]";
     StereoView view;
     view.left_name = "view " + std::to_string(v);
-    view.right_name = view.left_name;
-    view.left = ObservationFrom(pair[0], "views[" + std::to_string(v) + "][0]");
-    view.right =
-        ObservationFrom(pair[1], "views[" + std::to_string(v) + "][1]");
-    for (const std::optional<TargetObservation>* o :
-         {&view.left, &view.right}) {
-      if (!*o) continue;
-      for (const int id : (*o)->point_ids) {
-        if (id < 0 || id >= num_points) {
-          ThrowValueError("views[" + std::to_string(v) + "]: point id " +
-                          std::to_string(id) + " outside [0, " +
-                          std::to_string(num_points) + ")");
-        }
-      }
+    if (one_camera) {
+      view.left = TargetObservationFrom(views[v], name, name, num_points);
+      result.push_back(std::move(view));
+      continue;
     }
+    const py::tuple pair = py::reinterpret_borrow<py::object>(views[v]);
+    if (pair.size() != 2) {
+      ThrowValueError(name + " must be (left corners, right corners)");
+    }
+    view.right_name = view.left_name;
+    view.left = TargetObservationFrom(pair[0], name + "[0]", name, num_points);
+    view.right = TargetObservationFrom(pair[1], name + "[1]", name, num_points);
     result.push_back(std::move(view));
   }
   if (result.empty()) ThrowValueError("no views");
@@ -167,8 +189,9 @@ std::vector<OptionField> BoardAdjustmentFields(Options* o) {
           IntOption("num_threads", &o->num_threads)};
 }
 
-calib::StereoCalibrationOptions StereoOptionsFrom(const std::string& model,
-                                                  const py::kwargs& kwargs) {
+calib::StereoCalibrationOptions StereoOptionsFrom(
+    const std::string& model, const py::kwargs& kwargs,
+    const std::string& function = "calibrate_stereo") {
   calib::StereoCalibrationOptions o;
   const std::optional<LensModelId> lens = LensModelFromName(model);
   if (!lens || *lens == LensModelId::kPinhole) {
@@ -179,7 +202,7 @@ calib::StereoCalibrationOptions StereoOptionsFrom(const std::string& model,
   o.model = *lens;
   std::vector<OptionField> fields = BoardAdjustmentFields(&o);
   fields.push_back(BoolOption("compute_covariance", &o.compute_covariance));
-  ApplyOptions(kwargs, fields, "calibrate_stereo");
+  ApplyOptions(kwargs, fields, function);
   ThrowIfError(o.Check());
   return o;
 }
@@ -225,6 +248,30 @@ StereoCalibrationResult RunStereo(
   return {std::move(result), std::move(rig), std::move(notes)};
 }
 
+// The result of a one-camera calibration.
+struct MonoCalibrationResult {
+  calib::StereoCalibration calibration;
+  std::vector<std::string> notes;
+};
+
+MonoCalibrationResult RunMono(const CalibrationTarget& target,
+                              const std::vector<StereoView>& views,
+                              const ImageSize& size,
+                              const calib::StereoCalibrationOptions& options) {
+  StatusOr<calib::StereoCalibration> calibration = Status::Error("not run");
+  {
+    py::gil_scoped_release release;
+    calibration = calib::CalibrateMono(target, views, size, options);
+  }
+  MonoCalibrationResult result{ValueOrThrow(std::move(calibration)), {}};
+  for (const StereoView& view : views) {
+    if (!view.note.empty()) {
+      result.notes.push_back(view.left_name + ": " + view.note);
+    }
+  }
+  return result;
+}
+
 struct UnderwaterResult {
   calib::UnderwaterCalibration calibration;
   std::vector<std::string> notes;
@@ -255,6 +302,46 @@ DoubleArray Sigmas(const calib::CameraCalibration& c) {
   for (int i = 0; i < c.camera.num_params(); ++i)
     a.mutable_data()[i] = c.sigma[i];
   return a;
+}
+
+// The properties a stereo and a one-camera calibration result share (a
+// Result has `calibration`, a calib::StereoCalibration, and `notes`): the
+// residual statistics, the board's warp, the counts, the board poses
+// (cam0_from_target: 4x4 or None per input view) and the notes.
+template <typename Result>
+void DefineBoardFitProperties(py::class_<Result>* result) {
+  const auto number = [result](const char* name, auto member) {
+    result->def_property_readonly(
+        name, [member](const Result& r) { return r.calibration.*member; });
+  };
+  number("rms_px", &calib::StereoCalibration::rms_px);
+  number("inlier_rms_px", &calib::StereoCalibration::inlier_rms_px);
+  number("pixel_sigma", &calib::StereoCalibration::pixel_sigma);
+  number("initial_rms_px", &calib::StereoCalibration::initial_rms_px);
+  number("board_warp_estimated",
+         &calib::StereoCalibration::board_warp_estimated);
+  number("num_views_used", &calib::StereoCalibration::num_views_used);
+  number("num_inliers", &calib::StereoCalibration::num_inliers);
+  number("num_outliers", &calib::StereoCalibration::num_outliers);
+  number("num_parameters", &calib::StereoCalibration::num_parameters);
+  const auto matrix = [result](const char* name, auto member) {
+    result->def_property_readonly(name, [member](const Result& r) {
+      return ToNumpy(r.calibration.*member);
+    });
+  };
+  matrix("board_warp", &calib::StereoCalibration::board_warp);
+  matrix("board_warp_sigma", &calib::StereoCalibration::board_warp_sigma);
+  matrix("board_warp_covariance",
+         &calib::StereoCalibration::board_warp_covariance);
+  result->def_property_readonly("cam0_from_target", [](const Result& r) {
+    py::list poses;
+    for (const std::optional<Rigid3d>& pose : r.calibration.cam0_from_target) {
+      poses.append(pose ? py::object(ToNumpy(pose->ToMatrix()))
+                        : py::object(py::none()));
+    }
+    return poses;
+  });
+  result->def_readonly("notes", &Result::notes);
 }
 
 constexpr const char* kStereoOptionsDoc = R"doc(
@@ -390,7 +477,9 @@ camera frame). supersampling: sub-samples per pixel axis (1..16);
 blur_sigma_px: Gaussian blur, pixels; noise_sigma: gray levels.
 )doc");
 
-  py::class_<StereoCalibrationResult>(module, "StereoCalibrationResult", R"doc(
+  py::class_<StereoCalibrationResult> stereo_result(module,
+                                                    "StereoCalibrationResult",
+                                                    R"doc(
 The result of calibrate_stereo: rig (rcm.StereoRig, cam1_from_cam0 in
 meters), rms_px (over all corners of used views, as cv2.stereoCalibrate's),
 inlier_rms_px, pixel_sigma (estimated corner noise, pixels), initial_rms_px
@@ -402,24 +491,11 @@ cam0_from_target (per input view: 4x4 or None), board_warp_estimated,
 board_warp ([warp_x, warp_y], meters: the board's bow, zero when not
 estimated; the bowl at the centre is their sum), board_warp_sigma (meters),
 board_warp_covariance (2x2), notes (why views were dropped).
-)doc")
+)doc");
+  DefineBoardFitProperties(&stereo_result);
+  stereo_result
       .def_property_readonly(
           "rig", [](const StereoCalibrationResult& r) { return r.rig; })
-      .def_property_readonly(
-          "rms_px",
-          [](const StereoCalibrationResult& r) { return r.calibration.rms_px; })
-      .def_property_readonly("inlier_rms_px",
-                             [](const StereoCalibrationResult& r) {
-                               return r.calibration.inlier_rms_px;
-                             })
-      .def_property_readonly("pixel_sigma",
-                             [](const StereoCalibrationResult& r) {
-                               return r.calibration.pixel_sigma;
-                             })
-      .def_property_readonly("initial_rms_px",
-                             [](const StereoCalibrationResult& r) {
-                               return r.calibration.initial_rms_px;
-                             })
       .def_property_readonly("baseline",
                              [](const StereoCalibrationResult& r) {
                                return r.calibration.baseline;
@@ -441,55 +517,10 @@ board_warp_covariance (2x2), notes (why views were dropped).
           [](const StereoCalibrationResult& r) {
             return ToNumpy(r.calibration.extrinsics_covariance);
           })
-      .def_property_readonly("board_warp_estimated",
-                             [](const StereoCalibrationResult& r) {
-                               return r.calibration.board_warp_estimated;
-                             })
-      .def_property_readonly("board_warp",
-                             [](const StereoCalibrationResult& r) {
-                               return ToNumpy(r.calibration.board_warp);
-                             })
-      .def_property_readonly("board_warp_sigma",
-                             [](const StereoCalibrationResult& r) {
-                               return ToNumpy(r.calibration.board_warp_sigma);
-                             })
-      .def_property_readonly(
-          "board_warp_covariance",
-          [](const StereoCalibrationResult& r) {
-            return ToNumpy(r.calibration.board_warp_covariance);
-          })
-      .def_property_readonly("num_views_used",
-                             [](const StereoCalibrationResult& r) {
-                               return r.calibration.num_views_used;
-                             })
       .def_property_readonly("num_stereo_views",
                              [](const StereoCalibrationResult& r) {
                                return r.calibration.num_stereo_views;
                              })
-      .def_property_readonly("num_inliers",
-                             [](const StereoCalibrationResult& r) {
-                               return r.calibration.num_inliers;
-                             })
-      .def_property_readonly("num_outliers",
-                             [](const StereoCalibrationResult& r) {
-                               return r.calibration.num_outliers;
-                             })
-      .def_property_readonly("num_parameters",
-                             [](const StereoCalibrationResult& r) {
-                               return r.calibration.num_parameters;
-                             })
-      .def_property_readonly(
-          "cam0_from_target",
-          [](const StereoCalibrationResult& r) {
-            py::list poses;
-            for (const std::optional<Rigid3d>& pose :
-                 r.calibration.cam0_from_target) {
-              poses.append(pose ? py::object(ToNumpy(pose->ToMatrix()))
-                                : py::object(py::none()));
-            }
-            return poses;
-          })
-      .def_readonly("notes", &StereoCalibrationResult::notes)
       .def("__repr__", [](const StereoCalibrationResult& r) {
         return "StereoCalibrationResult(rms_px=" +
                std::to_string(r.calibration.rms_px) +
@@ -543,6 +574,92 @@ cam1_size: (width, height) in pixels.
       py::arg("target"), py::arg("views"), py::arg("cam0_size"),
       py::arg("cam1_size"), py::arg("model") = "radtan",
       stereo_corners_doc.c_str());
+
+  py::class_<MonoCalibrationResult> mono_result(module, "MonoCalibrationResult",
+                                                R"doc(
+The result of calibrate_mono: camera (rcm.Camera, the calibrated lens),
+sigma (standard deviations of [fx, fy, cx, cy, d...]: pixels for the
+first four, the coefficients' own units after), covariance (their n x n
+covariance, sigma^2 (J^T J)^-1 of the final least squares), rms_px (over
+all corners of used views, as cv2.calibrateCamera's), inlier_rms_px,
+pixel_sigma (estimated corner noise, pixels per axis), initial_rms_px
+(OpenCV's initialization), num_views_used, num_inliers, num_outliers,
+num_parameters, cam0_from_target (per input view: the camera from the
+target, 4x4 in meters, or None), board_warp_estimated, board_warp
+([warp_x, warp_y], meters), board_warp_sigma (meters),
+board_warp_covariance (2x2, m^2), notes (why views were dropped).
+)doc");
+  DefineBoardFitProperties(&mono_result);
+  mono_result
+      .def_property_readonly("camera",
+                             [](const MonoCalibrationResult& r) {
+                               return r.calibration.cam0.camera;
+                             })
+      .def_property_readonly("sigma",
+                             [](const MonoCalibrationResult& r) {
+                               return Sigmas(r.calibration.cam0);
+                             })
+      .def_property_readonly(
+          "covariance",
+          [](const MonoCalibrationResult& r) {
+            const int n = r.calibration.cam0.camera.num_params();
+            return ToNumpy(
+                r.calibration.cam0.covariance.topLeftCorner(n, n).eval());
+          })
+      .def("__repr__", [](const MonoCalibrationResult& r) {
+        return "MonoCalibrationResult(rms_px=" +
+               std::to_string(r.calibration.rms_px) +
+               ", views_used=" + std::to_string(r.calibration.num_views_used) +
+               ", fx=" + std::to_string(r.calibration.cam0.camera.fx()) +
+               " px)";
+      });
+
+  static const std::string mono_doc = std::string(R"doc(
+One camera's calibration in air by bundle adjustment over views of a
+planar target (C++ rcm::calib::CalibrateMono; rcm calibrate --left alone):
+the lens, every board pose and (by default) the board's bow, Huber solves
+with outlier rounds, then plain least squares.
+
+calibrate_mono(target, images, model='radtan', **options)
+    images: a list of NumPy uint8 arrays (gray, BGR) or file paths, all of
+    one size; the target is detected in each (GIL released).
+Returns a MonoCalibrationResult. ValueError with the library's message
+when fewer than 3 images show the target, and so on. With
+estimate_board_warp=False and model='radtan' it is cv2.calibrateCamera's
+model (k3 fixed to 0) on the same corners.
+)doc") + kStereoOptionsDoc + "use_single_camera_views does not apply.";
+  module.def(
+      "calibrate_mono",
+      [](const CalibrationTarget& target, const py::sequence& images,
+         const std::string& model, const py::kwargs& kwargs) {
+        const calib::StereoCalibrationOptions options =
+            StereoOptionsFrom(model, kwargs, "calibrate_mono");
+        const Detections detections = Detect(target, images, py::none());
+        return RunMono(target, detections.views, detections.sizes[0], options);
+      },
+      py::arg("target"), py::arg("images"), py::arg("model") = "radtan",
+      mono_doc.c_str());
+
+  static const std::string mono_corners_doc = std::string(R"doc(
+calibrate_mono from corner observations instead of images.
+
+views: a list with, per view, None or (point_ids (M,) ints, pixels (M, 2)
+raw pixels), point ids indexing target.points; image_size: (width, height)
+in pixels.
+)doc") + kStereoOptionsDoc;
+  module.def(
+      "calibrate_mono_from_corners",
+      [](const CalibrationTarget& target, const py::sequence& views,
+         const std::pair<int, int>& image_size, const std::string& model,
+         const py::kwargs& kwargs) {
+        const calib::StereoCalibrationOptions options =
+            StereoOptionsFrom(model, kwargs, "calibrate_mono_from_corners");
+        return RunMono(target,
+                       ViewsFromCorners(target, views, /*one_camera=*/true),
+                       SizeFrom(image_size), options);
+      },
+      py::arg("target"), py::arg("views"), py::arg("image_size"),
+      py::arg("model") = "radtan", mono_corners_doc.c_str());
 
   py::class_<UnderwaterResult>(module, "UnderwaterCalibrationResult", R"doc(
 The result of calibrate_underwater: n, sigma_n (from the covariance),

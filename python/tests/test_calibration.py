@@ -289,3 +289,91 @@ def test_exact_stereo_calibration_of_the_new_lens_models(realistic_rig, model,
         np.testing.assert_allclose(estimate.distortion, truth.distortion,
                                    rtol=0, atol=1e-6)
     assert result.rms_px < 1e-6
+
+
+def test_exact_mono_calibration_from_corners(realistic_rig):
+    """One camera (rcm calibrate --left alone): noise-free corners of a
+    bowed board give the lens, the bow and the poses back (as
+    tests/calib/mono_calibration_test.cc)."""
+    target = checkerboard()
+    truth = realistic_rig.cam0
+    warp = [4e-4, -2e-4]
+    points = bowed(target, warp)
+    poses = board_poses(truth, target, 18, seed=7)
+    views = [observe(truth, transform(pose, points), 1.0) for pose in poses]
+    result = rcm.calibrate_mono_from_corners(target, views, truth.image_size,
+                                             model="equidistant")
+    np.testing.assert_allclose(result.camera.intrinsics, truth.intrinsics,
+                               rtol=0, atol=EXACT)
+    np.testing.assert_allclose(result.camera.distortion, truth.distortion,
+                               rtol=0, atol=EXACT)
+    np.testing.assert_allclose(result.board_warp, warp, rtol=0, atol=EXACT)
+    assert result.rms_px < EXACT
+    assert result.num_views_used == 18
+    assert result.num_parameters == 8 + 6 * 18 + 2
+    for estimate, pose in zip(result.cam0_from_target, poses):
+        np.testing.assert_allclose(estimate, pose, atol=EXACT)
+    assert result.sigma.shape == (8,)
+    assert result.covariance.shape == (8, 8)
+    np.testing.assert_allclose(np.sqrt(np.diag(result.covariance)),
+                               result.sigma)
+    assert "MonoCalibrationResult(rms_px=" in repr(result)
+
+
+def test_mono_calibration_equals_opencv_on_its_sample():
+    """The left images of OpenCV's stereo sample (opencv-doc), a flat
+    board: on the same corners (OpenCV's detector, ids in its order: a
+    relabeling of the grid by a rigid motion of the board) and every corner
+    kept (max_outlier_rounds=0: OpenCV drops none, and its corners here
+    hold a few of several pixels), rcm's one-camera calibration equals
+    cv2.calibrateCamera within the issue's 0.01 px RMS and 0.1 px per
+    intrinsic. From the images, rcm's own detector: subpixel corners."""
+    import cv2
+    data = "/usr/share/doc/opencv-doc/examples/data/"
+    paths = [f"{data}left{k:02d}.jpg" for k in range(1, 15) if k != 10]
+    target = rcm.CalibrationTarget.checkerboard(9, 6, 0.025)
+    object_points, image_points = [], []
+    for path in paths:
+        gray = cv2.imread(path, cv2.IMREAD_GRAYSCALE)
+        found, corners = cv2.findChessboardCorners(gray, (9, 6))
+        assert found, path
+        corners = cv2.cornerSubPix(
+            gray, corners, (11, 11), (-1, -1),
+            (cv2.TERM_CRITERIA_COUNT + cv2.TERM_CRITERIA_EPS, 30, 1e-3))
+        object_points.append(target.points.astype(np.float32))
+        image_points.append(corners.reshape(-1, 2))
+    rms, k, _, _, _ = cv2.calibrateCamera(
+        object_points, image_points, (640, 480), None, None,
+        flags=cv2.CALIB_FIX_K3,
+        criteria=(cv2.TERM_CRITERIA_COUNT + cv2.TERM_CRITERIA_EPS, 200, 1e-12))
+    views = [(np.arange(54), c.astype(float)) for c in image_points]
+    ours = rcm.calibrate_mono_from_corners(target, views, (640, 480),
+                                           model="radtan",
+                                           estimate_board_warp=False,
+                                           max_outlier_rounds=0)
+    assert abs(ours.rms_px - rms) < 0.01
+    np.testing.assert_allclose(
+        ours.camera.intrinsics, [k[0, 0], k[1, 1], k[0, 2], k[1, 2]],
+        rtol=0, atol=0.1)
+    result = rcm.calibrate_mono(target, paths, model="radtan",
+                                estimate_board_warp=False)
+    assert result.num_views_used == 13
+    assert result.num_outliers == 0 and result.rms_px < 0.2
+
+
+def test_mono_calibration_bad_input():
+    target = checkerboard()
+    image = np.zeros((120, 160), np.uint8)
+    with pytest.raises(ValueError) as error:  # no board anywhere
+        rcm.calibrate_mono(target, [image] * 3)
+    assert "cam0 sees the target" in one_line(error)
+    with pytest.raises(TypeError) as error:
+        rcm.calibrate_mono(target, [image], huber=1.0)
+    assert "calibrate_mono" in one_line(error)
+    with pytest.raises(ValueError) as error:
+        rcm.calibrate_mono(target, [image, np.zeros((10, 10), np.uint8)])
+    one_line(error)
+    with pytest.raises(ValueError) as error:
+        rcm.calibrate_mono_from_corners(
+            target, [(np.array([99]), np.zeros((1, 2)))], (160, 120))
+    assert "point id" in one_line(error)
