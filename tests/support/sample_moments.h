@@ -4,6 +4,8 @@
 #ifndef RCM_TESTS_SUPPORT_SAMPLE_MOMENTS_H_
 #define RCM_TESTS_SUPPORT_SAMPLE_MOMENTS_H_
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <vector>
 
@@ -26,6 +28,23 @@ inline SampleMoments Moments(const std::vector<double>& values) {
   }
   moments.stddev = std::sqrt(variance / (count - 1.0));
   return moments;
+}
+
+// Success when the values' |mean| <= max_abs_mean and their standard
+// deviation lies in [min_stddev, max_stddev]; the failure states both.
+inline ::testing::AssertionResult LooksStandardNormal(
+    const std::vector<double>& values, double max_abs_mean, double min_stddev,
+    double max_stddev) {
+  const SampleMoments moments = Moments(values);
+  if (std::abs(moments.mean) <= max_abs_mean && moments.stddev >= min_stddev &&
+      moments.stddev <= max_stddev) {
+    return ::testing::AssertionSuccess();
+  }
+  return ::testing::AssertionFailure()
+         << "mean " << moments.mean << " (|mean| <= " << max_abs_mean
+         << " wanted), standard deviation " << moments.stddev << " (["
+         << min_stddev << ", " << max_stddev << "] wanted) over "
+         << values.size() << " values";
 }
 
 }  // namespace rcm::test
