@@ -155,6 +155,9 @@ release_only=(
 )
 
 budgeted=(
+  # The dome calibration's Monte Carlo (5 trials under the sanitizers) and
+  # its fast tests
+  'DomeCalibration.*'
   'UnderwaterCli.*'
   'UnderwaterModelSelection.*'
   'UnderwaterCalibration.LensCovarianceReachesN'

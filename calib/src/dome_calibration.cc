@@ -351,17 +351,19 @@ StatusOr<DomeCalibration> CalibrateDome(
     flat_candidate.evidence = std::max(0.0, evidence);
     flat_candidate.plausible = !(evidence > options.evidence_sigmas);
     rule.precision(3);
+    // The bowed board nests the flat one: it is unbiased whether or not
+    // the board bows, so it is the answer; the flat board, when the views
+    // cannot rule it out, widens the sigmas by what its answer differs
+    // beyond the two fits' noises.
+    chosen = &*bowed;
+    result.chosen = 1;
     if (flat_candidate.plausible) {
-      rule << "flat board chosen: the views do not agree that the board "
-              "bows (evidence "
+      rule << "bowed board; the flat board stays plausible (evidence "
            << evidence << " <= " << options.evidence_sigmas
-           << " sigmas); the bowed board's spread is in sigma";
+           << " sigmas) and its spread is in sigma";
     } else {
-      chosen = &*bowed;
-      result.chosen = 1;
-      rule << "bowed board chosen: the views agree that it bows (evidence "
-           << evidence << " > " << options.evidence_sigmas
-           << " sigmas against the flat board)";
+      rule << "bowed board; the views rule the flat board out (evidence "
+           << evidence << " > " << options.evidence_sigmas << " sigmas)";
     }
   } else {
     rule << "flat board (the bow is not estimated)";
@@ -370,12 +372,19 @@ StatusOr<DomeCalibration> CalibrateDome(
 
   const DomeFit& fit = *chosen;
   const DomeCandidate& best = result.candidates[result.chosen];
-  // The other candidate, when it stays plausible, widens the sigmas.
+  // The other candidate, when it stays plausible, widens the sigmas by
+  // its spread weighted as underwater_model_selection.h weighs it:
+  // w = exp(-evidence^2 / 2) beside the chosen one's 1.
   const DomeCandidate* other = nullptr;
+  double weight = 0.0;
   if (result.candidates.size() == 2) {
     const DomeCandidate& candidate = result.candidates[1 - result.chosen];
-    if (candidate.plausible) other = &candidate;
+    if (candidate.plausible) {
+      other = &candidate;
+      weight = std::exp(-0.5 * candidate.evidence * candidate.evidence);
+    }
   }
+  const double share = weight / (1.0 + weight);
   for (int c = 0; c < num_cameras; ++c) {
     result.decentering.push_back(best.decentering[c]);
     const int o = fit.centre_offset[c];
@@ -383,9 +392,11 @@ StatusOr<DomeCalibration> CalibrateDome(
     Eigen::Vector3d model = Eigen::Vector3d::Zero();
     if (other != nullptr) {
       for (int i = 0; i < 3; ++i) {
-        model[i] = std::sqrt(SpreadSquared(
-            other->decentering[c][i], best.decentering[c][i],
-            other->decentering_sigma[c][i], best.decentering_sigma[c][i]));
+        model[i] =
+            std::sqrt(share * SpreadSquared(other->decentering[c][i],
+                                            best.decentering[c][i],
+                                            other->decentering_sigma[c][i],
+                                            best.decentering_sigma[c][i]));
       }
     }
     result.decentering_sigma_model.push_back(model);
@@ -408,9 +419,10 @@ StatusOr<DomeCalibration> CalibrateDome(
   result.n = best.n;
   if (options.estimate_n) {
     result.sigma_n_model =
-        other != nullptr ? std::sqrt(SpreadSquared(
-                               other->n, best.n, other->sigma_n, best.sigma_n))
-                         : 0.0;
+        other != nullptr
+            ? std::sqrt(share * SpreadSquared(other->n, best.n, other->sigma_n,
+                                              best.sigma_n))
+            : 0.0;
     result.sigma_n = std::hypot(best.sigma_n, result.sigma_n_model);
   }
   if (fit.warp_offset >= 0) {
@@ -458,18 +470,18 @@ StatusOr<DomeCalibration> CalibrateDome(
     free_fit.estimate_board_warp = result.board_warp_estimated;
     free_fit.num_threads = options.num_threads;
     const Camera& cam0 = cameras[0].camera;
-    StatusOr<StereoCalibration> calibration = Status::Error("");
-    if (num_cameras == 1) {
-      std::vector<StereoView> left_views = views;
-      for (StereoView& view : left_views) view.right.reset();
-      calibration = CalibrateMono(target, left_views,
-                                  {cam0.width(), cam0.height()}, free_fit);
-    } else {
+    const auto fit_freely = [&]() -> StatusOr<StereoCalibration> {
+      if (num_cameras == 1) {
+        std::vector<StereoView> left_views = views;
+        for (StereoView& view : left_views) view.right.reset();
+        return CalibrateMono(target, left_views, {cam0.width(), cam0.height()},
+                             free_fit);
+      }
       const Camera& cam1 = cameras[1].camera;
-      calibration =
-          CalibrateStereo(target, views, {cam0.width(), cam0.height()},
-                          {cam1.width(), cam1.height()}, free_fit);
-    }
+      return CalibrateStereo(target, views, {cam0.width(), cam0.height()},
+                             {cam1.width(), cam1.height()}, free_fit);
+    };
+    const StatusOr<StereoCalibration> calibration = fit_freely();
     if (calibration.ok()) {
       conventional.ok = true;
       conventional.rms_px = calibration->rms_px;

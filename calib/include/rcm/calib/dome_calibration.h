@@ -32,10 +32,13 @@
 // mean(d) / (sd(d) / sqrt(V)) over the V views (in-sample: the bow adds
 // two unknowns to thousands of corners, so its own fit improvement per
 // view is ~2 / (2 m_v) and the statistic measures whether the views
-// agree that the board bows). The chosen model is the bowed one when the
-// evidence exceeds evidence_sigmas, else the flat one; when both remain
-// plausible each decentering component's sigma is widened by the spread
-// b^2 = max(0, (C_bowed - C_flat)^2 - |s_bowed^2 - s_flat^2|) (the
+// agree that the board bows). The answer is the bowed board's, which nests
+// the flat one and is unbiased whether or not the board bows; when the
+// flat board stays plausible (evidence <= evidence_sigmas) each
+// component's sigma is widened by its weighted spread, as
+// underwater_model_selection.h weighs candidates:
+//   sigma_model^2 = w / (1 + w) b^2,  w = exp(-evidence^2 / 2),
+//   b^2 = max(0, (C_bowed - C_flat)^2 - |s_bowed^2 - s_flat^2|) (the
 // Hausman correction of nested fits), and n's likewise.
 #ifndef RCM_CALIB_DOME_CALIBRATION_H_
 #define RCM_CALIB_DOME_CALIBRATION_H_

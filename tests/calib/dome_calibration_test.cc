@@ -1,0 +1,264 @@
+#include "rcm/calib/dome_calibration.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "calib/synthetic_target_views.h"
+#include "rcm/calib/calibration_target.h"
+#include "rcm/camera/dome_port_camera.h"
+#include "support/test_budget.h"
+#include "support/test_rigs.h"
+
+namespace rcm::calib::dome_calibration_test {
+namespace {
+
+// Noise-free corners are exact to ~1e-13 px; the solve stops on a relative
+// step of 1e-14, so the decentering comes back to ~1e-12 m. The issue
+// asks for 1e-9 m.
+constexpr double kExactDecenteringTolerance = 1e-9;  // meters
+constexpr double kExactIndexTolerance = 1e-9;
+
+CalibrationTarget Checkerboard() {
+  return MakeCheckerboardTarget(9, 6, 0.04).value();
+}
+
+// The 4-inch acrylic dome.
+DomePort Dome(const Eigen::Vector3d& decentering) {
+  DomePort dome;
+  dome.inner_radius = 0.04355;
+  dome.thickness = 0.00375;
+  dome.glass_index = 1.495;
+  dome.decentering = decentering;
+  return dome;
+}
+
+// What the calibration starts from: the dome's glass, the centred dome.
+DomeCameraInput Input(const Camera& camera) {
+  return {camera, Dome(Eigen::Vector3d::Zero())};
+}
+
+// Board poses at 0.4-1.4 m: the axial decentering needs distances.
+std::vector<Rigid3d> Poses(const Camera& camera, int count, unsigned seed) {
+  return test::BoardPoses(camera, Checkerboard(), count, seed, 0.4, 1.4, 35.0,
+                          1.333);
+}
+
+// One camera's views through its dome in water of index n, on a board
+// bowed by `warp`.
+std::vector<StereoView> OneCameraViews(
+    const DomePortCamera& through, const std::vector<Rigid3d>& poses,
+    double noise_px, unsigned seed,
+    const Eigen::Vector2d& warp = Eigen::Vector2d::Zero()) {
+  std::mt19937 rng(seed);
+  const std::vector<Eigen::Vector3d> points =
+      WarpedTargetPoints(Checkerboard(), warp);
+  const test::PointProjection project = [&](const Eigen::Vector3d& p) {
+    return through.ImageFromPoint(p);
+  };
+  std::vector<StereoView> views;
+  for (const Rigid3d& pose : poses) {
+    StereoView view;
+    view.left = test::ObserveTargetWith(through.camera(), project, pose, points,
+                                        noise_px, &rng);
+    views.push_back(std::move(view));
+  }
+  return views;
+}
+
+DomeCalibrationOptions Exact() {
+  DomeCalibrationOptions options;
+  options.fit_conventional_model = false;
+  return options;
+}
+
+// The issue's range: 1-10 mm in any direction.
+std::vector<Eigen::Vector3d> Decenterings() {
+  return {{0.001, 0.0, 0.0},
+          {0.0, -0.003, 0.008},
+          {-0.002, 0.001, -0.006},
+          {0.007, 0.005, 0.0}};
+}
+
+TEST(DomeCalibration, NoiseFreeRecoversDecenteringOneCamera) {
+  const Camera camera = ::rcm::test::AlphasenseCam0();
+  const std::vector<Rigid3d> poses = Poses(camera, 12, 3);
+  for (const Eigen::Vector3d& truth : Decenterings()) {
+    const DomePortCamera through =
+        DomePortCamera::Create(camera, Dome(truth), 1.333).value();
+    const StatusOr<DomeCalibration> result =
+        CalibrateDome(OneCameraViews(through, poses, 0.0, 1), {Input(camera)},
+                      Rigid3d(), Checkerboard(), Exact());
+    ASSERT_TRUE(result.ok()) << result.status().message();
+    ASSERT_EQ(result->decentering.size(), 1u);
+    EXPECT_LT((result->decentering[0] - truth).cwiseAbs().maxCoeff(),
+              kExactDecenteringTolerance)
+        << result->decentering[0].transpose() << " vs " << truth.transpose();
+    EXPECT_LT(result->rms_px, 1e-9);
+    EXPECT_EQ(result->num_outliers, 0);
+  }
+}
+
+TEST(DomeCalibration, NoiseFreeRecoversDecenteringStereo) {
+  const StereoRig rig = ::rcm::test::AlphasenseRealisticRig();
+  const Eigen::Vector3d truth_left(0.002, -0.001, 0.007);
+  const Eigen::Vector3d truth_right(-0.001, 0.003, 0.005);
+  const DomePortCamera left =
+      DomePortCamera::Create(rig.left(), Dome(truth_left), 1.34).value();
+  const DomePortCamera right =
+      DomePortCamera::Create(rig.right(), Dome(truth_right), 1.34).value();
+  const std::vector<StereoView> views = test::ObserveStereoWith(
+      rig.left(),
+      [&](const Eigen::Vector3d& p) { return left.ImageFromPoint(p); },
+      rig.right(),
+      [&](const Eigen::Vector3d& p) { return right.ImageFromPoint(p); },
+      rig.right_from_left(), Checkerboard(), Poses(rig.left(), 12, 5), 0.0, 1);
+  DomeCalibrationOptions options = Exact();
+  options.n = 1.34;
+  const StatusOr<DomeCalibration> result =
+      CalibrateDome(views, {Input(rig.left()), Input(rig.right())},
+                    rig.right_from_left(), Checkerboard(), options);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  ASSERT_EQ(result->decentering.size(), 2u);
+  EXPECT_LT((result->decentering[0] - truth_left).cwiseAbs().maxCoeff(),
+            kExactDecenteringTolerance);
+  EXPECT_LT((result->decentering[1] - truth_right).cwiseAbs().maxCoeff(),
+            kExactDecenteringTolerance);
+  EXPECT_EQ(result->rms_px_per_camera.size(), 2u);
+}
+
+TEST(DomeCalibration, NoiseFreeRecoversNWithTheDecentering) {
+  const Camera camera = ::rcm::test::AlphasenseCam0();
+  const Eigen::Vector3d truth(0.0015, -0.001, 0.0072);
+  const DomePortCamera through =
+      DomePortCamera::Create(camera, Dome(truth), 1.341).value();
+  DomeCalibrationOptions options = Exact();
+  options.estimate_n = true;
+  options.n = 1.333;
+  const StatusOr<DomeCalibration> result =
+      CalibrateDome(OneCameraViews(through, Poses(camera, 12, 7), 0.0, 1),
+                    {Input(camera)}, Rigid3d(), Checkerboard(), options);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  EXPECT_NEAR(result->n, 1.341, kExactIndexTolerance);
+  EXPECT_LT((result->decentering[0] - truth).cwiseAbs().maxCoeff(),
+            kExactDecenteringTolerance);
+  EXPECT_TRUE(result->n_estimated);
+  // How weakly: n and the axial decentering move together.
+  EXPECT_GT(std::abs(result->correlation_n_decentering[0].z()), 0.5);
+}
+
+// 0.1 px of pixel noise: each component within 4 of its reported sigmas (a
+// two-sided 6e-5 event per component for an honest Gaussian sigma), and
+// the sigma itself small enough to be useful. The dome's decentering is
+// seen only through how its bending changes with the distance (a camera
+// displaced as a whole is a change of every board pose), so it is far
+// less precise than a lens parameter: 20 views at 0.2 px gave 0.27 mm
+// laterally and 0.49 mm axially; at 0.1 px about half that (0.31 mm at
+// most, the axial one with the bowed board's spread), bounded by 0.4 mm.
+TEST(DomeCalibration, NoisyDecenteringWithinItsSigma) {
+  const Camera camera = ::rcm::test::AlphasenseCam0();
+  const Eigen::Vector3d truth(0.002, 0.001, 0.008);
+  const DomePortCamera through =
+      DomePortCamera::Create(camera, Dome(truth), 1.333).value();
+  DomeCalibrationOptions options;
+  const StatusOr<DomeCalibration> result =
+      CalibrateDome(OneCameraViews(through, Poses(camera, 20, 11), 0.1, 2),
+                    {Input(camera)}, Rigid3d(), Checkerboard(), options);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_LT(std::abs(result->decentering[0][i] - truth[i]),
+              4.0 * result->decentering_sigma[0][i])
+        << i;
+    EXPECT_LT(result->decentering_sigma[0][i], 4e-4) << i;
+  }
+  EXPECT_NEAR(result->pixel_sigma, 0.1, 0.01);
+  ASSERT_TRUE(result->conventional.ok) << result->conventional.error;
+  // The dome's refraction is not a lens distortion: the conventional fit
+  // leaves more than the noise.
+  EXPECT_GT(result->conventional.rms_px, result->rms_px);
+  EXPECT_EQ(result->candidates.size(), 2u);
+}
+
+// The reported sigmas against the spread of 50 noisy calibrations of one
+// camera (20 views, 0.3 px), the bow estimated as on a real dive: the z
+// score of each component has standard deviation in [0.8, 1.3] (its
+// sampling error from 50 trials is ~0.1) and mean within 0.5.
+void ExpectHonestSigma(const Eigen::Vector2d& board_warp) {
+  const Camera camera = ::rcm::test::AlphasenseCam0();
+  const Eigen::Vector3d truth(0.0025, -0.0015, 0.0075);
+  const DomePortCamera through =
+      DomePortCamera::Create(camera, Dome(truth), 1.333).value();
+  const std::vector<Rigid3d> poses = Poses(camera, 20, 13);
+  DomeCalibrationOptions options;
+  options.fit_conventional_model = false;
+  const int trials = ::rcm::test::Trials(50);
+  std::vector<Eigen::Vector3d> z;
+  for (int trial = 0; trial < trials; ++trial) {
+    const StatusOr<DomeCalibration> result = CalibrateDome(
+        OneCameraViews(through, poses, 0.3, 100 + trial, board_warp),
+        {Input(camera)}, Rigid3d(), Checkerboard(), options);
+    ASSERT_TRUE(result.ok()) << result.status().message();
+    z.push_back((result->decentering[0] - truth)
+                    .cwiseQuotient(result->decentering_sigma[0]));
+  }
+  if (!::rcm::test::ChecksStatistics()) return;
+  for (int i = 0; i < 3; ++i) {
+    double sum = 0.0, squares = 0.0;
+    for (const Eigen::Vector3d& score : z) {
+      sum += score[i];
+      squares += score[i] * score[i];
+    }
+    const double mean = sum / trials;
+    const double sd = std::sqrt(squares / trials - mean * mean);
+    EXPECT_GT(sd, 0.8) << "component " << i;
+    EXPECT_LT(sd, 1.3) << "component " << i;
+    EXPECT_LT(std::abs(mean), 0.5) << "component " << i;
+  }
+}
+
+// A board bowed by 1 mm at its centre, which 0.3 px over 20 views only
+// half rule the flat board out (evidence 1.5-3.5): measured z sd 0.88,
+// 1.08, 0.84.
+TEST(DomeCalibration, MonteCarloSigmaIsHonestOnABowedBoard) {
+  ExpectHonestSigma(Eigen::Vector2d(0.0006, 0.0004));
+}
+
+TEST(DomeCalibration, MonteCarloSigmaIsHonestOnAFlatBoard) {
+  ExpectHonestSigma(Eigen::Vector2d::Zero());
+}
+
+TEST(DomeCalibration, BadInputIsOneLine) {
+  const Camera camera = ::rcm::test::AlphasenseCam0();
+  const DomePortCamera through =
+      DomePortCamera::Create(camera, Dome({0.0, 0.0, 0.005}), 1.333).value();
+  const std::vector<StereoView> views =
+      OneCameraViews(through, Poses(camera, 6, 3), 0.0, 1);
+  const auto message = [&](const std::vector<DomeCameraInput>& cameras,
+                           const DomeCalibrationOptions& options) {
+    const StatusOr<DomeCalibration> result =
+        CalibrateDome(views, cameras, Rigid3d(), Checkerboard(), options);
+    EXPECT_FALSE(result.ok());
+    const std::string text = result.ok() ? "" : result.status().message();
+    EXPECT_EQ(text.find('\n'), std::string::npos) << text;
+    return text;
+  };
+  EXPECT_NE(message({}, Exact()).find("1 or 2 cameras"), std::string::npos);
+  DomeCameraInput outside = Input(camera);
+  outside.dome.decentering = Eigen::Vector3d(0.0, 0.0, 0.05);
+  EXPECT_NE(message({outside}, Exact()).find("outside the inner sphere"),
+            std::string::npos);
+  DomeCalibrationOptions bad_n = Exact();
+  bad_n.n = 2.5;
+  EXPECT_NE(message({Input(camera)}, bad_n).find("outside [1, 2]"),
+            std::string::npos);
+  const StatusOr<DomeCalibration> few =
+      CalibrateDome(std::vector<StereoView>(views.begin(), views.begin() + 2),
+                    {Input(camera)}, Rigid3d(), Checkerboard(), Exact());
+  ASSERT_FALSE(few.ok());
+  EXPECT_NE(few.status().message().find("needs 3"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace rcm::calib::dome_calibration_test
