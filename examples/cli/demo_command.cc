@@ -32,6 +32,7 @@
 #include "rcm/stereo/epipolar.h"
 #include "rcm/stereo/stereo_rectification.h"
 #include "rcm/util/number_format.h"
+#include "glass_index_flag.h"
 #include "simulation_flags.h"
 
 namespace rcm::cli {
@@ -69,7 +70,7 @@ extern const Subcommand kDemoCommand = {
     "demo",
     "simulate a dive, estimate n from the images, plot it (no input needed)",
     kDemoUsage,
-    {__FILE__, kSimulationFlagsSource, kIndexFlagSource},
+    {__FILE__, kSimulationFlagsSource, kGlassIndexFlagSource, kIndexFlagSource},
     RunDemo};
 
 namespace {

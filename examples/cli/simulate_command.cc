@@ -20,6 +20,7 @@
 #include "rcm/sim/sequence_writer.h"
 #include "rcm/util/number_format.h"
 #include "rig_flags.h"
+#include "glass_index_flag.h"
 #include "simulation_flags.h"
 #include "target_flags.h"
 
@@ -107,7 +108,7 @@ extern const Subcommand kSimulateCommand = {
     "simulate",
     "synthetic stereo sequence through exact flat ports, with ground truth",
     kSimulateUsage,
-    {__FILE__, kSimulationFlagsSource, kIndexFlagSource, kRigFlagsSource,
+    {__FILE__, kSimulationFlagsSource, kGlassIndexFlagSource, kIndexFlagSource, kRigFlagsSource,
      kTargetFlagsSource},
     RunSimulate};
 

@@ -29,7 +29,6 @@ DEFINE_double(air_gap, 0.0,
               "port: air between the camera center and the glass, meters "
               "(0 = the paper's thin port)");
 DEFINE_double(glass_thickness, 0.0, "port: glass thickness, meters");
-DEFINE_double(glass_index, 1.49, "port: refractive index of the glass");
 DEFINE_double(port_tilt, 0.0,
               "port: tilt of the glass normal from the optical axis "
               "(pitch), degrees");

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "glass_index_flag.h"
 #include "rcm/sim/sequence_simulator.h"
 #include "rcm/stereo/stereo_rig.h"
 #include "rcm/util/status.h"
@@ -18,7 +19,6 @@ DECLARE_double(frame_rate);
 DECLARE_string(rig);
 DECLARE_double(air_gap);
 DECLARE_double(glass_thickness);
-DECLARE_double(glass_index);
 DECLARE_double(port_tilt);
 DECLARE_double(image_noise);
 DECLARE_int32(supersampling);
