@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
@@ -30,11 +31,10 @@ constexpr int kMaxWarpIterations = 30;
 // The target point (x, y) where the camera ray d meets the bowed board,
 // from the plane's hit; nullopt when Newton does not converge or the hit is
 // behind the camera. target = R^T (s d - t).
-std::optional<Eigen::Vector2d> WarpedHit(const Eigen::Matrix3d& target_from_cam,
-                                         const Eigen::Vector3d& origin,
-                                         const Eigen::Vector3d& ray,
+// `origin` and `direction` are the ray's in the target frame.
+std::optional<Eigen::Vector2d> WarpedHit(const Eigen::Vector3d& origin,
+                                         const Eigen::Vector3d& direction,
                                          const BoardWarpSurface& surface) {
-  const Eigen::Vector3d direction = target_from_cam * ray;
   if (!(std::abs(direction.z()) > 0.0)) return std::nullopt;
   double s = -origin.z() / direction.z();
   for (int i = 0; i < kMaxWarpIterations; ++i) {
@@ -54,6 +54,20 @@ std::optional<Eigen::Vector2d> WarpedHit(const Eigen::Matrix3d& target_from_cam,
   return std::nullopt;
 }
 
+// Create's checks of the texture.
+Status CheckTexture(const TargetImage& target_image) {
+  const cv::Mat& texture = target_image.image;
+  if (texture.empty() || texture.type() != CV_8UC1) {
+    return Status::Error("target image must be a non-empty 8-bit gray image");
+  }
+  const Eigen::Matrix2d linear = target_image.target_from_texture.leftCols<2>();
+  const double det = linear.determinant();
+  if (!target_image.target_from_texture.allFinite() || !(std::abs(det) > 0)) {
+    return Status::Error("target_from_texture is not invertible");
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status TargetRenderOptions::Check() const {
@@ -70,8 +84,7 @@ Status TargetRenderOptions::Check() const {
     message << "background = " << background << " must be in [0, 255]";
   } else if (num_threads < 1) {
     message << "num_threads = " << num_threads << " must be >= 1";
-  } else if (!board_warp.warp.allFinite() ||
-             !board_warp.origin.allFinite() ||
+  } else if (!board_warp.warp.allFinite() || !board_warp.origin.allFinite() ||
              !(board_warp.extent.minCoeff() > 0.0) ||
              !board_warp.extent.allFinite()) {
     message << "board_warp must be finite with a positive extent";
@@ -83,41 +96,73 @@ Status TargetRenderOptions::Check() const {
 
 StatusOr<TargetRenderer> TargetRenderer::Create(const Camera& camera,
                                                 TargetImage target_image) {
-  const cv::Mat& texture = target_image.image;
-  if (texture.empty() || texture.type() != CV_8UC1) {
-    return Status::Error("target image must be a non-empty 8-bit gray image");
-  }
-  const Eigen::Matrix2d linear = target_image.target_from_texture.leftCols<2>();
-  const double det = linear.determinant();
-  if (!target_image.target_from_texture.allFinite() || !(std::abs(det) > 0)) {
-    return Status::Error("target_from_texture is not invertible");
-  }
+  RCM_RETURN_IF_ERROR(CheckTexture(target_image));
   TargetRenderer renderer(camera, std::move(target_image));
-  const int columns = camera.width() + 1;
-  const int rows = camera.height() + 1;
+  RCM_RETURN_IF_ERROR(renderer.TraceCorners(
+      [&camera](const Eigen::Vector2d& pixel) -> std::optional<RayInMedium> {
+        const std::optional<Eigen::Vector2d> normalized =
+            camera.NormalizedFromImage(pixel);
+        if (!normalized || !normalized->allFinite()) return std::nullopt;
+        return RayInMedium{Eigen::Vector3d::Zero(),
+                           normalized->homogeneous().normalized()};
+      },
+      /*central=*/true));
+  return renderer;
+}
+
+StatusOr<TargetRenderer> TargetRenderer::Create(const DomePortCamera& camera,
+                                                TargetImage target_image) {
+  RCM_RETURN_IF_ERROR(CheckTexture(target_image));
+  TargetRenderer renderer(camera.camera(), std::move(target_image));
+  renderer.dome_camera_ = camera;
+  RCM_RETURN_IF_ERROR(renderer.TraceCorners(
+      [&camera](const Eigen::Vector2d& pixel) -> std::optional<RayInMedium> {
+        std::optional<RayInMedium> ray = camera.RayFromImage(pixel);
+        if (ray) ray->direction.normalize();
+        return ray;
+      },
+      /*central=*/false));
+  return renderer;
+}
+
+Status TargetRenderer::TraceCorners(
+    const std::function<std::optional<RayInMedium>(const Eigen::Vector2d&)>&
+        trace,
+    bool central) {
+  const int columns = camera_.width() + 1;
+  const int rows = camera_.height() + 1;
   constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
-  renderer.corner_rays_.assign(static_cast<size_t>(columns) * rows,
-                               Eigen::Vector3f::Constant(kNan));
-  std::vector<Eigen::Vector3f>& rays = renderer.corner_rays_;
+  corner_rays_.assign(static_cast<size_t>(columns) * rows,
+                      Eigen::Vector3f::Constant(kNan));
+  if (central) {
+    corner_origins_.clear();
+  } else {
+    corner_origins_.assign(corner_rays_.size(),
+                           Eigen::Vector3f::Constant(kNan));
+  }
   ParallelFor(
       rows, kCreateThreads, kMinRowsPerThread, [&](int64_t begin, int64_t end) {
         for (int64_t y = begin; y < end; ++y) {
           for (int x = 0; x < columns; ++x) {
-            const std::optional<Eigen::Vector2d> normalized =
-                camera.NormalizedFromImage(Eigen::Vector2d(x - 0.5, y - 0.5));
-            if (!normalized || !normalized->allFinite()) continue;
-            rays[y * columns + x] =
-                normalized->homogeneous().normalized().cast<float>();
+            const std::optional<RayInMedium> ray =
+                trace(Eigen::Vector2d(x - 0.5, y - 0.5));
+            if (!ray) continue;
+            corner_rays_[y * columns + x] = ray->direction.cast<float>();
+            if (!central) {
+              corner_origins_[y * columns + x] = ray->origin.cast<float>();
+            }
           }
         }
       });
   const bool any_valid =
-      std::any_of(rays.begin(), rays.end(),
+      std::any_of(corner_rays_.begin(), corner_rays_.end(),
                   [](const Eigen::Vector3f& ray) { return ray.allFinite(); });
   if (!any_valid) {
-    return Status::Error("the camera's lens cannot undistort any pixel");
+    return Status::Error(central
+                             ? "the camera's lens cannot undistort any pixel"
+                             : "no pixel's ray leaves the dome");
   }
-  return renderer;
+  return Status::Ok();
 }
 
 cv::Mat TargetRenderer::Render(const Rigid3d& cam_from_target,
@@ -153,21 +198,40 @@ cv::Mat TargetRenderer::Render(const Rigid3d& cam_from_target,
         cam_from_target.rotation.transpose();
     const Eigen::Vector3d origin =
         -(target_from_cam * cam_from_target.translation);
+    constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+    const bool central = corner_origins_.empty();
     std::vector<Eigen::Vector3d> corners(corner_rays_.size());
     ParallelFor(
         static_cast<int64_t>(height) + 1, options.num_threads,
         kMinRowsPerThread, [&](int64_t begin, int64_t end) {
           for (int64_t k = begin * columns; k < end * columns; ++k) {
             const Eigen::Vector3d ray = corner_rays_[k].cast<double>();
-            corners[k] = texture_from_ray * ray;
+            Eigen::Vector3d ray_origin = origin;
+            if (central) {
+              corners[k] = texture_from_ray * ray;
+            } else {
+              // P(s) = o_t + s d_t meets z = 0 at s; T (P_x, P_y, 1) / s.
+              ray_origin =
+                  target_from_cam * (corner_origins_[k].cast<double>() -
+                                     cam_from_target.translation);
+              const double direction_z = target_from_cam.row(2).dot(ray);
+              const double s = -ray_origin.z() / direction_z;
+              corners[k] = std::isfinite(s) && s != 0.0
+                               ? Eigen::Vector3d(
+                                     texture_from_target *
+                                     (ray_origin + s * (target_from_cam * ray))
+                                         .head<2>()
+                                         .homogeneous() /
+                                     s)
+                               : Eigen::Vector3d::Constant(kNan);
+            }
             if (!warped || !(corners[k].z() > 0.0)) continue;
-            const std::optional<Eigen::Vector2d> hit =
-                WarpedHit(target_from_cam, origin, ray, options.board_warp);
-            corners[k] = hit ? Eigen::Vector3d(
-                                   corners[k].z() *
-                                   (texture_from_target * hit->homogeneous()))
-                             : Eigen::Vector3d::Constant(
-                                   std::numeric_limits<double>::quiet_NaN());
+            const std::optional<Eigen::Vector2d> hit = WarpedHit(
+                ray_origin, target_from_cam * ray, options.board_warp);
+            corners[k] =
+                hit ? Eigen::Vector3d(corners[k].z() * (texture_from_target *
+                                                        hit->homogeneous()))
+                    : Eigen::Vector3d::Constant(kNan);
           }
         });
 
@@ -261,6 +325,19 @@ std::vector<std::optional<Eigen::Vector2d>> ProjectTargetPoints(
       pixel = camera.ProjectNormalized(in_camera.hnormalized());
       if (pixel && !camera.InImage(*pixel)) pixel.reset();
     }
+    pixels.push_back(pixel);
+  }
+  return pixels;
+}
+
+std::vector<std::optional<Eigen::Vector2d>> ProjectTargetPoints(
+    const DomePortCamera& camera, const Rigid3d& cam_from_target,
+    const CalibrationTarget& target, const Eigen::Vector2d& board_warp) {
+  std::vector<std::optional<Eigen::Vector2d>> pixels;
+  for (const Eigen::Vector3d& point : WarpedTargetPoints(target, board_warp)) {
+    std::optional<Eigen::Vector2d> pixel =
+        camera.ImageFromPoint(cam_from_target * point);
+    if (pixel && !camera.camera().InImage(*pixel)) pixel.reset();
     pixels.push_back(pixel);
   }
   return pixels;

@@ -4,14 +4,18 @@
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <optional>
 #include <vector>
 
+#include "rcm/calib/board_warp.h"
 #include "rcm/calib/calibration_target.h"
+#include "rcm/calib/target_detector.h"
 #include "rcm/calib/target_image.h"
+#include "rcm/camera/dome_port_camera.h"
 #include "rcm/sim/reference_rigs.h"
 
 namespace rcm::calib::target_renderer_test {
@@ -209,6 +213,176 @@ TEST(TargetRenderer, RenderTimeIsReported) {
   EXPECT_EQ(image.cols, 720);
 }
 
+// Through a dome port (the 4-inch acrylic dome, decentered 2 mm, -1 mm and
+// 7 mm) in water.
+DomePortCamera BehindDome(const Camera& camera,
+                          const Eigen::Vector3d& decentering) {
+  DomePort dome;
+  dome.inner_radius = 0.04355;
+  dome.thickness = 0.00375;
+  dome.glass_index = 1.495;
+  dome.decentering = decentering;
+  return DomePortCamera::Create(camera, dome, 1.333).value();
+}
+
+const Eigen::Vector3d kDecentering(0.002, -0.001, 0.007);
+
+// The point of the target plane that pixel position `pixel` sees through
+// the dome under a frontal pose: P = o - t + s d on z = 0.
+Eigen::Vector2d TargetSeenThroughDomeAt(const DomePortCamera& camera,
+                                        const Rigid3d& pose,
+                                        const Eigen::Vector2d& pixel) {
+  const RayInMedium ray = *camera.RayFromImage(pixel);
+  const Eigen::Vector3d origin = ray.origin - pose.translation;
+  return (origin - origin.z() / ray.direction.z() * ray.direction).head<2>();
+}
+
+// As PixelInsideOneSquareHasExactlyItsColour: the corner rays are the
+// dome's exact ones, so a pixel whose four corners see one square is that
+// square's colour.
+TEST(TargetRenderer, DomePixelInsideOneSquareHasExactlyItsColour) {
+  const DomePortCamera camera = BehindDome(SmallPinhole(), kDecentering);
+  const TargetImage texture = DrawTargetImage(Checkerboard(), 2000.0);
+  const TargetRenderer renderer =
+      TargetRenderer::Create(camera, texture).value();
+  ASSERT_TRUE(renderer.dome_camera().has_value());
+  const Rigid3d pose = Frontal(0.8);
+  TargetRenderOptions options;
+  options.background = 77;
+  const cv::Mat image = renderer.Render(pose, options);
+  int uniform = 0;
+  int off_target = 0;
+  for (int y = 0; y < image.rows; ++y) {
+    for (int x = 0; x < image.cols; ++x) {
+      int values[4];
+      for (int k = 0; k < 4; ++k) {
+        values[k] = TextureAt(
+            texture, TargetSeenThroughDomeAt(
+                         camera, pose,
+                         Eigen::Vector2d(x - 0.5 + (k & 1), y - 0.5 + k / 2)));
+      }
+      const bool same = values[0] == values[1] && values[1] == values[2] &&
+                        values[2] == values[3];
+      if (!same) continue;
+      const int expected = values[0] < 0 ? 77 : values[0];
+      EXPECT_EQ(image.at<uint8_t>(y, x), expected) << x << ", " << y;
+      ++(values[0] < 0 ? off_target : uniform);
+    }
+  }
+  EXPECT_GT(uniform, 1000);
+  EXPECT_GT(off_target, 100);
+  // Behind the camera: background.
+  options.background = 33;
+  EXPECT_EQ(cv::countNonZero(renderer.Render(Frontal(-0.8), options) != 33), 0);
+}
+
+// A centred dome does not refract: its image is the air camera's, up to
+// the blend's weights (w = 1 / s from the dome's outer surface, not the
+// camera centre), which move a sub-sample by far less than a pixel.
+TEST(TargetRenderer, CentredDomeRendersTheAirImage) {
+  const Camera camera = AlphasenseFrontCam0();
+  const TargetImage texture = DrawTargetImage(Checkerboard(), 2000.0);
+  const TargetRenderer air = TargetRenderer::Create(camera, texture).value();
+  const TargetRenderer dome =
+      TargetRenderer::Create(BehindDome(camera, Eigen::Vector3d::Zero()),
+                             texture)
+          .value();
+  Rigid3d pose = Frontal(0.5);
+  pose.rotation =
+      Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  TargetRenderOptions options;
+  options.board_warp =
+      BoardWarpSurfaceOf(Checkerboard(), Eigen::Vector2d(0.002, -0.001));
+  cv::Mat difference;
+  cv::absdiff(air.Render(pose, options), dome.Render(pose, options),
+              difference);
+  double max_difference = 0.0;
+  cv::minMaxLoc(difference, nullptr, &max_difference);
+  EXPECT_LE(max_difference, 1.0);
+}
+
+// Detected corners on renders through a decentered dome against
+// DomePortCamera::ImageFromPoint of the true corners: the detector's
+// tolerance class of target_detector_test.cc (median 0.1 px, max 0.35 px
+// for the chessboard on 4x4 supersampled renders, blur 0.5 px, noise 2
+// gray levels).
+TEST(TargetRenderer, DomeCornersAreDetectedWhereTheyProject) {
+  constexpr double kToleranceMedianPx = 0.1;
+  constexpr double kToleranceMaxPx = 0.35;
+  const CalibrationTarget target = MakeCheckerboardTarget(8, 5, 0.04).value();
+  const DomePortCamera camera = BehindDome(AlphasenseFrontCam0(), kDecentering);
+  const TargetRenderer renderer =
+      TargetRenderer::Create(camera, DrawTargetImage(target, 4000.0)).value();
+  // The board's centre at (cx, cy, z), tilted about x and y.
+  const double views[][5] = {{0.0, 0.0, 0.55, 0.0, 0.0},
+                             {0.05, -0.03, 0.6, 0.35, -0.3},
+                             {-0.08, 0.06, 0.5, -0.3, 0.35}};
+  const Eigen::Vector3d centre(0.5 * 7 * 0.04 - 0.02, 0.5 * 4 * 0.04 - 0.02,
+                               0.0);
+  std::vector<double> errors;
+  int missing = 0;
+  uint64_t seed = 1;
+  for (const auto& view : views) {
+    Rigid3d pose;
+    pose.rotation = (Eigen::AngleAxisd(view[3], Eigen::Vector3d::UnitX()) *
+                     Eigen::AngleAxisd(view[4], Eigen::Vector3d::UnitY()))
+                        .toRotationMatrix();
+    pose.translation =
+        Eigen::Vector3d(view[0], view[1], view[2]) - pose.rotation * centre;
+    TargetRenderOptions options;
+    options.blur_sigma_px = 0.5;
+    options.noise_sigma = 2.0;
+    options.seed = seed++;
+    const std::optional<TargetObservation> observation =
+        DetectTarget(renderer.Render(pose, options), target);
+    ASSERT_TRUE(observation.has_value()) << "view " << seed - 1;
+    const std::vector<std::optional<Eigen::Vector2d>> truth =
+        ProjectTargetPoints(camera, pose, target);
+    int visible = 0;
+    for (const auto& pixel : truth) visible += pixel.has_value();
+    missing += visible - observation->size();
+    for (int k = 0; k < observation->size(); ++k) {
+      const std::optional<Eigen::Vector2d>& pixel =
+          truth[observation->point_ids[k]];
+      ASSERT_TRUE(pixel.has_value()) << observation->point_ids[k];
+      errors.push_back((observation->pixels[k] - *pixel).norm());
+    }
+  }
+  std::sort(errors.begin(), errors.end());
+  ASSERT_FALSE(errors.empty());
+  const double median = errors[errors.size() / 2];
+  std::printf(
+      "chessboard through a dome: %zu corners, %d missed, median "
+      "%.3f px, max %.3f px\n",
+      errors.size(), missing, median, errors.back());
+  EXPECT_EQ(missing, 0);
+  EXPECT_LT(median, kToleranceMedianPx);
+  EXPECT_LT(errors.back(), kToleranceMaxPx);
+}
+
+TEST(TargetRenderer, ProjectTargetPointsThroughADomeAgreesWithTheDome) {
+  const DomePortCamera camera = BehindDome(AlphasenseFrontCam0(), kDecentering);
+  const CalibrationTarget target = Checkerboard();
+  Rigid3d pose;
+  pose.rotation =
+      Eigen::AngleAxisd(0.4, Eigen::Vector3d(0.3, 1.0, 0.2).normalized())
+          .toRotationMatrix();
+  pose.translation = Eigen::Vector3d(-0.1, -0.05, 0.4);
+  const Eigen::Vector2d warp(0.001, 0.0005);
+  const std::vector<std::optional<Eigen::Vector2d>> pixels =
+      ProjectTargetPoints(camera, pose, target, warp);
+  const std::vector<Eigen::Vector3d> points = WarpedTargetPoints(target, warp);
+  ASSERT_EQ(pixels.size(), points.size());
+  for (size_t k = 0; k < points.size(); ++k) {
+    ASSERT_TRUE(pixels[k].has_value()) << k;
+    EXPECT_EQ(*pixels[k], *camera.ImageFromPoint(pose * points[k]));
+  }
+  for (const std::optional<Eigen::Vector2d>& pixel :
+       ProjectTargetPoints(camera, Frontal(-0.5), target)) {
+    EXPECT_FALSE(pixel.has_value());
+  }
+}
+
 TEST(TargetRenderer, CreateRejectsBadTexture) {
   TargetImage empty;
   EXPECT_EQ(TargetRenderer::Create(SmallPinhole(), empty).status().message(),
@@ -217,6 +391,11 @@ TEST(TargetRenderer, CreateRejectsBadTexture) {
   singular.target_from_texture.setZero();
   EXPECT_EQ(TargetRenderer::Create(SmallPinhole(), singular).status().message(),
             "target_from_texture is not invertible");
+  EXPECT_EQ(
+      TargetRenderer::Create(BehindDome(SmallPinhole(), kDecentering), singular)
+          .status()
+          .message(),
+      "target_from_texture is not invertible");
 }
 
 TEST(TargetRenderOptions, Check) {

@@ -1,5 +1,6 @@
 // Synthetic images of a printed calibration target seen through an in-air
-// camera, with the exact corner positions to compare detectors against.
+// camera, or through a dome port under water, with the exact corner
+// positions to compare detectors against.
 //
 // Each pixel (x, y) (centers at integers) is split into s x s sub-samples
 // at (x + (i + 0.5) / s - 0.5, y + (j + 0.5) / s - 0.5), i, j = 0 .. s - 1.
@@ -36,6 +37,22 @@
 // flat board when the warp is 0. A corner whose iteration does not
 // converge (a ray grazing the board) is background.
 //
+// Through a dome port (Create from a DomePortCamera, dome_port_camera.h):
+// the rays do not leave the camera centre. Create traces each pixel
+// corner's ray in the medium, origin o (on the dome's outer surface) and
+// unit direction d, camera frame; per render it meets the target plane at
+//
+//   P(s) = o_t + s d_t,  o_t = R^T (o - t),  d_t = R^T d,
+//   s = -o_t,z / d_t,z,  target point (P_x, P_y),
+//
+// and its homogeneous texture point is T (P_x, P_y, 1) / s: for o = 0 that
+// is the central [r1 r2 t]^-1 d above (whose w is 1 / s for a unit d), so
+// the sub-samples blend as for the air camera, with the plane behind the
+// ray's origin (s < 0) background as behind the camera. The bowed board
+// is met by the same Newton from o_t. The corner rays are exact; only the
+// blend inside a pixel is bilinear (the dome bends rays smoothly over a
+// pixel, so it adds nothing measurable to the air lens's ~0.002 px).
+//
 // Noise: the draw of pixel p is a function of (seed, p) only (SplitMix64
 // counter hash, Box-Muller), so images are identical for any num_threads.
 #ifndef RCM_CALIB_TARGET_RENDERER_H_
@@ -43,6 +60,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <utility>
@@ -52,6 +70,7 @@
 #include "rcm/calib/calibration_target.h"
 #include "rcm/calib/target_image.h"
 #include "rcm/camera/camera.h"
+#include "rcm/camera/dome_port_camera.h"
 #include "rcm/geometry/rigid3d.h"
 #include "rcm/util/status.h"
 
@@ -77,24 +96,45 @@ class TargetRenderer {
   // be undistorted.
   static StatusOr<TargetRenderer> Create(const Camera& camera,
                                          TargetImage target_image);
+  // Through a dome port (header): the same, with the rays in the medium
+  // of `camera`; fails too when no pixel's ray leaves the dome.
+  static StatusOr<TargetRenderer> Create(const DomePortCamera& camera,
+                                         TargetImage target_image);
 
   // An 8-bit gray image (CV_8UC1) of the camera's size. CHECKs
   // options.Check().
   cv::Mat Render(const Rigid3d& cam_from_target,
                  const TargetRenderOptions& options) const;
 
+  // The lens (behind the dome when there is one).
   const Camera& camera() const { return camera_; }
+  // The dome the renderer traces through; nullopt in air.
+  const std::optional<DomePortCamera>& dome_camera() const {
+    return dome_camera_;
+  }
   const TargetImage& target_image() const { return target_image_; }
 
  private:
   TargetRenderer(const Camera& camera, TargetImage target_image)
       : camera_(camera), target_image_(std::move(target_image)) {}
 
+  // The pixel corners' rays through `ray` (origin, unit direction; nullopt
+  // where there is none), and the error when no corner has one.
+  Status TraceCorners(
+      const std::function<std::optional<RayInMedium>(const Eigen::Vector2d&)>&
+          ray,
+      bool central);
+
   Camera camera_;
+  std::optional<DomePortCamera> dome_camera_;
   TargetImage target_image_;
   // Unit ray direction of pixel corner (x - 0.5, y - 0.5) at index
-  // y * (width + 1) + x; NaN where the lens cannot undistort it.
+  // y * (width + 1) + x; NaN where the lens cannot undistort it (or the
+  // ray does not leave the dome).
   std::vector<Eigen::Vector3f> corner_rays_;
+  // Through a dome, the rays' origins (camera frame, meters) at the same
+  // indices; empty for the central air camera.
+  std::vector<Eigen::Vector3f> corner_origins_;
 };
 
 // The ground-truth pixel of each TargetPoints(target) point seen by
@@ -104,6 +144,13 @@ class TargetRenderer {
 // (WarpedTargetPoints).
 std::vector<std::optional<Eigen::Vector2d>> ProjectTargetPoints(
     const Camera& camera, const Rigid3d& cam_from_target,
+    const CalibrationTarget& target,
+    const Eigen::Vector2d& board_warp = Eigen::Vector2d::Zero());
+// The same through a dome port (DomePortCamera::ImageFromPoint): nullopt
+// for a point no forward ray reaches, one the lens cannot project, or
+// outside the image.
+std::vector<std::optional<Eigen::Vector2d>> ProjectTargetPoints(
+    const DomePortCamera& camera, const Rigid3d& cam_from_target,
     const CalibrationTarget& target,
     const Eigen::Vector2d& board_warp = Eigen::Vector2d::Zero());
 
