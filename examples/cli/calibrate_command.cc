@@ -18,6 +18,10 @@
 
 #include "air_flag.h"
 #include "air_gap_flag.h"
+#include "calibrate_dome.h"
+#include "dome_port_flags.h"
+#include "glass_index_flag.h"
+#include "index_flag.h"
 #include "air_views_flags.h"
 #include "calibrate_underwater.h"
 #include "calibration_input.h"
@@ -170,7 +174,8 @@ extern const Subcommand kCalibrateCommand = {
     {__FILE__, kImageInputFlagsSource, kCalibrationInputFlagsSource,
      kTargetFlagsSource, kLensModelFlagSource, kUnderwaterFlagsSource,
      kAirGapFlagSource, kAirFlagSource, kAirViewsFlagsSource,
-     kMediumFlagSource},
+     kMediumFlagSource, kDomeCalibrationFlagsSource, kDomePortFlagsSource,
+     kGlassIndexFlagSource, kIndexFlagSource},
     RunCalibrate};
 
 namespace {
@@ -264,6 +269,11 @@ int RunCalibrate() {
                "--air, --air-left/--air-right/--air-corners, --air-target, "
                "--same-board, --estimate-air-gap, --estimate-port-tilt, "
                "--thin-port and --medium go with --underwater");
+    return kExitUsage;
+  }
+  if (const Status status = CheckNoDomeFlags("an air calibration");
+      !status.ok()) {
+    PrintError(command, status.message());
     return kExitUsage;
   }
 

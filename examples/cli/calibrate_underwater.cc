@@ -18,8 +18,10 @@
 #include "air_flag.h"
 #include "air_gap_flag.h"
 #include "air_views_flags.h"
+#include "calibrate_dome.h"
 #include "calibration_input.h"
 #include "calibration_run.h"
+#include "dome_port_flags.h"
 #include "image_input_flags.h"
 #include "medium_flag.h"
 #include "progress.h"
@@ -95,11 +97,10 @@ nlohmann::json Vector3Json(const Eigen::Vector3d& v) {
 // The report's pictures and table: the underwater corners drawn as the
 // air calibration's are (calibration_report.h), through a StereoCalibration
 // that holds the underwater solution's residuals and poses.
-Status WriteUnderwaterReport(const std::string& folder,
-                             const UnderwaterCalibration& result,
-                             const std::vector<StereoView>& views,
-                             const ImageSize sizes[2], bool one_camera,
-                             calib::CalibrationReport* report) {
+// The drawing of an underwater result for the report: its lenses, poses
+// and corners as a calibration's.
+calib::StereoCalibration UnderwaterDrawing(
+    const UnderwaterCalibration& result) {
   calib::StereoCalibration drawing(result.rig.left(), result.rig.right());
   drawing.cam1_from_cam0 = result.rig.right_from_left();
   drawing.cam0_from_target = result.cam0_from_target;
@@ -111,6 +112,16 @@ Status WriteUnderwaterReport(const std::string& folder,
   drawing.num_stereo_views = result.num_stereo_views;
   drawing.num_inliers = result.num_inliers;
   drawing.num_outliers = result.num_outliers;
+  return drawing;
+}
+
+}  // namespace
+
+Status WriteUnderwaterReport(const std::string& folder,
+                             const calib::StereoCalibration& drawing,
+                             const std::vector<StereoView>& views,
+                             const ImageSize sizes[2], bool one_camera,
+                             calib::CalibrationReport* report) {
   *report = calib::SummarizeCalibration(drawing, views, sizes[0], sizes[1]);
   std::error_code error;
   std::filesystem::create_directories(folder, error);
@@ -133,6 +144,8 @@ Status WriteUnderwaterReport(const std::string& folder,
   return WriteFileAtomically((dir / "per_view.csv").string(),
                              calib::FormatPerViewCsv(*report));
 }
+
+namespace {
 
 // The candidates as the JSON lists them.
 nlohmann::json CandidatesJson(const UnderwaterModelSelection& selection) {
@@ -212,6 +225,15 @@ int RunCalibrateUnderwater(const Subcommand& command,
                            const calib::CalibrationTarget& target,
                            const CalibrationOutputPaths& paths,
                            const UnderwaterRunOptions& run) {
+  // A dome (--port dome, or dome blocks in the air camchain) has its own
+  // calibration: the decentering, with n held or estimated.
+  if (DomePortRequested() || AirCamchainHasDomes()) {
+    return RunCalibrateDome(command, target, paths, run);
+  }
+  if (const Status status = CheckNoDomeFlags("a flat port"); !status.ok()) {
+    PrintError(command, status.message());
+    return kExitUsage;
+  }
   const auto start = std::chrono::steady_clock::now();
   if (FLAGS_air.empty()) {
     PrintError(command,
@@ -352,8 +374,9 @@ int RunCalibrateUnderwater(const Subcommand& command,
 
   // The report first, the camchain last.
   calib::CalibrationReport report;
-  if (const Status status = WriteUnderwaterReport(paths.report, *result, views,
-                                                  sizes, one_camera, &report);
+  if (const Status status =
+          WriteUnderwaterReport(paths.report, UnderwaterDrawing(*result), views,
+                                sizes, one_camera, &report);
       !status.ok()) {
     PrintError(command, status.message());
     return kExitFailure;

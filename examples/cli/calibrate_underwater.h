@@ -6,9 +6,14 @@
 
 #include <gflags/gflags.h>
 
+#include <string>
+#include <vector>
+
 #include "calibration_run.h"
 #include "command.h"
+#include "rcm/calib/calibration_report.h"
 #include "rcm/calib/calibration_target.h"
+#include "rcm/calib/stereo_calibration.h"
 
 DECLARE_bool(underwater);
 DECLARE_bool(estimate_port_tilt);
@@ -34,6 +39,15 @@ int RunCalibrateUnderwater(const Subcommand& command,
                            const calib::CalibrationTarget& target,
                            const CalibrationOutputPaths& paths,
                            const UnderwaterRunOptions& options);
+
+// The report folder of an underwater calibration: the residual fields and
+// coverage of each camera, the per-view RMS plot and CSV, from `drawing`
+// (the result's lenses, poses and corners as a calibration's).
+Status WriteUnderwaterReport(const std::string& folder,
+                             const calib::StereoCalibration& drawing,
+                             const std::vector<calib::StereoView>& views,
+                             const calib::ImageSize sizes[2], bool one_camera,
+                             calib::CalibrationReport* report);
 
 }  // namespace rcm::cli
 
