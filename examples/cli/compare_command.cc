@@ -11,6 +11,7 @@
 #include <string>
 
 #include "air_flag.h"
+#include "camera_flag.h"
 #include "command.h"
 #include "rcm/estimation/calibration_comparison.h"
 #include "rcm/io/atomic_file.h"
@@ -22,9 +23,6 @@
 DEFINE_string(water, "",
               "the underwater calibration of the same camera: a Kalibr "
               "camchain or a ROS camera_info");
-DEFINE_string(camera, "cam0",
-              "the camera to compare, in each file that is a camchain "
-              "(a camera_info has one)");
 DEFINE_bool(shift, true,
             "also estimate a shift of the air calibration's principal point");
 DEFINE_double(inset, 0.05,
@@ -90,7 +88,7 @@ extern const Subcommand kCompareCommand = {
     "compare",
     "n implied by an air and an underwater calibration of one camera",
     kCompareUsage,
-    {__FILE__, kAirFlagSource},
+    {__FILE__, kAirFlagSource, kCameraFlagSource},
     RunCompare};
 
 namespace {

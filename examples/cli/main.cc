@@ -15,6 +15,7 @@ namespace rcm::cli {
 extern const Subcommand kCalibrateCommand;
 extern const Subcommand kCompareCommand;
 extern const Subcommand kDemoCommand;
+extern const Subcommand kDomeCheckCommand;
 extern const Subcommand kEstimateCommand;
 extern const Subcommand kExportCommand;
 extern const Subcommand kSimulateCommand;
@@ -27,9 +28,9 @@ using rcm::cli::Subcommand;
 
 const Subcommand* const kSubcommands[] = {
     &rcm::cli::kCalibrateCommand, &rcm::cli::kCompareCommand,
-    &rcm::cli::kDemoCommand,      &rcm::cli::kEstimateCommand,
-    &rcm::cli::kExportCommand,    &rcm::cli::kSimulateCommand,
-    &rcm::cli::kUndistortCommand};
+    &rcm::cli::kDemoCommand,      &rcm::cli::kDomeCheckCommand,
+    &rcm::cli::kEstimateCommand,  &rcm::cli::kExportCommand,
+    &rcm::cli::kSimulateCommand,  &rcm::cli::kUndistortCommand};
 
 void PrintUsage(std::ostream& out) {
   out << "rcm: the refractive index of the water from a stereo camera "

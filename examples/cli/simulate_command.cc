@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "command.h"
+#include "depth_range_flag.h"
 #include "index_flag.h"
 #include "number_list_flag.h"
 #include "progress.h"
@@ -33,10 +34,6 @@ DEFINE_double(match_noise, 0.0,
               "deviation in pixels");
 DEFINE_double(outliers, 0.0,
               "fraction of each frame's matches replaced by gross outliers");
-DEFINE_string(depth_range, "",
-              "MIN,MAX in meters: sample the matches at depths uniform in "
-              "[MIN, MAX] on random left pixels' rays instead of on the "
-              "tank's surfaces (needs --noimages)");
 DEFINE_string(exposure_delay, "",
               "MS,DEG_S[,M_S]: the right camera exposes MS milliseconds "
               "after the left (cameras not triggered together, e.g. a "
@@ -108,7 +105,7 @@ extern const Subcommand kSimulateCommand = {
     "simulate",
     "synthetic stereo sequence through exact flat ports, with ground truth",
     kSimulateUsage,
-    {__FILE__, kSimulationFlagsSource, kGlassIndexFlagSource, kIndexFlagSource, kRigFlagsSource,
+    {__FILE__, kDepthRangeFlagSource, kSimulationFlagsSource, kGlassIndexFlagSource, kIndexFlagSource, kRigFlagsSource,
      kTargetFlagsSource},
     RunSimulate};
 
