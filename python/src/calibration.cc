@@ -4,18 +4,21 @@
 #include <pybind11/stl.h>
 
 #include <cmath>
+#include <sstream>
 
 #include "bindings.h"
 #include "conversions.h"
 #include "errors.h"
 #include "options.h"
 #include "rcm/calib/calibration_target.h"
+#include "rcm/calib/dome_calibration.h"
 #include "rcm/calib/mono_calibration.h"
 #include "rcm/calib/stereo_calibration.h"
 #include "rcm/calib/target_detector.h"
 #include "rcm/calib/target_image.h"
 #include "rcm/calib/target_renderer.h"
 #include "rcm/calib/underwater_calibration.h"
+#include "rcm/camera/dome_port_geometry.h"
 #include "rcm/io/image_file.h"
 
 namespace rcm::python {
@@ -178,15 +181,16 @@ ImageSize SizeFrom(const std::pair<int, int>& size) {
 // bundle adjustment's robust loss, outlier rounds, solver and threads.
 template <typename Options>
 std::vector<OptionField> BoardAdjustmentFields(Options* o) {
-  return {DoubleOption("huber_px", &o->huber_px),
-          DoubleOption("outlier_sigmas", &o->outlier_sigmas),
-          DoubleOption("min_outlier_threshold_px", &o->min_outlier_threshold_px),
-          IntOption("max_outlier_rounds", &o->max_outlier_rounds),
-          IntOption("max_num_iterations", &o->max_num_iterations),
-          BoolOption("use_single_camera_views", &o->use_single_camera_views),
-          IntOption("min_corners_per_view", &o->min_corners_per_view),
-          BoolOption("estimate_board_warp", &o->estimate_board_warp),
-          IntOption("num_threads", &o->num_threads)};
+  return {
+      DoubleOption("huber_px", &o->huber_px),
+      DoubleOption("outlier_sigmas", &o->outlier_sigmas),
+      DoubleOption("min_outlier_threshold_px", &o->min_outlier_threshold_px),
+      IntOption("max_outlier_rounds", &o->max_outlier_rounds),
+      IntOption("max_num_iterations", &o->max_num_iterations),
+      BoolOption("use_single_camera_views", &o->use_single_camera_views),
+      IntOption("min_corners_per_view", &o->min_corners_per_view),
+      BoolOption("estimate_board_warp", &o->estimate_board_warp),
+      IntOption("num_threads", &o->num_threads)};
 }
 
 calib::StereoCalibrationOptions StereoOptionsFrom(
@@ -295,6 +299,120 @@ UnderwaterResult RunUnderwater(
     }
   }
   return result;
+}
+
+calib::DomeCalibrationOptions DomeOptionsFrom(const py::kwargs& kwargs,
+                                              const std::string& function) {
+  calib::DomeCalibrationOptions o;
+  const std::vector<OptionField> fields = {
+      BoolOption("estimate_n", &o.estimate_n),
+      DoubleOption("n", &o.n),
+      BoolOption("estimate_board_warp", &o.estimate_board_warp),
+      DoubleOption("evidence_sigmas", &o.evidence_sigmas),
+      DoubleOption("huber_px", &o.huber_px),
+      DoubleOption("outlier_sigmas", &o.outlier_sigmas),
+      DoubleOption("min_outlier_threshold_px", &o.min_outlier_threshold_px),
+      IntOption("max_outlier_rounds", &o.max_outlier_rounds),
+      IntOption("max_num_iterations", &o.max_num_iterations),
+      IntOption("min_corners_per_view", &o.min_corners_per_view),
+      BoolOption("fit_conventional_model", &o.fit_conventional_model),
+      IntOption("num_threads", &o.num_threads)};
+  ApplyOptions(kwargs, fields, function);
+  ThrowIfError(o.Check());
+  return o;
+}
+
+// One object or a list of them (1 or 2) of the bound class T.
+template <typename T>
+std::vector<T> OneOrTwo(const py::handle& object, const std::string& name,
+                        const std::string& type) {
+  std::vector<T> items;
+  if (py::isinstance<T>(object)) {
+    items.push_back(object.cast<T>());
+    return items;
+  }
+  if (!py::isinstance<py::sequence>(object) ||
+      py::isinstance<py::str>(object)) {
+    ThrowTypeError(name + " must be an rcm." + type + " or a list of 1 or 2");
+  }
+  for (const py::handle item : py::reinterpret_borrow<py::sequence>(object)) {
+    if (!py::isinstance<T>(item)) {
+      ThrowTypeError(name + " must hold rcm." + type + " objects");
+    }
+    items.push_back(item.cast<T>());
+  }
+  if (items.empty() || items.size() > 2) {
+    ThrowValueError(name + " must hold 1 or 2 cameras' " + type + ", got " +
+                    std::to_string(items.size()));
+  }
+  return items;
+}
+
+// The inputs of CalibrateDome from the Python arguments.
+struct DomeInputs {
+  std::vector<calib::DomeCameraInput> cameras;
+  Rigid3d cam1_from_cam0;
+};
+
+DomeInputs DomeInputsFrom(const py::handle& lenses, const py::handle& domes,
+                          const py::object& cam1_from_cam0) {
+  const std::vector<Camera> cameras =
+      OneOrTwo<Camera>(lenses, "cameras", "Camera");
+  const std::vector<DomePort> ports =
+      OneOrTwo<DomePort>(domes, "domes", "DomePort");
+  if (cameras.size() != ports.size()) {
+    ThrowValueError("cameras and domes differ in length (" +
+                    std::to_string(cameras.size()) + " and " +
+                    std::to_string(ports.size()) + ")");
+  }
+  DomeInputs inputs;
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    inputs.cameras.push_back({cameras[c], ports[c]});
+  }
+  if (cameras.size() == 2) {
+    if (cam1_from_cam0.is_none()) {
+      ThrowValueError(
+          "two cameras need cam1_from_cam0 (4x4, the air calibration's)");
+    }
+    inputs.cam1_from_cam0 = ValueOrThrow(Rigid3d::FromMatrix(
+        Matrix4FromPython(cam1_from_cam0, "cam1_from_cam0")));
+  } else if (!cam1_from_cam0.is_none()) {
+    ThrowValueError("cam1_from_cam0 is for two cameras; one was given");
+  }
+  return inputs;
+}
+
+struct DomeResult {
+  calib::DomeCalibration calibration;
+  std::vector<std::string> notes;
+};
+
+DomeResult RunDome(const CalibrationTarget& target,
+                   const std::vector<StereoView>& views,
+                   const DomeInputs& inputs,
+                   const calib::DomeCalibrationOptions& options) {
+  StatusOr<calib::DomeCalibration> calibration = Status::Error("not run");
+  {
+    py::gil_scoped_release release;
+    calibration = calib::CalibrateDome(views, inputs.cameras,
+                                       inputs.cam1_from_cam0, target, options);
+  }
+  DomeResult result{ValueOrThrow(std::move(calibration)), {}};
+  for (const StereoView& view : views) {
+    if (!view.note.empty()) {
+      result.notes.push_back(view.left_name + ": " + view.note);
+    }
+  }
+  return result;
+}
+
+// Per camera 3-vectors as (K, 3).
+DoubleArray PerCamera(const std::vector<Eigen::Vector3d>& vectors) {
+  DoubleArray a = NewArray(static_cast<int64_t>(vectors.size()), 3);
+  for (size_t c = 0; c < vectors.size(); ++c) {
+    for (int k = 0; k < 3; ++k) a.mutable_data()[3 * c + k] = vectors[c][k];
+  }
+  return a;
 }
 
 DoubleArray Sigmas(const calib::CameraCalibration& c) {
@@ -810,6 +928,248 @@ calibrate_stereo_from_corners; the image sizes are the air rig's).
       },
       py::arg("target"), py::arg("views"), py::arg("air_rig"),
       underwater_corners_doc.c_str());
+
+  py::class_<DomeResult>(module, "DomeCalibrationResult", R"doc(
+The result of calibrate_dome: per camera (K = 1 or 2) decentering (K, 3),
+the dome's centre in the camera frame, meters; decentering_sigma (K, 3),
+total (noise and the spread over candidate board models), meters;
+decentering_sigma_model (K, 3), the spread alone; decentering_covariance
+(K, 3, 3), m^2; n (estimated or held), sigma_n (total, 0 when held),
+sigma_n_model, n_estimated, correlation_n_decentering (K, 3); rms_px (all
+corners that project), inlier_rms_px, rms_px_per_camera (K,), pixel_sigma
+(corner noise per axis), conventional_rms_px (a conventional lens fitted
+freely to the same corners, no dome; None when not fitted or failed),
+conventional (dict: ok, error, model, rms_px, inlier_rms_px, pixel_sigma,
+num_parameters), candidates (list of dicts: name, board_warp,
+decentering (K, 3), decentering_sigma (K, 3), n, sigma_n, rms_px,
+pixel_sigma, evidence, plausible), chosen (index), rule (one line),
+board_warp_estimated, board_warp and board_warp_sigma (meters),
+cam0_from_target (per input view 4x4 meters or None), num_views_used,
+num_inliers, num_outliers, num_parameters, notes.
+)doc")
+      .def_property_readonly("decentering",
+                             [](const DomeResult& r) {
+                               return PerCamera(r.calibration.decentering);
+                             })
+      .def_property_readonly(
+          "decentering_sigma",
+          [](const DomeResult& r) {
+            return PerCamera(r.calibration.decentering_sigma);
+          })
+      .def_property_readonly(
+          "decentering_sigma_model",
+          [](const DomeResult& r) {
+            return PerCamera(r.calibration.decentering_sigma_model);
+          })
+      .def_property_readonly(
+          "decentering_covariance",
+          [](const DomeResult& r) {
+            const auto& covariances = r.calibration.decentering_covariance;
+            DoubleArray a(std::vector<py::ssize_t>{
+                static_cast<py::ssize_t>(covariances.size()), 3, 3});
+            for (size_t c = 0; c < covariances.size(); ++c) {
+              for (int i = 0; i < 3; ++i) {
+                for (int j = 0; j < 3; ++j) {
+                  a.mutable_data()[9 * c + 3 * i + j] = covariances[c](i, j);
+                }
+              }
+            }
+            return a;
+          })
+      .def_property_readonly(
+          "correlation_n_decentering",
+          [](const DomeResult& r) {
+            return PerCamera(r.calibration.correlation_n_decentering);
+          })
+      .def_property_readonly(
+          "n", [](const DomeResult& r) { return r.calibration.n; })
+      .def_property_readonly(
+          "sigma_n", [](const DomeResult& r) { return r.calibration.sigma_n; })
+      .def_property_readonly(
+          "sigma_n_model",
+          [](const DomeResult& r) { return r.calibration.sigma_n_model; })
+      .def_property_readonly(
+          "n_estimated",
+          [](const DomeResult& r) { return r.calibration.n_estimated; })
+      .def_property_readonly(
+          "rms_px", [](const DomeResult& r) { return r.calibration.rms_px; })
+      .def_property_readonly(
+          "inlier_rms_px",
+          [](const DomeResult& r) { return r.calibration.inlier_rms_px; })
+      .def_property_readonly(
+          "rms_px_per_camera",
+          [](const DomeResult& r) { return r.calibration.rms_px_per_camera; })
+      .def_property_readonly(
+          "pixel_sigma",
+          [](const DomeResult& r) { return r.calibration.pixel_sigma; })
+      .def_property_readonly("conventional_rms_px",
+                             [](const DomeResult& r) -> py::object {
+                               const calib::ConventionalFit& f =
+                                   r.calibration.conventional;
+                               if (!f.ok) return py::none();
+                               return py::float_(f.rms_px);
+                             })
+      .def_property_readonly("conventional",
+                             [](const DomeResult& r) {
+                               const calib::ConventionalFit& f =
+                                   r.calibration.conventional;
+                               py::dict d;
+                               d["ok"] = f.ok;
+                               d["error"] = f.error;
+                               d["model"] = std::string(LensModelName(f.model));
+                               d["rms_px"] = f.rms_px;
+                               d["inlier_rms_px"] = f.inlier_rms_px;
+                               d["pixel_sigma"] = f.pixel_sigma;
+                               d["num_parameters"] = f.num_parameters;
+                               return d;
+                             })
+      .def_property_readonly(
+          "candidates",
+          [](const DomeResult& r) {
+            py::list list;
+            for (const calib::DomeCandidate& c : r.calibration.candidates) {
+              py::dict d;
+              d["name"] = c.name;
+              d["board_warp"] = c.board_warp;
+              d["decentering"] = PerCamera(c.decentering);
+              d["decentering_sigma"] = PerCamera(c.decentering_sigma);
+              d["n"] = c.n;
+              d["sigma_n"] = c.sigma_n;
+              d["rms_px"] = c.rms_px;
+              d["pixel_sigma"] = c.pixel_sigma;
+              d["evidence"] = c.evidence;
+              d["plausible"] = c.plausible;
+              list.append(d);
+            }
+            return list;
+          })
+      .def_property_readonly(
+          "chosen", [](const DomeResult& r) { return r.calibration.chosen; })
+      .def_property_readonly(
+          "rule", [](const DomeResult& r) { return r.calibration.rule; })
+      .def_property_readonly("board_warp_estimated",
+                             [](const DomeResult& r) {
+                               return r.calibration.board_warp_estimated;
+                             })
+      .def_property_readonly(
+          "board_warp",
+          [](const DomeResult& r) { return ToNumpy(r.calibration.board_warp); })
+      .def_property_readonly("board_warp_sigma",
+                             [](const DomeResult& r) {
+                               return ToNumpy(r.calibration.board_warp_sigma);
+                             })
+      .def_property_readonly(
+          "cam0_from_target",
+          [](const DomeResult& r) {
+            py::list poses;
+            for (const auto& pose : r.calibration.cam0_from_target) {
+              if (pose) {
+                poses.append(ToNumpy(pose->ToMatrix()));
+              } else {
+                poses.append(py::none());
+              }
+            }
+            return poses;
+          })
+      .def_property_readonly(
+          "num_views_used",
+          [](const DomeResult& r) { return r.calibration.num_views_used; })
+      .def_property_readonly(
+          "num_inliers",
+          [](const DomeResult& r) { return r.calibration.num_inliers; })
+      .def_property_readonly(
+          "num_outliers",
+          [](const DomeResult& r) { return r.calibration.num_outliers; })
+      .def_property_readonly(
+          "num_parameters",
+          [](const DomeResult& r) { return r.calibration.num_parameters; })
+      .def_readonly("notes", &DomeResult::notes)
+      .def("__repr__", [](const DomeResult& r) {
+        std::ostringstream text;
+        text << "DomeCalibrationResult(decentering_mm=[";
+        for (size_t c = 0; c < r.calibration.decentering.size(); ++c) {
+          const Eigen::Vector3d mm = 1e3 * r.calibration.decentering[c];
+          text << (c ? ", " : "") << "[" << mm.x() << ", " << mm.y() << ", "
+               << mm.z() << "]";
+        }
+        text << "], n=" << r.calibration.n
+             << ", rms_px=" << r.calibration.rms_px << ")";
+        return text.str();
+      });
+
+  static const char* const kDomeOptionsDoc = R"doc(
+Options (keywords, C++ rcm::calib::DomeCalibrationOptions): estimate_n
+(False: n held), n (the medium's index, held or the start, default 1.333),
+estimate_board_warp (True: the bowed board beside the flat one),
+evidence_sigmas (3), huber_px (1), outlier_sigmas (5),
+min_outlier_threshold_px (2), max_outlier_rounds (3), max_num_iterations
+(200), min_corners_per_view (6), fit_conventional_model (True),
+num_threads (2).
+)doc";
+  static const std::string dome_doc = std::string(R"doc(
+The underwater calibration through dome ports (C++
+rcm::calib::CalibrateDome; rcm calibrate --underwater --port dome): each
+dome's decentering (and n with estimate_n) from views of a planar target in
+water, with the air lenses held.
+
+calibrate_dome(target, images, cameras, domes, right_images=None,
+               cam1_from_cam0=None, **options)
+    images: a list of NumPy uint8 arrays or paths (the first camera's);
+    right_images: the second camera's, for two cameras. cameras: an
+    rcm.Camera (the air calibration) or a list of 1 or 2; domes: an
+    rcm.DomePort or a list, one per camera (radii and glass; the
+    decentering is the start); cam1_from_cam0: 4x4 (meters), the air
+    calibration's extrinsics, for two cameras.
+Returns a DomeCalibrationResult. ValueError with the library's message for
+fewer than 3 usable views, a dome that fails its check, and so on.
+)doc") + kDomeOptionsDoc;
+  module.def(
+      "calibrate_dome",
+      [](const CalibrationTarget& target, const py::sequence& images,
+         const py::object& cameras, const py::object& domes,
+         const py::object& right_images, const py::object& cam1_from_cam0,
+         const py::kwargs& kwargs) {
+        const calib::DomeCalibrationOptions options =
+            DomeOptionsFrom(kwargs, "calibrate_dome");
+        const DomeInputs inputs =
+            DomeInputsFrom(cameras, domes, cam1_from_cam0);
+        if ((inputs.cameras.size() == 2) == right_images.is_none()) {
+          ThrowValueError(
+              "right_images go with two cameras, and only with two");
+        }
+        const Detections detections = Detect(target, images, right_images);
+        return RunDome(target, detections.views, inputs, options);
+      },
+      py::arg("target"), py::arg("images"), py::arg("cameras"),
+      py::arg("domes"), py::arg("right_images") = py::none(),
+      py::arg("cam1_from_cam0") = py::none(), dome_doc.c_str());
+
+  static const std::string dome_corners_doc = std::string(R"doc(
+calibrate_dome from corner observations instead of images.
+
+calibrate_dome_from_corners(target, views, cameras, domes,
+                            cam1_from_cam0=None, **options)
+    views: per view, for one camera None or (point_ids (M,) ints, pixels
+    (M, 2) raw pixels); for two cameras (left corners, right corners), each
+    None or such a pair. Point ids index target.points.
+)doc") + kDomeOptionsDoc;
+  module.def(
+      "calibrate_dome_from_corners",
+      [](const CalibrationTarget& target, const py::sequence& views,
+         const py::object& cameras, const py::object& domes,
+         const py::object& cam1_from_cam0, const py::kwargs& kwargs) {
+        const calib::DomeCalibrationOptions options =
+            DomeOptionsFrom(kwargs, "calibrate_dome_from_corners");
+        const DomeInputs inputs =
+            DomeInputsFrom(cameras, domes, cam1_from_cam0);
+        return RunDome(
+            target,
+            ViewsFromCorners(target, views,
+                             /*one_camera=*/inputs.cameras.size() == 1),
+            inputs, options);
+      },
+      py::arg("target"), py::arg("views"), py::arg("cameras"), py::arg("domes"),
+      py::arg("cam1_from_cam0") = py::none(), dome_corners_doc.c_str());
 }
 
 }  // namespace rcm::python
