@@ -20,13 +20,39 @@ namespace {
 using internal::Corner;
 using internal::Pose;
 
+// What the problem's corners refer to: water views [0, num_water_views),
+// air views after them (traced at n = 1), each with its board's points.
+struct DomeProblem {
+  const std::vector<DomeCameraInput>* cameras = nullptr;
+  std::vector<Eigen::Vector3d> water_points, air_points;
+  std::vector<Eigen::Vector2d> water_basis, air_basis;
+  int num_water_views = 0;
+  int num_views = 0;  // water and air
+  bool lenses_estimated = false;
+  bool air_same_board = true;
+  bool Air(const Corner& corner) const {
+    return corner.view >= num_water_views;
+  }
+  const Eigen::Vector3d& Point(const Corner& corner) const {
+    return Air(corner) ? air_points[corner.point_id]
+                       : water_points[corner.point_id];
+  }
+  const Eigen::Vector2d& Basis(const Corner& corner) const {
+    return Air(corner) ? air_basis[corner.point_id]
+                       : water_basis[corner.point_id];
+  }
+};
+
 // The unknowns of one candidate's problem.
 struct DomeState {
   double n = 1.333;
-  std::vector<Pose> poses;                    // per view
+  double n_air = 1.0;                         // held
+  std::vector<Pose> poses;                    // per view, water then air
   std::vector<Pose> cam_from_cam0;            // per camera, held
   std::vector<std::array<double, 3>> centre;  // per camera
+  std::vector<std::array<double, kMaxLensParams>> lens;  // per camera
   std::array<double, 2> warp{0.0, 0.0};
+  std::array<double, 2> air_warp{0.0, 0.0};  // another air board's
 };
 
 // The fit of one candidate model, with its covariance.
@@ -44,32 +70,56 @@ struct DomeFit {
   std::vector<double> view_ssr;  // per view, inliers, NaN when unused
 };
 
-ceres::CostFunction* MakeDomeCost(const Camera& camera, const DomePort& dome,
-                                  const Eigen::Vector3d& point,
-                                  const Eigen::Vector2d& basis,
-                                  const Eigen::Vector2d& pixel) {
-  std::array<double, kMaxLensParams> lens{};
-  std::copy(camera.params(), camera.params() + camera.num_params(),
-            lens.begin());
-  RCM_LENS_MODEL_SWITCH(camera.model(),
-                        return DomeReprojectionError<LensModel>::Create(
-                            lens, dome, point, basis, pixel););
+ceres::CostFunction* MakeDomeCost(const DomeProblem& problem,
+                                  const DomeState& state,
+                                  const Corner& corner) {
+  const DomeCameraInput& input = (*problem.cameras)[corner.camera];
+  const Eigen::Vector3d& point = problem.Point(corner);
+  const Eigen::Vector2d& basis = problem.Basis(corner);
+  if (problem.lenses_estimated) {
+    RCM_LENS_MODEL_SWITCH(input.camera.model(),
+                          return DomeLensReprojectionError<LensModel>::Create(
+                              input.dome, point, basis, corner.pixel););
+  }
+  RCM_LENS_MODEL_SWITCH(
+      input.camera.model(),
+      return DomeReprojectionError<LensModel>::Create(
+          state.lens[corner.camera], input.dome, point, basis, corner.pixel););
   return nullptr;
 }
 
-StatusOr<DomeFit> FitDomeCandidate(const std::vector<DomeCameraInput>& cameras,
-                                   const std::vector<Eigen::Vector3d>& points,
-                                   const std::vector<Eigen::Vector2d>& basis,
+// The parameter blocks of a corner's residual, in the functor's order.
+std::vector<double*> DomeBlocks(const DomeProblem& problem, DomeState* state,
+                                const Corner& corner) {
+  std::vector<double*> blocks;
+  if (problem.lenses_estimated) {
+    blocks.push_back(state->lens[corner.camera].data());
+  }
+  const bool air = problem.Air(corner);
+  blocks.push_back(air ? &state->n_air : &state->n);
+  blocks.push_back(state->poses[corner.view].data());
+  blocks.push_back(state->cam_from_cam0[corner.camera].data());
+  blocks.push_back(state->centre[corner.camera].data());
+  blocks.push_back(air && !problem.air_same_board ? state->air_warp.data()
+                                                  : state->warp.data());
+  return blocks;
+}
+
+StatusOr<DomeFit> FitDomeCandidate(const DomeProblem& description,
                                    const std::vector<Corner>& start_corners,
                                    const DomeState& start, bool board_warp,
-                                   int num_views,
                                    const DomeCalibrationOptions& options) {
   DomeFit fit;
   fit.state = start;
   fit.corners = start_corners;
-  if (!board_warp) fit.state.warp = {0.0, 0.0};
+  if (!board_warp) {
+    fit.state.warp = {0.0, 0.0};
+    fit.state.air_warp = {0.0, 0.0};
+  }
   DomeState& state = fit.state;
+  const std::vector<DomeCameraInput>& cameras = *description.cameras;
   const int num_cameras = static_cast<int>(cameras.size());
+  const int num_views = description.num_views;
   std::vector<bool> view_used(num_views, false);
   for (const Corner& corner : fit.corners) view_used[corner.view] = true;
 
@@ -77,15 +127,25 @@ StatusOr<DomeFit> FitDomeCandidate(const std::vector<DomeCameraInput>& cameras,
     for (const Corner& corner : fit.corners) {
       if (!corner.inlier) continue;
       problem->AddResidualBlock(
-          MakeDomeCost(cameras[corner.camera].camera,
-                       cameras[corner.camera].dome, points[corner.point_id],
-                       basis[corner.point_id], corner.pixel),
-          huber_px > 0.0 ? new ceres::HuberLoss(huber_px) : nullptr, &state.n,
-          state.poses[corner.view].data(),
-          state.cam_from_cam0[corner.camera].data(),
-          state.centre[corner.camera].data(), state.warp.data());
+          MakeDomeCost(description, state, corner),
+          huber_px > 0.0 ? new ceres::HuberLoss(huber_px) : nullptr,
+          DomeBlocks(description, &state, corner));
     }
-    problem->SetParameterBlockConstant(&state.n);
+    if (problem->HasParameterBlock(&state.n_air)) {
+      problem->SetParameterBlockConstant(&state.n_air);
+    }
+    for (int c = 0; c < num_cameras && description.lenses_estimated; ++c) {
+      double* lens = state.lens[c].data();
+      if (!problem->HasParameterBlock(lens)) continue;
+      for (const DistortionBound& bound :
+           DistortionBounds(cameras[c].camera.model())) {
+        problem->SetParameterLowerBound(lens, 4 + bound.index, bound.lower);
+        problem->SetParameterUpperBound(lens, 4 + bound.index, bound.upper);
+      }
+    }
+    if (problem->HasParameterBlock(&state.n)) {
+      problem->SetParameterBlockConstant(&state.n);
+    }
     if (options.estimate_n && problem->HasParameterBlock(&state.n)) {
       problem->SetParameterBlockVariable(&state.n);
       problem->SetParameterLowerBound(&state.n, 0, RefractiveCamera::kMinIndex);
@@ -96,20 +156,18 @@ StatusOr<DomeFit> FitDomeCandidate(const std::vector<DomeCameraInput>& cameras,
         problem->SetParameterBlockConstant(state.cam_from_cam0[c].data());
       }
     }
-    if (!board_warp && problem->HasParameterBlock(state.warp.data())) {
-      problem->SetParameterBlockConstant(state.warp.data());
+    for (double* warp : {state.warp.data(), state.air_warp.data()}) {
+      if (!board_warp && problem->HasParameterBlock(warp)) {
+        problem->SetParameterBlockConstant(warp);
+      }
     }
   };
   const auto residual = [&](const Corner& corner) -> Eigen::Vector2d {
-    std::unique_ptr<ceres::CostFunction> cost(MakeDomeCost(
-        cameras[corner.camera].camera, cameras[corner.camera].dome,
-        points[corner.point_id], basis[corner.point_id], corner.pixel));
-    const double* blocks[5] = {&state.n, state.poses[corner.view].data(),
-                               state.cam_from_cam0[corner.camera].data(),
-                               state.centre[corner.camera].data(),
-                               state.warp.data()};
+    std::unique_ptr<ceres::CostFunction> cost(
+        MakeDomeCost(description, state, corner));
+    const std::vector<double*> blocks = DomeBlocks(description, &state, corner);
     Eigen::Vector2d e;
-    if (!cost->Evaluate(blocks, e.data(), nullptr)) {
+    if (!cost->Evaluate(blocks.data(), e.data(), nullptr)) {
       return Eigen::Vector2d::Constant(std::nan(""));
     }
     return e;
@@ -141,6 +199,12 @@ StatusOr<DomeFit> FitDomeCandidate(const std::vector<DomeCameraInput>& cameras,
   for (bool used : view_used) num_used_views += used ? 1 : 0;
   fit.num_parameters = 6 * num_used_views + 3 * num_cameras +
                        (options.estimate_n ? 1 : 0) + (board_warp ? 2 : 0);
+  if (description.lenses_estimated) {
+    for (const DomeCameraInput& input : cameras) {
+      fit.num_parameters += input.camera.num_params();
+    }
+    if (board_warp && !description.air_same_board) fit.num_parameters += 2;
+  }
   const int dof = 2 * fit.statistics.num_inliers - fit.num_parameters;
   if (dof <= 0) {
     return Status::Error("too few corners (" +
@@ -256,7 +320,8 @@ Status DomeCalibrationOptions::Check() const {
 StatusOr<DomeCalibration> CalibrateDome(
     const std::vector<StereoView>& views,
     const std::vector<DomeCameraInput>& cameras, const Rigid3d& cam1_from_cam0,
-    const CalibrationTarget& target, const DomeCalibrationOptions& options) {
+    const CalibrationTarget& target, const DomeCalibrationOptions& options,
+    const AirTargetViews* air_views) {
   RCM_RETURN_IF_ERROR(options.Check());
   const int num_cameras = static_cast<int>(cameras.size());
   if (num_cameras != 1 && num_cameras != 2) {
@@ -268,22 +333,27 @@ StatusOr<DomeCalibration> CalibrateDome(
       return Status::Error("cam" + std::to_string(c) + ": " + status.message());
     }
   }
-  const std::vector<Eigen::Vector3d> points = TargetPoints(target);
-  const std::vector<Eigen::Vector2d> basis = BoardWarpBasis(target);
-  const int num_points = static_cast<int>(points.size());
-  StatusOr<internal::UsedObservations> used = internal::SelectObservations(
-      views, num_points, options.min_corners_per_view, true);
-  if (!used.ok()) return used.status();
-  const int num_views = static_cast<int>(views.size());
-  if (num_cameras == 1) {
-    for (auto& sides : *used) sides[1] = nullptr;
+  DomeProblem description;
+  description.cameras = &cameras;
+  description.water_points = TargetPoints(target);
+  description.water_basis = BoardWarpBasis(target);
+  description.lenses_estimated = air_views != nullptr;
+  if (air_views != nullptr) {
+    description.air_points = TargetPoints(air_views->target);
+    description.air_basis = BoardWarpBasis(air_views->target);
+    description.air_same_board = air_views->same_board;
   }
+  const int num_water_views = static_cast<int>(views.size());
+  description.num_water_views = num_water_views;
+  description.num_views =
+      num_water_views +
+      (air_views != nullptr ? static_cast<int>(air_views->views.size()) : 0);
 
-  // Start: poses from the air cameras (the dome ignored), then one camera's
-  // pose moved to cam0.
+  // Start: poses from the air lenses (the dome ignored), one camera's pose
+  // moved to cam0.
   DomeState start;
   start.n = options.n;
-  start.poses.assign(num_views, Pose{});
+  start.poses.assign(description.num_views, Pose{});
   start.cam_from_cam0.push_back(internal::PoseFromRigid(Rigid3d()));
   if (num_cameras == 2) {
     start.cam_from_cam0.push_back(internal::PoseFromRigid(cam1_from_cam0));
@@ -291,48 +361,79 @@ StatusOr<DomeCalibration> CalibrateDome(
   for (const DomeCameraInput& input : cameras) {
     const Eigen::Vector3d& c = input.dome.decentering;
     start.centre.push_back({c.x(), c.y(), c.z()});
+    std::array<double, kMaxLensParams> lens{};
+    std::copy(input.camera.params(),
+              input.camera.params() + input.camera.num_params(), lens.begin());
+    start.lens.push_back(lens);
   }
   std::vector<Corner> corners;
   int num_views_used = 0;
-  for (int v = 0; v < num_views; ++v) {
-    std::optional<Rigid3d> pose;
-    for (int c = 0; c < num_cameras && !pose; ++c) {
-      if ((*used)[v][c] == nullptr) continue;
-      const std::optional<Rigid3d> cam_from_target =
-          InitializeTargetPose(cameras[c].camera, points, *(*used)[v][c]);
-      if (!cam_from_target) continue;
-      pose = c == 0 ? *cam_from_target
-                    : cam1_from_cam0.Inverse() * *cam_from_target;
-    }
-    if (!pose) continue;
-    ++num_views_used;
-    start.poses[v] = internal::PoseFromRigid(*pose);
-    for (int c = 0; c < num_cameras; ++c) {
-      const TargetObservation* observation = (*used)[v][c];
-      if (observation == nullptr) continue;
-      for (int k = 0; k < observation->size(); ++k) {
-        corners.push_back(
-            {v, c, observation->point_ids[k], observation->pixels[k], true});
+  int num_air_views_used = 0;
+  // The views of one medium, from view index `offset` on.
+  const auto add_views = [&](const std::vector<StereoView>& medium_views,
+                             const std::vector<Eigen::Vector3d>& points,
+                             int offset, int* used_count) -> Status {
+    StatusOr<internal::UsedObservations> used = internal::SelectObservations(
+        medium_views, static_cast<int>(points.size()),
+        options.min_corners_per_view, true);
+    if (!used.ok()) return used.status();
+    for (int v = 0; v < static_cast<int>(medium_views.size()); ++v) {
+      if (num_cameras == 1) (*used)[v][1] = nullptr;
+      std::optional<Rigid3d> pose;
+      for (int c = 0; c < num_cameras && !pose; ++c) {
+        if ((*used)[v][c] == nullptr) continue;
+        const std::optional<Rigid3d> cam_from_target =
+            InitializeTargetPose(cameras[c].camera, points, *(*used)[v][c]);
+        if (!cam_from_target) continue;
+        pose = c == 0 ? *cam_from_target
+                      : cam1_from_cam0.Inverse() * *cam_from_target;
+      }
+      if (!pose) continue;
+      ++*used_count;
+      start.poses[offset + v] = internal::PoseFromRigid(*pose);
+      for (int c = 0; c < num_cameras; ++c) {
+        const TargetObservation* observation = (*used)[v][c];
+        if (observation == nullptr) continue;
+        for (int k = 0; k < observation->size(); ++k) {
+          corners.push_back({offset + v, c, observation->point_ids[k],
+                             observation->pixels[k], true});
+        }
       }
     }
-  }
+    return Status::Ok();
+  };
+  RCM_RETURN_IF_ERROR(
+      add_views(views, description.water_points, 0, &num_views_used));
   if (num_views_used < 3) {
     return Status::Error("only " + std::to_string(num_views_used) +
                          " views show the target with at least " +
                          std::to_string(options.min_corners_per_view) +
                          " corners and a pose; a dome calibration needs 3");
   }
+  if (air_views != nullptr) {
+    if (const Status status =
+            add_views(air_views->views, description.air_points, num_water_views,
+                      &num_air_views_used);
+        !status.ok()) {
+      return Status::Error("air views: " + status.message());
+    }
+    if (num_air_views_used < 3) {
+      return Status::Error(
+          "only " + std::to_string(num_air_views_used) +
+          " air views show the target with a pose; estimating the lenses "
+          "with the dome needs 3");
+    }
+  }
 
   // The candidates: the flat board, then (estimate_board_warp) the bowed
   // one from the flat one's solution.
-  StatusOr<DomeFit> flat = FitDomeCandidate(cameras, points, basis, corners,
-                                            start, false, num_views, options);
+  StatusOr<DomeFit> flat =
+      FitDomeCandidate(description, corners, start, false, options);
   if (!flat.ok()) return flat.status();
   std::optional<DomeFit> bowed;
   if (options.estimate_board_warp) {
-    StatusOr<DomeFit> fit =
-        FitDomeCandidate(cameras, points, basis, flat->corners, flat->state,
-                         true, num_views, options);
+    StatusOr<DomeFit> fit = FitDomeCandidate(description, flat->corners,
+                                             flat->state, true, options);
     if (!fit.ok()) return fit.status();
     bowed = std::move(*fit);
   }
@@ -433,16 +534,40 @@ StatusOr<DomeCalibration> CalibrateDome(
             .diagonal()
             .cwiseSqrt();
   }
-  std::vector<bool> view_used(num_views, false);
-  for (const Corner& corner : fit.corners) view_used[corner.view] = true;
-  result.cam0_from_target = internal::UsedViewPoses(fit.state.poses, view_used);
+  std::vector<bool> view_used(num_water_views, false);
+  for (const Corner& corner : fit.corners) {
+    if (corner.view < num_water_views) view_used[corner.view] = true;
+  }
+  result.cam0_from_target = internal::UsedViewPoses(
+      std::vector<Pose>(fit.state.poses.begin(),
+                        fit.state.poses.begin() + num_water_views),
+      view_used);
   result.num_views_used = num_views_used;
-  internal::ResidualStatistics statistics = fit.statistics;
+  result.num_air_views_used = num_air_views_used;
+  // The water corners' statistics (the air views' apart).
   result.rms_px_per_camera.assign(num_cameras, 0.0);
   std::vector<int> counts(num_cameras, 0);
-  for (const CornerResidual& corner : statistics.corners) {
-    if (!corner.residual.allFinite()) continue;
-    result.rms_px_per_camera[corner.camera] += corner.residual.squaredNorm();
+  double water_squares = 0.0, inlier_squares = 0.0, air_squares = 0.0;
+  int water_count = 0, air_count = 0;
+  for (const CornerResidual& corner : fit.statistics.corners) {
+    const bool finite = corner.residual.allFinite();
+    const double squared = finite ? corner.residual.squaredNorm() : 0.0;
+    if (corner.view >= num_water_views) {
+      air_squares += squared;
+      air_count += finite ? 1 : 0;
+      continue;
+    }
+    result.corners.push_back(corner);
+    if (corner.inlier) {
+      ++result.num_inliers;
+      inlier_squares += squared;
+    } else {
+      ++result.num_outliers;
+    }
+    if (!finite) continue;
+    water_squares += squared;
+    ++water_count;
+    result.rms_px_per_camera[corner.camera] += squared;
     ++counts[corner.camera];
   }
   for (int c = 0; c < num_cameras; ++c) {
@@ -450,7 +575,23 @@ StatusOr<DomeCalibration> CalibrateDome(
         counts[c] > 0 ? std::sqrt(result.rms_px_per_camera[c] / counts[c])
                       : 0.0;
   }
-  internal::StoreResidualStatistics(std::move(statistics), &result);
+  result.rms_px =
+      water_count > 0 ? std::sqrt(water_squares / water_count) : 0.0;
+  result.inlier_rms_px = result.num_inliers > 0
+                             ? std::sqrt(inlier_squares / result.num_inliers)
+                             : 0.0;
+  result.air_rms_px = air_count > 0 ? std::sqrt(air_squares / air_count) : 0.0;
+  result.lenses_estimated = description.lenses_estimated;
+  for (int c = 0; c < num_cameras; ++c) {
+    StatusOr<Camera> lens =
+        cameras[c].camera.WithParams(fit.state.lens[c].data());
+    if (!lens.ok()) {
+      return Status::Error(
+          "cam" + std::to_string(c) +
+          ": the estimated lens is invalid: " + lens.status().message());
+    }
+    result.cameras.push_back(*lens);
+  }
   result.pixel_sigma = fit.pixel_sigma;
   result.num_parameters = fit.num_parameters;
 

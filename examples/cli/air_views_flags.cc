@@ -35,7 +35,8 @@ bool AirViewsGiven() {
 }
 
 StatusOr<AirViewsInput> ReadAirViews(
-    const calib::CalibrationTarget& water_target, bool estimate_board_warp) {
+    const calib::CalibrationTarget& water_target, bool estimate_board_warp,
+    bool allow_left_only) {
   if (!AirViewsGiven()) {
     if (FLAGS_same_board || !FLAGS_air_target.empty()) {
       return Status::Error(
@@ -45,7 +46,9 @@ StatusOr<AirViewsInput> ReadAirViews(
     }
     return Status::Error("no air views");
   }
-  if (FLAGS_air_left.empty() || FLAGS_air_right.empty()) {
+  const bool left_only =
+      allow_left_only && !FLAGS_air_left.empty() && FLAGS_air_right.empty();
+  if (!left_only && (FLAGS_air_left.empty() || FLAGS_air_right.empty())) {
     return Status::Error(
         "--air-left and --air-right go together: give both cameras' air "
         "images");
@@ -77,12 +80,13 @@ StatusOr<AirViewsInput> ReadAirViews(
                          {}};
     source.flags = {"--air-corners", "--air-left", "--air-right"};
     StatusOr<CalibrationInput> read =
-        ReadCornersInput(air.target, /*allow_left_only=*/false, source);
+        ReadCornersInput(air.target, left_only, source);
     if (!read.ok()) return read.status();
     detections = std::move(read->detections);
     input.description = "air " + read->description;
   } else {
     StereoFolderOptions options;
+    options.left_only = left_only;
     options.left_dir = FLAGS_air_left;
     options.right_dir = FLAGS_air_right;
     StatusOr<std::unique_ptr<StereoImageSource>> source =

@@ -42,8 +42,11 @@ struct AirViewsInput {
 // that is another board, a detection or file that fails, no air view
 // that shows the target. `estimate_board_warp`: the air board's warp is
 // estimated (not under --flat-board).
+// `allow_left_only`: --air-left without --air-right gives one camera's air
+// views (the dome calibration of one camera).
 StatusOr<AirViewsInput> ReadAirViews(
-    const calib::CalibrationTarget& water_target, bool estimate_board_warp);
+    const calib::CalibrationTarget& water_target, bool estimate_board_warp,
+    bool allow_left_only = false);
 
 }  // namespace rcm::cli
 

@@ -64,12 +64,6 @@ Status CheckDomeFlags() {
         "--port dome: --estimate-air-gap, --estimate-port-tilt and "
         "--thin-port describe flat ports");
   }
-  if (AirViewsGiven() || FLAGS_same_board || !FLAGS_air_target.empty()) {
-    return Status::Error(
-        "--port dome: the joint air and water calibration (--air-left, "
-        "--same-board, --air-target) is for flat ports; calibrate the lens "
-        "in air first (rcm calibrate --left AIR_DIR)");
-  }
   if (FLAGS_air.empty()) {
     return Status::Error(
         "--underwater --port dome needs --air AIR.yaml, the in-air "
@@ -145,6 +139,27 @@ int RunCalibrateDome(const Subcommand& command,
   if (!air.ok()) {
     PrintError(command, air.status().message());
     return kExitFailure;
+  }
+  // The air views of the joint calibration (the lenses estimated, the air
+  // views traced through the dome at n = 1), read before anything is
+  // written.
+  std::optional<AirViewsInput> air_views;
+  if (AirViewsGiven() || FLAGS_same_board || !FLAGS_air_target.empty()) {
+    StatusOr<AirViewsInput> read =
+        ReadAirViews(target, run.estimate_board_warp,
+                     /*allow_left_only=*/FLAGS_right.empty());
+    if (!read.ok()) {
+      PrintError(command, read.status().message());
+      return kExitFailure;
+    }
+    air_views = *std::move(read);
+    if (!FLAGS_json) {
+      std::cout << "rcm calibrate --underwater --port dome: "
+                << air_views->description
+                << " (lenses from air and water together, the air views "
+                   "through the dome)"
+                << std::endl;
+    }
   }
   StatusOr<CalibrationInput> input = ReadCalibrationInput(
       target, /*allow_left_only=*/true, paths,
@@ -224,8 +239,9 @@ int RunCalibrateDome(const Subcommand& command,
 
   std::optional<Progress> solving(std::in_place,
                                   "rcm calibrate: the dome's decentering", 1);
-  const StatusOr<DomeCalibration> result = calib::CalibrateDome(
-      detections.views, cameras, cam1_from_cam0, target, options);
+  const StatusOr<DomeCalibration> result =
+      calib::CalibrateDome(detections.views, cameras, cam1_from_cam0, target,
+                           options, air_views ? &air_views->views : nullptr);
   solving.reset();
   if (!result.ok()) {
     PrintError(command, result.status().message());
@@ -233,8 +249,8 @@ int RunCalibrateDome(const Subcommand& command,
   }
 
   // The report first, the camchain last.
-  calib::StereoCalibration drawing(cameras[0].camera,
-                                   cameras[num_cameras - 1].camera);
+  calib::StereoCalibration drawing(result->cameras[0],
+                                   result->cameras[num_cameras - 1]);
   drawing.num_cameras = num_cameras;
   drawing.cam1_from_cam0 = cam1_from_cam0;
   drawing.cam0_from_target = result->cam0_from_target;
@@ -254,6 +270,10 @@ int RunCalibrateDome(const Subcommand& command,
   }
 
   std::vector<std::string> warnings;
+  if (air_views) {
+    warnings.insert(warnings.end(), air_views->warnings.begin(),
+                    air_views->warnings.end());
+  }
   const calib::ConventionalFit& conventional = result->conventional;
   if (conventional.ok && conventional.rms_px < result->rms_px) {
     warnings.push_back(
@@ -358,6 +378,15 @@ int RunCalibrateDome(const Subcommand& command,
   warp_covariance.diagonal() = result->board_warp_sigma.array().square();
   json["board_flatness"] = BoardFlatnessJson(
       result->board_warp_estimated, result->board_warp, warp_covariance);
+  json["lenses_estimated"] = result->lenses_estimated;
+  if (air_views) {
+    json["air_views"] = {{"source", air_views->description},
+                         {"views_used", result->num_air_views_used},
+                         {"rms_px", result->air_rms_px},
+                         {"same_board", air_views->views.same_board}};
+  } else {
+    json["air_views"] = nullptr;
+  }
   json["warnings"] = warnings;
   if (Status status = WriteFileAtomically(
           (std::filesystem::path(paths.report) / "underwater.json").string(),
@@ -367,13 +396,15 @@ int RunCalibrateDome(const Subcommand& command,
     return kExitFailure;
   }
 
-  // The air camchain with each camera's dome (the estimated decentering).
+  // The air camchain with each camera's dome (the estimated decentering)
+  // and, from the joint calibration, its lens.
   Camchain camchain = *air;
   camchain.cameras.erase(camchain.cameras.begin() + num_cameras,
                          camchain.cameras.end());
   for (int c = 0; c < num_cameras; ++c) {
     DomePort dome = (*domes)[c];
     dome.decentering = result->decentering[c];
+    camchain.cameras[c].camera = result->cameras[c];
     camchain.cameras[c].port.reset();
     camchain.cameras[c].dome = dome;
   }
@@ -410,6 +441,12 @@ int RunCalibrateDome(const Subcommand& command,
         result->n, result->sigma_n, correlation_text.c_str());
   } else {
     std::printf("n %.4f held (--n; --estimate-n to estimate it)\n", result->n);
+  }
+  if (result->lenses_estimated) {
+    std::printf(
+        "air views: %d used, rms %.4f px through the dome at n = 1; the "
+        "lenses estimated from air and water together\n",
+        result->num_air_views_used, result->air_rms_px);
   }
   std::printf("%s\n", result->rule.c_str());
   std::printf("rms %.4f px (pixel noise %.4f px)", result->rms_px,

@@ -1,6 +1,8 @@
 // rcm calibrate --underwater --port dome (calibrate_dome.cc): the
 // decentering of each camera's dome, and n with --estimate-n, from views of
-// a target in the water with the air calibration's lenses held
+// a target in the water with the air calibration's lenses held, or with
+// air views (--air-left / --air-corners) estimated from air and water
+// together, the air views traced through the dome at n = 1
 // (rcm/calib/dome_calibration.h).
 #ifndef RCM_EXAMPLES_CLI_CALIBRATE_DOME_H_
 #define RCM_EXAMPLES_CLI_CALIBRATE_DOME_H_

@@ -159,6 +159,64 @@ TEST(CalibrateDomeCli, OneCameraGivesDecenteringAndDomeCamchain) {
   EXPECT_TRUE(fs::exists(dive.dir + "/water-report/residuals_cam0.png"));
 }
 
+// The joint calibration: air views through the same dome (n = 1) in a
+// corners file, the lens estimated from both media.
+TEST(CalibrateDomeCli, AirViewsThroughTheDomeEstimateTheLens) {
+  const Eigen::Vector3d truth(0.0005, -0.0005, 0.0072);
+  const DomeDive dive = WriteDomeDive("dome_joint", {truth});
+  const Camera camera = rcm::test::AlphasenseRealisticRig().left();
+  const DomePortCamera in_air =
+      DomePortCamera::Create(camera, Dome(truth), 1.0).value();
+  std::vector<calib::CornersFileImage> images;
+  std::mt19937 rng(2);
+  const std::vector<Eigen::Vector3d> points = calib::TargetPoints(Board());
+  for (const Rigid3d& pose :
+       calib::test::BoardPoses(camera, Board(), 10, 9, 0.4, 1.2)) {
+    images.push_back(
+        {"air/" + std::to_string(images.size()) + ".png",
+         calib::test::ObserveTargetWith(
+             camera,
+             [&](const Eigen::Vector3d& p) { return in_air.ImageFromPoint(p); },
+             pose, points, 0.0, &rng)});
+  }
+  const std::string air_corners = dive.dir + "/air_corners.vnl";
+  ASSERT_TRUE(calib::WriteCornersFile(air_corners, images,
+                                      calib::NumTargetPoints(Board()))
+                  .ok());
+  const RunResult result = Rcm(With(With({"calibrate",
+                                          "--underwater",
+                                          "--air",
+                                          dive.air,
+                                          "--corners",
+                                          dive.corners,
+                                          "--left",
+                                          "left/*",
+                                          "--image-size",
+                                          "720,540",
+                                          "--air-corners",
+                                          air_corners,
+                                          "--air-left",
+                                          "air/*",
+                                          "--same-board",
+                                          "--folds",
+                                          "0",
+                                          "--json",
+                                          "--out",
+                                          dive.dir + "/water.yaml"},
+                                         DomeFlags()),
+                                    BoardFlags()));
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const nlohmann::json json = nlohmann::json::parse(result.out);
+  EXPECT_TRUE(json["lenses_estimated"].get<bool>());
+  EXPECT_EQ(json["air_views"]["views_used"], 10);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(json["decentering_m"][0][i].get<double>(), truth[i],
+                kCornersFileDecenteringTolerance);
+  }
+  const Camchain written = ReadCamchain(dive.dir + "/water.yaml").value();
+  EXPECT_NEAR(written.cameras[0].camera.fx(), camera.fx(), 1e-4);
+}
+
 TEST(CalibrateDomeCli, StereoWithNEstimated) {
   const Eigen::Vector3d left(0.0015, 0.001, 0.006);
   const Eigen::Vector3d right(-0.001, 0.002, 0.008);

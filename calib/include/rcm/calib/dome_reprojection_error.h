@@ -91,6 +91,58 @@ struct DomeReprojectionError {
   const Eigen::Vector2d pixel;
 };
 
+// The joint calibration of air and water through the dome
+// (dome_calibration.h, air views) estimates the lens too: the same
+// residual with the lens as the first block, [fx, fy, cx, cy, d...]
+// (lens_models.h order, LensModel::kNumParams). The air views are traced
+// through the same dome at n = 1 (a held block): the glass shell in air
+// is a weak meniscus lens whose bending an air calibration made through
+// the dome holds in its lens.
+template <typename LensModel>
+struct DomeLensReprojectionError {
+  DomeLensReprojectionError(const DomePort& dome,
+                            const Eigen::Vector3d& point_in_target,
+                            const Eigen::Vector2d& warp_basis,
+                            const Eigen::Vector2d& pixel)
+      : dome(dome),
+        point_in_target(point_in_target),
+        warp_basis(warp_basis),
+        pixel(pixel) {}
+
+  template <typename T>
+  bool operator()(const T* lens, const T* n, const T* cam0_from_target,
+                  const T* cam_from_cam0, const T* decentering,
+                  const T* board_warp, T* residuals) const {
+    T point_in_camera[3];
+    board_internal::WarpedPointInCam1(point_in_target, warp_basis, board_warp,
+                                      cam0_from_target, cam_from_cam0,
+                                      point_in_camera);
+    T normalized[2];
+    if (!DomePortRefraction::NormalizedFromPoint(n[0], decentering, dome,
+                                                 point_in_camera, normalized)) {
+      return false;
+    }
+    board_internal::NormalizedPointResidual<LensModel>(
+        lens, normalized[0], normalized[1], pixel, residuals);
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const DomePort& dome,
+                                     const Eigen::Vector3d& point_in_target,
+                                     const Eigen::Vector2d& warp_basis,
+                                     const Eigen::Vector2d& pixel) {
+    return new ceres::AutoDiffCostFunction<
+        DomeLensReprojectionError, 2, LensModel::kNumParams, 1, 6, 6, 3, 2>(
+        new DomeLensReprojectionError(dome, point_in_target, warp_basis,
+                                      pixel));
+  }
+
+  const DomePort dome;  // its decentering is not read (a parameter block)
+  const Eigen::Vector3d point_in_target;
+  const Eigen::Vector2d warp_basis;
+  const Eigen::Vector2d pixel;
+};
+
 }  // namespace rcm::calib
 
 #endif  // RCM_CALIB_DOME_REPROJECTION_ERROR_H_
