@@ -221,8 +221,11 @@ int RunDomeCheck() {
     return kExitUsage;
   }
   if (const Status status = options.Check(); !status.ok()) {
-    PrintError(command, "--depth-range " + range_text +
-                            " / --reference-depth: " + status.message());
+    const bool reference =
+        status.message().find("reference_depth") != std::string::npos;
+    PrintError(command, (reference ? std::string("--reference-depth: ")
+                                   : "--depth-range " + range_text + ": ") +
+                            status.message());
     return kExitUsage;
   }
   const StatusOr<std::optional<DomePort>> flag_dome = DomePortFromFlags();
