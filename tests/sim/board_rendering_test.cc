@@ -1,22 +1,25 @@
 // The calibration board rendered into the pool (stereo_renderer.h,
 // scene_board.h) against ground truth: the pixels are the exact pixel
 // integrals of the pattern seen through the port, and rcm::calib's
-// chessboard detector finds the corners where the exact flat-port
-// projection of the truth corners puts them.
+// chessboard detector finds the corners where the exact flat-port (or
+// dome) projection of the truth corners puts them.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "rcm/calib/calibration_target.h"
 #include "rcm/calib/target_detector.h"
+#include "rcm/camera/dome_port_geometry.h"
 #include "rcm/camera/flat_port_camera.h"
 #include "rcm/sim/board_motion.h"
+#include "rcm/sim/port_camera.h"
 #include "rcm/sim/reference_rigs.h"
 #include "rcm/sim/scene_board.h"
 #include "rcm/sim/stereo_renderer.h"
@@ -58,24 +61,43 @@ Rigid3d BoardPose(const StereoRig& rig, const SceneBoard& board,
   return pose;
 }
 
+// The 4-inch acrylic dome, decentered.
+DomePort Dome(const Eigen::Vector3d& decentering) {
+  DomePort dome;
+  dome.inner_radius = 0.04355;
+  dome.thickness = 0.00375;
+  dome.glass_index = 1.495;
+  dome.decentering = decentering;
+  return dome;
+}
+
+// Decenterings of 1-3 mm laterally and 5-10 mm axially, one per camera.
+const std::array<std::optional<DomePort>, 2> kDomes = {
+    Dome(Eigen::Vector3d(0.002, -0.001, 0.007)),
+    Dome(Eigen::Vector3d(-0.0015, 0.0025, 0.009))};
+
 struct Scene {
   StereoImages images;
-  std::array<FlatPortCamera, 2> cameras;
+  std::array<PortCamera, 2> cameras;
   std::array<Rigid3d, 2> world_from_camera;
   PlacedBoard board;
 };
 
+// With `domes`, each camera looks through its dome (when given) instead
+// of `port`.
 Scene Render(const StereoRig& rig, const FlatPort& port,
              const SceneBoard& board, const Rigid3d& cam0_from_target,
-             const RenderOptions& options) {
-  StereoRenderer renderer =
-      StereoRenderer::Create(rig, port, port, &Pool(), options).value();
+             const RenderOptions& options,
+             const std::array<std::optional<DomePort>, 2>& domes = {}) {
+  StereoRenderer renderer = StereoRenderer::Create(rig, port, port, &Pool(),
+                                                   options, domes[0], domes[1])
+                                .value();
   const Rigid3d world_from_cam0 = RobotPose();
   const PlacedBoard placed(board, world_from_cam0 * cam0_from_target);
   return Scene{
       renderer.Render(world_from_cam0, kWaterIndex, 0, &placed).value(),
-      {FlatPortCamera::Create(rig.left(), port, kWaterIndex).value(),
-       FlatPortCamera::Create(rig.right(), port, kWaterIndex).value()},
+      {PortCamera::Create(rig.left(), port, domes[0], kWaterIndex).value(),
+       PortCamera::Create(rig.right(), port, domes[1], kWaterIndex).value()},
       {world_from_cam0, world_from_cam0 * rig.right_from_left().Inverse()},
       placed};
 }
@@ -165,6 +187,28 @@ TEST(BoardRendering, AlphasenseCornersAreDetectedWhereTheyProject) {
   ExpectCornersWhereTheyProject(AlphasenseFrontRectifiedRig());
 }
 
+// Through decentered domes (kDomes) the same: the renderer traces the
+// dome's exact rays, so the corners are found where
+// DomePortCamera::ImageFromPoint puts them, within the flat port's bounds.
+TEST(BoardRendering, DomeCornersAreDetectedWhereTheDomeProjects) {
+  const StereoRig rig = AlphasenseFrontRectifiedRig();
+  const SceneBoard board;
+  const Scene scene =
+      Render(rig, FlatPort(), board, BoardPose(rig, board, 1.2, 30.0, 7.0),
+             RenderOptions(), kDomes);
+  for (int c = 0; c < 2; ++c) {
+    SCOPED_TRACE(c == 0 ? "left" : "right");
+    ASSERT_TRUE(scene.cameras[c].is_dome());
+    const CornerErrors errors = DetectionErrors(scene, c);
+    std::printf(
+        "%s through its dome: %d corners, median %.3f px, max %.3f px\n",
+        c == 0 ? "left" : "right", errors.detected, errors.median, errors.max);
+    EXPECT_EQ(errors.detected, board.cols * board.rows);
+    EXPECT_LT(errors.median, kMedianTolerancePx);
+    EXPECT_LT(errors.max, kMaxTolerancePx);
+  }
+}
+
 // The mean error of the detected corners on the pattern's border (the
 // outer rows and columns) along the outward direction of the border (away
 // from the pattern, in the image: from the next corner inwards to the
@@ -226,8 +270,8 @@ TEST(BoardRendering, BorderCornersAreNotPulledOutward) {
   for (const double distance : {0.75, 1.8}) {
     SCOPED_TRACE("distance " + std::to_string(distance));
     const Scene scene =
-        Render(rig, FlatPort(), board, BoardPose(rig, board, distance, 30.0, 7.0),
-               RenderOptions());
+        Render(rig, FlatPort(), board,
+               BoardPose(rig, board, distance, 30.0, 7.0), RenderOptions());
     AddBorderOutwardErrors(scene, &sum, &count);
   }
   ASSERT_GT(count, 0);
@@ -242,7 +286,7 @@ TEST(BoardRendering, BorderCornersAreNotPulledOutward) {
 double ExactPixel(const Scene& scene, const RenderOptions& options, int x,
                   int y) {
   constexpr int kSamples = 12;  // per pixel along each axis
-  const FlatPortCamera& camera = scene.cameras[0];
+  const PortCamera& camera = scene.cameras[0];
   const Rigid3d& world_from_camera = scene.world_from_camera[0];
   double radiance = 0.0;
   for (int j = 0; j < kSamples; ++j) {
@@ -267,7 +311,10 @@ double ExactPixel(const Scene& scene, const RenderOptions& options, int x,
   return 255.0 * options.exposure * radiance / (kSamples * kSamples);
 }
 
-TEST(BoardRendering, PixelsAreTheExactPixelIntegral) {
+// The left image's pixels around every corner against ExactPixel, the
+// narrow rig behind `port` or, where given, `domes`.
+void ExpectExactPixelIntegral(
+    const FlatPort& port, const std::array<std::optional<DomePort>, 2>& domes) {
   // Around every corner of the left image (narrow rig, thick port, board
   // 0.9 m ahead, tilted 35 degrees: 20 px squares), the rendered pixels
   // against ExactPixel:
@@ -294,8 +341,8 @@ TEST(BoardRendering, PixelsAreTheExactPixelIntegral) {
   options.light_intensity = 0.0;
   const StereoRig rig = NarrowFieldRig();
   const SceneBoard board;
-  const Scene scene = Render(rig, ThickPort(), board,
-                             BoardPose(rig, board, 0.9, 35.0, 7.0), options);
+  const Scene scene = Render(
+      rig, port, board, BoardPose(rig, board, 0.9, 35.0, 7.0), options, domes);
   const Rigid3d camera_from_target =
       scene.world_from_camera[0].Inverse() * scene.board.world_from_target();
   double sum = 0.0, worst = 0.0, worst_shift = 0.0;
@@ -334,10 +381,23 @@ TEST(BoardRendering, PixelsAreTheExactPixelIntegral) {
     worst_shift = std::max(worst_shift, shift.norm());
     shift_sum += shift;
   }
+  std::printf("shift mean %.4f px, largest %.4f px; DN mean %.2f, max %.1f\n",
+              shift_sum.norm() / board.Corners().size(), worst_shift,
+              sum / count, worst);
   EXPECT_LT(shift_sum.norm() / board.Corners().size(), kMeanShiftTolerancePx);
   EXPECT_LT(worst_shift, kShiftTolerancePx);
   EXPECT_LT(sum / count, kMeanToleranceDn);
   EXPECT_LT(worst, kMaxToleranceDn);
+}
+
+TEST(BoardRendering, PixelsAreTheExactPixelIntegral) {
+  ExpectExactPixelIntegral(ThickPort(), {});
+}
+
+// Through a decentered dome the renderer's ray table holds the dome's
+// exact rays: the same bounds.
+TEST(BoardRendering, DomePixelsAreTheExactPixelIntegral) {
+  ExpectExactPixelIntegral(FlatPort(), kDomes);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <opencv2/imgproc.hpp>
 
+#include "rcm/camera/dome_port_camera.h"
 #include "rcm/camera/flat_port_camera.h"
 #include "rcm/estimation/batch_refinement.h"
 #include "rcm/sim/reference_rigs.h"
@@ -486,6 +487,85 @@ TEST(SequenceSimulator, SameSeedSameFramesWithABoard) {
   EXPECT_GT((a.cam0_from_target->translation - c.cam0_from_target->translation)
                 .norm(),
             1e-3);
+}
+
+}  // namespace
+}  // namespace rcm::sequence_simulator_test
+
+namespace rcm::sequence_simulator_test {
+namespace {
+
+// The 4-inch acrylic dome, decentered.
+DomePort Dome(const Eigen::Vector3d& decentering) {
+  DomePort dome;
+  dome.inner_radius = 0.04355;
+  dome.thickness = 0.00375;
+  dome.glass_index = 1.495;
+  dome.decentering = decentering;
+  return dome;
+}
+
+// The distance between two rays (origin, unit direction) at their closest.
+double RayGap(const RayInMedium& a, const RayInMedium& b) {
+  const Eigen::Vector3d normal = a.direction.cross(b.direction);
+  return std::abs((b.origin - a.origin).dot(normal.normalized()));
+}
+
+// Through domes the board stays in view and the matches are exact: the
+// left and right rays of every match (each traced through its own dome,
+// DomePortCamera) meet, which the same pixels through flat thin ports do
+// not.
+TEST(SequenceSimulator, DomesMakeTheBoardAndTheMatches) {
+  constexpr double kN = 1.34;
+  const StereoRig rig = NarrowFieldRig();
+  SequenceOptions options = MatchesOnly({{kN, 3}}, 200);
+  options.board = SceneBoard();
+  options.left_dome = Dome(Eigen::Vector3d(0.002, -0.001, 0.007));
+  options.right_dome = Dome(Eigen::Vector3d(-0.0015, 0.0025, 0.009));
+  std::unique_ptr<SequenceSimulator> simulator =
+      SequenceSimulator::Create(rig, options).value();
+  const DomePortCamera left =
+      DomePortCamera::Create(rig.left(), *options.left_dome, kN).value();
+  const DomePortCamera right =
+      DomePortCamera::Create(rig.right(), *options.right_dome, kN).value();
+  const FlatPortCamera flat_left =
+      FlatPortCamera::Create(rig.left(), FlatPort(), kN).value();
+  const FlatPortCamera flat_right =
+      FlatPortCamera::Create(rig.right(), FlatPort(), kN).value();
+  const Rigid3d left_from_right = rig.right_from_left().Inverse();
+  const auto in_left = [&](const RayInMedium& ray) {
+    return RayInMedium{left_from_right * ray.origin,
+                       left_from_right.rotation * ray.direction};
+  };
+  double largest_gap = 0.0, largest_flat_gap = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    const SequenceFrame frame = simulator->Frame(i).value();
+    EXPECT_TRUE(frame.board_fully_visible[0] && frame.board_fully_visible[1]);
+    ASSERT_EQ(frame.matches.size(), 200u);
+    for (const StereoCorrespondence& match : frame.matches) {
+      largest_gap = std::max(
+          largest_gap, RayGap(*left.RayFromImage(match.left_pixel),
+                              in_left(*right.RayFromImage(match.right_pixel))));
+      largest_flat_gap = std::max(
+          largest_flat_gap,
+          RayGap(*flat_left.RayFromImage(match.left_pixel),
+                 in_left(*flat_right.RayFromImage(match.right_pixel))));
+    }
+  }
+  EXPECT_LT(largest_gap, 1e-8);
+  EXPECT_GT(largest_flat_gap, 1e-4);
+
+  // Bad domes and depth-range matches through domes are refused.
+  options.left_dome->decentering = Eigen::Vector3d(0.0, 0.0, 0.05);
+  const StatusOr<std::unique_ptr<SequenceSimulator>> outside =
+      SequenceSimulator::Create(rig, options);
+  ASSERT_FALSE(outside.ok());
+  EXPECT_NE(outside.status().message().find("left"), std::string::npos);
+  options = MatchesOnly({{kN, 1}}, 10);
+  options.match_min_depth = 0.5;
+  options.match_max_depth = 2.0;
+  options.right_dome = Dome(Eigen::Vector3d(0.001, 0.0, 0.005));
+  EXPECT_FALSE(SequenceSimulator::Create(rig, options).ok());
 }
 
 }  // namespace

@@ -142,7 +142,7 @@ Rigid3d BoardMotion::Cam0FromTarget(double t, double excursion) const {
 
 bool BoardPointsVisible(const PlacedBoard& board,
                         const std::vector<Eigen::Vector3d>& points_in_target,
-                        const TankScene& tank, const FlatPortCamera& camera,
+                        const TankScene& tank, const PortCamera& camera,
                         const Rigid3d& world_from_camera, double margin_px) {
   const Rigid3d camera_from_world = world_from_camera.Inverse();
   const Camera& lens = camera.camera();
@@ -173,7 +173,9 @@ bool BoardPointsVisible(const PlacedBoard& board,
 StatusOr<std::vector<BoardFrame>> PlanBoardFrames(
     const BoardMotion& motion, const StereoRig& rig, const FlatPort& left_port,
     const FlatPort& right_port, const std::vector<double>& n_of_frame,
-    const std::vector<TimedPose>& poses, const TankScene& tank) {
+    const std::vector<TimedPose>& poses, const TankScene& tank,
+    const std::optional<DomePort>& left_dome,
+    const std::optional<DomePort>& right_dome) {
   if (n_of_frame.size() != poses.size()) {
     return Status::Error("board frames: " + std::to_string(n_of_frame.size()) +
                          " media for " + std::to_string(poses.size()) +
@@ -188,18 +190,18 @@ StatusOr<std::vector<BoardFrame>> PlanBoardFrames(
   // The cameras behind their ports, once per medium (a sequence has few),
   // and which of them each frame uses.
   std::vector<double> media;
-  std::vector<std::array<FlatPortCamera, 2>> cameras;
+  std::vector<std::array<PortCamera, 2>> cameras;
   std::vector<int> medium_of_frame(num_frames);
   for (int f = 0; f < num_frames; ++f) {
     const double n = n_of_frame[f];
     const auto known = std::find(media.begin(), media.end(), n);
     medium_of_frame[f] = static_cast<int>(known - media.begin());
     if (known != media.end()) continue;
-    StatusOr<FlatPortCamera> left =
-        FlatPortCamera::Create(rig.left(), left_port, n);
+    StatusOr<PortCamera> left =
+        PortCamera::Create(rig.left(), left_port, left_dome, n);
     if (!left.ok()) return left.status().WithContext("left port");
-    StatusOr<FlatPortCamera> right =
-        FlatPortCamera::Create(rig.right(), right_port, n);
+    StatusOr<PortCamera> right =
+        PortCamera::Create(rig.right(), right_port, right_dome, n);
     if (!right.ok()) return right.status().WithContext("right port");
     media.push_back(n);
     cameras.push_back({std::move(left).value(), std::move(right).value()});
@@ -213,7 +215,7 @@ StatusOr<std::vector<BoardFrame>> PlanBoardFrames(
         board, world_from_cam0 * motion.Cam0FromTarget(poses[f].t, e));
     const Rigid3d world_from_cam[2] = {world_from_cam0,
                                        world_from_cam0 * cam0_from_cam1};
-    const std::array<FlatPortCamera, 2>& camera = cameras[medium_of_frame[f]];
+    const std::array<PortCamera, 2>& camera = cameras[medium_of_frame[f]];
     std::array<bool, 2> seen;
     for (int c = 0; c < 2; ++c) {
       seen[c] = BoardPointsVisible(placed, points, tank, camera[c],

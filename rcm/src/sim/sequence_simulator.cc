@@ -6,7 +6,7 @@
 #include <sstream>
 #include <utility>
 
-#include "rcm/camera/flat_port_camera.h"
+#include "rcm/sim/port_camera.h"
 #include "rcm/sim/scene_intersection.h"
 #include "rcm/sim/stereo_sampler.h"
 #include "rcm/util/splitmix64.h"
@@ -84,6 +84,10 @@ Status SequenceOptions::Check() const {
   RCM_RETURN_IF_ERROR(MediaSchedule::Create(media).status());
   RCM_RETURN_IF_ERROR(left_port.Check().WithContext("left port"));
   RCM_RETURN_IF_ERROR(right_port.Check().WithContext("right port"));
+  if (left_dome) RCM_RETURN_IF_ERROR(left_dome->Check().WithContext("left"));
+  if (right_dome) {
+    RCM_RETURN_IF_ERROR(right_dome->Check().WithContext("right"));
+  }
   RCM_RETURN_IF_ERROR(scene.Check());
   RCM_RETURN_IF_ERROR(render.Check());
   RCM_RETURN_IF_ERROR(cam1_drift.Check());
@@ -109,6 +113,9 @@ Status SequenceOptions::Check() const {
   } else if (UsesDepthRange() && render_images) {
     message << "matches over a depth range do not belong to the images; "
                "render no images with them";
+  } else if (UsesDepthRange() && (left_dome || right_dome)) {
+    message << "matches over a depth range are sampled through flat ports, "
+               "not domes";
   } else {
     return Status::Ok();
   }
@@ -156,7 +163,8 @@ StatusOr<std::unique_ptr<SequenceSimulator>> SequenceSimulator::Create(
     if (!motion.ok()) return motion.status();
     StatusOr<std::vector<BoardFrame>> frames = PlanBoardFrames(
         motion.value(), true_rig, options.left_port, options.right_port,
-        simulator->n_of_frame_, simulator->poses_, *simulator->scene_);
+        simulator->n_of_frame_, simulator->poses_, *simulator->scene_,
+        options.left_dome, options.right_dome);
     if (!frames.ok()) return frames.status();
     simulator->board_frames_ = std::move(frames).value();
   }
@@ -164,9 +172,9 @@ StatusOr<std::unique_ptr<SequenceSimulator>> SequenceSimulator::Create(
   if (options.render_images) {
     RenderOptions render = options.render;
     render.seed = DeriveSeed(options.seed, kRenderSeed);
-    StatusOr<StereoRenderer> renderer =
-        StereoRenderer::Create(true_rig, options.left_port, options.right_port,
-                               simulator->scene_.get(), render);
+    StatusOr<StereoRenderer> renderer = StereoRenderer::Create(
+        true_rig, options.left_port, options.right_port,
+        simulator->scene_.get(), render, options.left_dome, options.right_dome);
     if (!renderer.ok()) return renderer.status();
     simulator->renderer_ =
         std::make_unique<StereoRenderer>(std::move(renderer).value());
@@ -183,10 +191,14 @@ Rigid3d SequenceSimulator::RightFromLeftOfFrame(int index) const {
 std::vector<StereoCorrespondence> SequenceSimulator::SampleMatches(
     int index, double n, const PlacedBoard* board) {
   // Ports and media passed SequenceOptions::Check in Create.
-  const FlatPortCamera left =
-      FlatPortCamera::Create(true_rig_.left(), options_.left_port, n).value();
-  const FlatPortCamera right =
-      FlatPortCamera::Create(true_rig_.right(), options_.right_port, n).value();
+  const PortCamera left =
+      PortCamera::Create(true_rig_.left(), options_.left_port,
+                         options_.left_dome, n)
+          .value();
+  const PortCamera right =
+      PortCamera::Create(true_rig_.right(), options_.right_port,
+                         options_.right_dome, n)
+          .value();
   const Rigid3d& world_from_left = poses_[index].world_from_cam0;
   // cam1 at the right exposure (exposure_delay.h).
   const Rigid3d world_from_right =

@@ -6,7 +6,7 @@
 #include <utility>
 #include <vector>
 
-#include "rcm/camera/flat_port_camera.h"
+#include "rcm/sim/port_camera.h"
 #include "rcm/sim/scene_intersection.h"
 #include "rcm/util/parallel_for.h"
 #include "rcm/util/splitmix64.h"
@@ -34,8 +34,8 @@ float Chord(const float* a, const float* b) {
 }
 
 // Fills `samples` with the rays of every sample of `camera` (see RayTable).
-void TraceSamples(const FlatPortCamera& camera, int supersampling,
-                  int num_threads, std::vector<float>* samples) {
+void TraceSamples(const PortCamera& camera, int supersampling, int num_threads,
+                  std::vector<float>* samples) {
   const int s = supersampling;
   const int64_t columns = static_cast<int64_t>(camera.camera().width()) * s;
   const int64_t rows = static_cast<int64_t>(camera.camera().height()) * s;
@@ -139,16 +139,21 @@ Status RenderOptions::Check() const {
   return Status::Error(message.str());
 }
 
-StatusOr<StereoRenderer> StereoRenderer::Create(const StereoRig& rig,
-                                                const FlatPort& left_port,
-                                                const FlatPort& right_port,
-                                                const TankScene* scene,
-                                                const RenderOptions& options) {
+StatusOr<StereoRenderer> StereoRenderer::Create(
+    const StereoRig& rig, const FlatPort& left_port, const FlatPort& right_port,
+    const TankScene* scene, const RenderOptions& options,
+    const std::optional<DomePort>& left_dome,
+    const std::optional<DomePort>& right_dome) {
   RCM_RETURN_IF_ERROR(options.Check());
   if (scene == nullptr) return Status::Error("the renderer needs a scene");
   RCM_RETURN_IF_ERROR(left_port.Check().WithContext("left"));
   RCM_RETURN_IF_ERROR(right_port.Check().WithContext("right"));
-  return StereoRenderer(rig, left_port, right_port, scene, options);
+  if (left_dome) RCM_RETURN_IF_ERROR(left_dome->Check().WithContext("left"));
+  if (right_dome) {
+    RCM_RETURN_IF_ERROR(right_dome->Check().WithContext("right"));
+  }
+  return StereoRenderer(rig, left_port, right_port, scene, options, left_dome,
+                        right_dome);
 }
 
 StatusOr<const StereoRenderer::CacheEntry*> StereoRenderer::Rays(double n) {
@@ -159,8 +164,8 @@ StatusOr<const StereoRenderer::CacheEntry*> StereoRenderer::Rays(double n) {
   entry.n = n;
   for (int c = 0; c < 2; ++c) {
     const Camera& camera = c == 0 ? rig_.left() : rig_.right();
-    StatusOr<FlatPortCamera> port_camera =
-        FlatPortCamera::Create(camera, ports_[c], n);
+    StatusOr<PortCamera> port_camera =
+        PortCamera::Create(camera, ports_[c], domes_[c], n);
     if (!port_camera.ok()) return port_camera.status();
     auto table = std::make_shared<RayTable>();
     table->width = camera.width();

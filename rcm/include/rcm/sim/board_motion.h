@@ -44,11 +44,13 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
+#include "rcm/camera/dome_port_geometry.h"
 #include "rcm/camera/flat_port.h"
-#include "rcm/camera/flat_port_camera.h"
 #include "rcm/geometry/rigid3d.h"
+#include "rcm/sim/port_camera.h"
 #include "rcm/sim/scene_board.h"
 #include "rcm/sim/tank_scene.h"
 #include "rcm/sim/trajectory.h"
@@ -121,13 +123,14 @@ class BoardMotion {
 };
 
 // True when every point (target frame) of the board is seen by the camera:
-// its exact pixel (FlatPortCamera::ImageFromPoint) is in the image at least
+// its exact pixel (PortCamera::ImageFromPoint, through the flat port or the
+// dome) is in the image at least
 // margin_px from the border, and the ray of that pixel (RayFromImage, moved
 // to the world) meets the board's printed side first (IntersectScene)
 // within 1e-6 m of the point, not the tank nor the board's back.
 bool BoardPointsVisible(const PlacedBoard& board,
                         const std::vector<Eigen::Vector3d>& points_in_target,
-                        const TankScene& tank, const FlatPortCamera& camera,
+                        const TankScene& tank, const PortCamera& camera,
                         const Rigid3d& world_from_camera, double margin_px);
 
 // One frame of the board.
@@ -141,12 +144,15 @@ struct BoardFrame {
 
 // The board's frames over a sequence (file comment): `rig` is the rig that
 // sees it (with its true extrinsics), `n_of_frame` the medium of each
-// frame and `poses` cam0's pose in the tank (equal sizes). Fails when a
-// port or medium is invalid or the sizes differ.
+// frame and `poses` cam0's pose in the tank (equal sizes); a camera with a
+// dome sees through it instead of its flat port. Fails when a port or
+// medium is invalid or the sizes differ.
 StatusOr<std::vector<BoardFrame>> PlanBoardFrames(
     const BoardMotion& motion, const StereoRig& rig, const FlatPort& left_port,
     const FlatPort& right_port, const std::vector<double>& n_of_frame,
-    const std::vector<TimedPose>& poses, const TankScene& tank);
+    const std::vector<TimedPose>& poses, const TankScene& tank,
+    const std::optional<DomePort>& left_dome = std::nullopt,
+    const std::optional<DomePort>& right_dome = std::nullopt);
 
 }  // namespace rcm
 

@@ -1,6 +1,8 @@
 // SequenceSimulator: a synthetic underwater stereo sequence with ground
 // truth. A robot moves through a textured tank (tank_scene.h, trajectory.h)
-// with the stereo rig behind exact flat ports (flat_port.h); each frame is
+// with the stereo rig behind exact flat ports (flat_port.h) or domes
+// (dome_port_geometry.h; SequenceOptions::left_dome, right_dome, traced
+// exactly by port_camera.h); each frame is
 // in the medium the schedule gives (media_schedule.h, e.g. air -> water ->
 // air). Per frame it renders both 8-bit images (stereo_renderer.h) and
 // samples exact correspondences that are consistent with the images: a
@@ -41,6 +43,7 @@
 #include <optional>
 #include <vector>
 
+#include "rcm/camera/dome_port_geometry.h"
 #include "rcm/camera/flat_port.h"
 #include "rcm/geometry/rigid3d.h"
 #include "rcm/geometry/stereo_correspondence.h"
@@ -98,6 +101,11 @@ struct SequenceOptions {
       std::vector<MediaSegment>(1, MediaSegment{1.333, 20});
   FlatPort left_port;   // default: the paper's thin port
   FlatPort right_port;  // default: the paper's thin port
+  // A camera with a dome (default none) looks through it instead of its
+  // flat port: images, board and matches. The decentering is the truth;
+  // the rig (and a writer's camchain) knows nothing of it.
+  std::optional<DomePort> left_dome;
+  std::optional<DomePort> right_dome;
   TankSceneOptions scene;
   // Its frames is replaced by the media schedule's frame count.
   TrajectoryOptions trajectory;
@@ -111,7 +119,7 @@ struct SequenceOptions {
   // [min, max] (left camera frame) on the rays of uniform left pixels
   // (SampleFlatPortCorrespondences), for studies over a controlled depth
   // range; they do not belong to the images, so render_images must be
-  // false.
+  // false, and need flat ports (no dome).
   double match_min_depth = 0.0;  // meters
   double match_max_depth = 0.0;  // meters
   // Default none: the rig is as calibrated.

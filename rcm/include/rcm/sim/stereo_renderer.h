@@ -1,11 +1,13 @@
 // StereoRenderer: 8-bit monochrome stereo images of a TankScene as the
 // dataset cameras would record them, through each camera's lens and exact
-// flat port (rcm/camera/flat_port_camera.h), in air (n = 1, the tank drained)
+// flat port (rcm/camera/flat_port_camera.h) or, when one is given, dome
+// port (rcm/camera/dome_port_camera.h), in air (n = 1, the tank drained)
 // or in water (n > 1).
 //
 // Per pixel, s x s samples on a regular grid (pixel centers at integers,
 // sample (i, j) of pixel (x, y) at (x + (i + 0.5) / s - 0.5, y + ...)) are
-// traced: the sample's ray in the medium (FlatPortCamera::RayFromImage,
+// traced: the sample's ray in the medium (PortCamera::RayFromImage, exact
+// through either port: origin on the port's outer surface, direction;
 // camera frame; cached per camera and n since it does not depend on the
 // pose) is moved to the world and intersected with the scene
 // (scene_intersection.h: the tank, and the calibration board when one is
@@ -52,6 +54,7 @@
 #include <optional>
 #include <vector>
 
+#include "rcm/camera/dome_port_geometry.h"
 #include "rcm/camera/flat_port.h"
 #include "rcm/geometry/rigid3d.h"
 #include "rcm/sim/scene_board.h"
@@ -104,12 +107,14 @@ struct StereoImages {
 class StereoRenderer {
  public:
   // Fails when the options or a port are invalid or the scene is null.
-  // The scene must outlive the renderer.
-  static StatusOr<StereoRenderer> Create(const StereoRig& rig,
-                                         const FlatPort& left_port,
-                                         const FlatPort& right_port,
-                                         const TankScene* scene,
-                                         const RenderOptions& options);
+  // The scene must outlive the renderer. A camera with a dome looks
+  // through it instead of its flat port.
+  static StatusOr<StereoRenderer> Create(
+      const StereoRig& rig, const FlatPort& left_port,
+      const FlatPort& right_port, const TankScene* scene,
+      const RenderOptions& options,
+      const std::optional<DomePort>& left_dome = std::nullopt,
+      const std::optional<DomePort>& right_dome = std::nullopt);
 
   const StereoRig& rig() const { return rig_; }
   const RenderOptions& options() const { return options_; }
@@ -142,9 +147,12 @@ class StereoRenderer {
 
   StereoRenderer(const StereoRig& rig, const FlatPort& left_port,
                  const FlatPort& right_port, const TankScene* scene,
-                 const RenderOptions& options)
+                 const RenderOptions& options,
+                 const std::optional<DomePort>& left_dome,
+                 const std::optional<DomePort>& right_dome)
       : rig_(rig),
         ports_{left_port, right_port},
+        domes_{left_dome, right_dome},
         scene_(scene),
         options_(options) {}
 
@@ -153,6 +161,7 @@ class StereoRenderer {
 
   StereoRig rig_;
   std::array<FlatPort, 2> ports_;
+  std::array<std::optional<DomePort>, 2> domes_;  // nullopt: the flat port
   const TankScene* scene_;
   RenderOptions options_;
   std::vector<CacheEntry> cache_;  // oldest first
