@@ -88,6 +88,31 @@ DoubleArray MapRows(const py::handle& input, const std::string& name,
   return output;
 }
 
+// Applies `ray_of` (pixel -> optional RayInMedium) to every pixel row,
+// without the GIL: (origins, directions), NaN rows where it fails.
+template <typename RayOf>
+py::tuple RaysFromPixels(const py::handle& pixels, const RayOf& ray_of) {
+  const Rows rows = RowsFromPython(pixels, "pixels", 2, true, true, false);
+  DoubleArray origins = NewArray(rows.rows, 3, rows.single);
+  DoubleArray directions = NewArray(rows.rows, 3, rows.single);
+  double* o = origins.mutable_data();
+  double* d = directions.mutable_data();
+  const double* p = rows.data();
+  {
+    py::gil_scoped_release release;
+    for (int64_t i = 0; i < rows.rows; ++i) {
+      const Eigen::Vector2d pixel(p[2 * i], p[2 * i + 1]);
+      const std::optional<RayInMedium> ray =
+          pixel.allFinite() ? ray_of(pixel) : std::nullopt;
+      for (int k = 0; k < 3; ++k) {
+        o[3 * i + k] = ray ? ray->origin[k] : kNaN;
+        d[3 * i + k] = ray ? ray->direction[k] : kNaN;
+      }
+    }
+  }
+  return py::make_tuple(origins, directions);
+}
+
 FlatPort MakePort(double air_gap, double glass_thickness, double glass_index,
                   const py::object& normal) {
   FlatPort port;
@@ -340,43 +365,24 @@ not: a pixel's ray starts on the outer glass face.
       .def(
           "pixel_to_ray",
           [](const RigCamera& c, const py::object& pixels, double n) {
-            const Rows rows =
-                RowsFromPython(pixels, "pixels", 2, true, true, false);
-            DoubleArray origins = NewArray(rows.rows, 3, rows.single);
-            DoubleArray directions = NewArray(rows.rows, 3, rows.single);
-            double* o = origins.mutable_data();
-            double* d = directions.mutable_data();
-            const double* p = rows.data();
             if (c.port.IsThin()) {
               const RefractiveCamera camera =
                   ValueOrThrow(RefractiveCamera::Create(c.camera, n));
-              py::gil_scoped_release release;
-              for (int64_t i = 0; i < rows.rows; ++i) {
-                const Eigen::Vector2d pixel(p[2 * i], p[2 * i + 1]);
-                const std::optional<Eigen::Vector3d> bearing =
-                    pixel.allFinite() ? camera.BearingInWaterFromImage(pixel)
-                                      : std::nullopt;
-                for (int k = 0; k < 3; ++k) {
-                  o[3 * i + k] = bearing ? 0.0 : kNaN;
-                  d[3 * i + k] = bearing ? (*bearing)[k] : kNaN;
-                }
-              }
-            } else {
-              const FlatPortCamera camera =
-                  ValueOrThrow(FlatPortCamera::Create(c.camera, c.port, n));
-              py::gil_scoped_release release;
-              for (int64_t i = 0; i < rows.rows; ++i) {
-                const Eigen::Vector2d pixel(p[2 * i], p[2 * i + 1]);
-                const std::optional<RayInMedium> ray =
-                    pixel.allFinite() ? camera.RayFromImage(pixel)
-                                      : std::nullopt;
-                for (int k = 0; k < 3; ++k) {
-                  o[3 * i + k] = ray ? ray->origin[k] : kNaN;
-                  d[3 * i + k] = ray ? ray->direction[k] : kNaN;
-                }
-              }
+              return RaysFromPixels(
+                  pixels,
+                  [&](const Eigen::Vector2d& pixel)
+                      -> std::optional<RayInMedium> {
+                    const std::optional<Eigen::Vector3d> bearing =
+                        camera.BearingInWaterFromImage(pixel);
+                    if (!bearing) return std::nullopt;
+                    return RayInMedium{Eigen::Vector3d::Zero(), *bearing};
+                  });
             }
-            return py::make_tuple(origins, directions);
+            const FlatPortCamera camera =
+                ValueOrThrow(FlatPortCamera::Create(c.camera, c.port, n));
+            return RaysFromPixels(pixels, [&](const Eigen::Vector2d& pixel) {
+              return camera.RayFromImage(pixel);
+            });
           },
           py::arg("pixels"), py::arg("n"),
           R"doc(
@@ -497,26 +503,9 @@ message for a dome that fails its check or n outside [1, 2].
       .def(
           "ray_from_image",
           [](const DomePortCamera& c, const py::object& pixels) {
-            const Rows rows =
-                RowsFromPython(pixels, "pixels", 2, true, true, false);
-            DoubleArray origins = NewArray(rows.rows, 3, rows.single);
-            DoubleArray directions = NewArray(rows.rows, 3, rows.single);
-            double* o = origins.mutable_data();
-            double* d = directions.mutable_data();
-            const double* p = rows.data();
-            {
-              py::gil_scoped_release release;
-              for (int64_t i = 0; i < rows.rows; ++i) {
-                const Eigen::Vector2d pixel(p[2 * i], p[2 * i + 1]);
-                const std::optional<RayInMedium> ray =
-                    pixel.allFinite() ? c.RayFromImage(pixel) : std::nullopt;
-                for (int k = 0; k < 3; ++k) {
-                  o[3 * i + k] = ray ? ray->origin[k] : kNaN;
-                  d[3 * i + k] = ray ? ray->direction[k] : kNaN;
-                }
-              }
-            }
-            return py::make_tuple(origins, directions);
+            return RaysFromPixels(pixels, [&](const Eigen::Vector2d& pixel) {
+              return c.RayFromImage(pixel);
+            });
           },
           py::arg("pixels"),
           R"doc(

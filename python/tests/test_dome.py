@@ -8,6 +8,7 @@ import pytest
 
 import rcm
 from conftest import image_grid, one_line
+from test_calibration import rotation
 
 # As the C++ tests: a dome that does not refract is the air camera to
 # 1e-12 px; the forward solve converges to 1e-9 px; noise-free corners give
@@ -124,16 +125,6 @@ def test_dome_check(lens):
     plain = rcm.evaluate_dome_port_error(camera, grid_step=32.0)
     assert plain.reference_depth is None and plain.central_max_px is None
     assert plain.central_max_px_per_depth is None
-
-
-def rotation(axis_angle):
-    axis_angle = np.asarray(axis_angle, float)
-    angle = np.linalg.norm(axis_angle)
-    if angle == 0.0:
-        return np.eye(3)
-    k = axis_angle / angle
-    skew = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return np.eye(3) + np.sin(angle) * skew + (1 - np.cos(angle)) * skew @ skew
 
 
 def dome_views(camera, target, count, seed):

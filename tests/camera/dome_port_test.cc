@@ -13,6 +13,7 @@
 namespace rcm::dome_port_test {
 namespace {
 
+using test::AcrylicDome;
 using test::AllTestCameras;
 using test::ImageGrid;
 using test::PinholeCamera;
@@ -27,17 +28,6 @@ constexpr double kRoundTripTolerancePx = 1e-9;
 // Central differences of step h on functions of unit curvature scale:
 // truncation h^2 ~ 1e-12, rounding eps / h ~ 1e-10, relative.
 constexpr double kDerivativeTolerance = 1e-6;
-
-// The dome of a deep-rated 4-inch housing: acrylic, 43.55 mm inside,
-// 3.75 mm thick.
-DomePort AcrylicDome(const Eigen::Vector3d& decentering) {
-  DomePort dome;
-  dome.inner_radius = 0.04355;
-  dome.thickness = 0.00375;
-  dome.glass_index = 1.495;
-  dome.decentering = decentering;
-  return dome;
-}
 
 // Decenterings of 1-10 mm in every direction (the range).
 std::vector<Eigen::Vector3d> Decenterings() {

@@ -13,22 +13,13 @@
 namespace rcm::dome_port_error_test {
 namespace {
 
+using test::AcrylicDome;
 using test::AllTestCameras;
 using test::PinholeCamera;
 
 // A centred dome does not refract: the errors are rounding, a few ulps of
 // the normalized point times the focal length (dome_port_test.cc).
 constexpr double kCentredTolerancePx = 1e-12;
-
-// The 4-inch acrylic dome of the issue: 43.55 mm inside, 3.75 mm thick.
-DomePort AcrylicDome(const Eigen::Vector3d& decentering) {
-  DomePort dome;
-  dome.inner_radius = 0.04355;
-  dome.thickness = 0.00375;
-  dome.glass_index = 1.495;
-  dome.decentering = decentering;
-  return dome;
-}
 
 DomePortCamera DomeCamera(const Camera& camera,
                           const Eigen::Vector3d& decentering,

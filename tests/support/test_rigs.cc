@@ -32,6 +32,15 @@ Camera PinholeCamera() {
       .value();
 }
 
+DomePort AcrylicDome(const Eigen::Vector3d& decentering) {
+  DomePort dome;
+  dome.inner_radius = 0.04355;
+  dome.thickness = 0.00375;
+  dome.glass_index = 1.495;
+  dome.decentering = decentering;
+  return dome;
+}
+
 Camera WideEquidistantCamera() {
   const std::vector<double> k = AlphasenseCam0().Distortion();
   const double theta = 89.5 * M_PI / 180.0;

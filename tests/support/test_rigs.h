@@ -1,6 +1,6 @@
 // Cameras and rigs shared by the tests: the paper's real calibration, a
-// radtan camera, a pinhole, a fisheye reaching 89.5 degrees, and stereo
-// rigs built from them.
+// radtan camera, a pinhole, a fisheye reaching 89.5 degrees, stereo rigs
+// built from them, and a dome port.
 #ifndef RCM_TESTS_SUPPORT_TEST_RIGS_H_
 #define RCM_TESTS_SUPPORT_TEST_RIGS_H_
 
@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "rcm/camera/camera.h"
+#include "rcm/camera/dome_port_geometry.h"
 #include "rcm/estimation/prepared_correspondence.h"
 #include "rcm/geometry/stereo_correspondence.h"
 #include "rcm/stereo/stereo_rig.h"
@@ -39,6 +40,11 @@ Camera DoubleSphereCamera();
 Camera EucmCamera();
 // Every camera above, for tests that sweep them.
 std::vector<Camera> AllTestCameras();
+
+// The dome of a deep-rated 4-inch housing (issue 33): acrylic (1.495),
+// 43.55 mm inside, 3.75 mm thick (47.30 mm outside), its centre at
+// `decentering` in the camera frame (meters).
+DomePort AcrylicDome(const Eigen::Vector3d& decentering);
 
 // The ideal rectified pair of the paper: right_from_left = (I, (-b, 0, 0)).
 StereoRig IdealRig(const Camera& left, const Camera& right,
