@@ -7,11 +7,14 @@
 #include <cmath>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "command.h"
 #include "depth_range_flag.h"
+#include "dome_port_flags.h"
+#include "glass_index_flag.h"
 #include "index_flag.h"
 #include "number_list_flag.h"
 #include "progress.h"
@@ -21,7 +24,6 @@
 #include "rcm/sim/sequence_writer.h"
 #include "rcm/util/number_format.h"
 #include "rig_flags.h"
-#include "glass_index_flag.h"
 #include "simulation_flags.h"
 #include "target_flags.h"
 
@@ -49,6 +51,10 @@ DEFINE_string(board_warp, "",
               "calobject_warp, rcm calibrate's board_warp_mm: X_MM + Y_MM "
               "is the bowl at the centre; positive bows it away from the "
               "cameras); default flat");
+DEFINE_string(right_dome_decentering, "",
+              "with --port dome: X,Y,Z, the right camera's dome centre in "
+              "its frame, meters (default: --dome-decentering, the same "
+              "for both cameras)");
 DEFINE_bool(images, true, "render the images (--noimages: matches only)");
 DEFINE_bool(overwrite, false,
             "replace a sequence already in --out (its frames, matches, "
@@ -70,11 +76,20 @@ constexpr char kSimulateUsage[] =
     "                    [--board chessboard --cols 9 --rows 6\n"
     "                    --square 0.03 [--board-distance 0.6,2]\n"
     "                    [--board-warp 1,0.5]] [--seed "
-    "1]\n\n"
+    "1]\n"
+    "                    [--port dome --dome-inner-radius 0.04355\n"
+    "                    --dome-thickness 0.00375 --glass-index 1.495\n"
+    "                    --dome-decentering 0.002,-0.001,0.007\n"
+    "                    [--right-dome-decentering X,Y,Z]]\n\n"
     "A robot moves through a textured pool with the stereo rig looking 16\n"
     "degrees down; each camera sees through an exact flat port (air gap,\n"
     "glass, optional tilt; vector Snell's law), not through the model that\n"
-    "rcm estimates, so the data can test that model. Writes into DIR:\n"
+    "rcm estimates, so the data can test that model. With --port dome each\n"
+    "camera sees through a dome instead (both of the same glass, centred\n"
+    "at --dome-decentering in the camera's frame, the right one at\n"
+    "--right-dome-decentering when given), traced exactly; the camchain\n"
+    "stays the air calibration (no port block), as a user has it, for\n"
+    "rcm calibrate --underwater --port dome. Writes into DIR:\n"
     "  left/000000.png ...   8-bit mono images of cam0\n"
     "  right/000000.png ...  8-bit mono images of cam1\n"
     "  camchain.yaml         the in-air calibration (Kalibr), without the\n"
@@ -89,7 +104,9 @@ constexpr char kSimulateUsage[] =
     "                        --depth-range points at sampled depths;\n"
     "                        with --exposure-delay the right pixels see\n"
     "                        the scene moved during the delay)\n"
-    "  simulation.json       the settings, to reproduce the run\n"
+    "  simulation.json       the settings, to reproduce the run; with\n"
+    "                        --port dome its port block holds the truth:\n"
+    "                        decentering_m per camera (left, right)\n"
     "With --board a diver holds a printed chessboard (the flags of rcm\n"
     "calibrate; chessboards only) in front of the rig, moving it slowly and\n"
     "keeping it in view of both cameras when possible; --board-warp\n"
@@ -103,10 +120,12 @@ int RunSimulate();
 
 extern const Subcommand kSimulateCommand = {
     "simulate",
-    "synthetic stereo sequence through exact flat ports, with ground truth",
+    "synthetic stereo sequence through exact flat or dome ports, with "
+    "ground truth",
     kSimulateUsage,
-    {__FILE__, kDepthRangeFlagSource, kSimulationFlagsSource, kGlassIndexFlagSource, kIndexFlagSource, kRigFlagsSource,
-     kTargetFlagsSource},
+    {__FILE__, kDepthRangeFlagSource, kDomePortFlagsSource,
+     kSimulationFlagsSource, kGlassIndexFlagSource, kIndexFlagSource,
+     kRigFlagsSource, kTargetFlagsSource},
     RunSimulate};
 
 namespace {
@@ -137,6 +156,63 @@ Status ExposureDelayFromFlag(SequenceOptions* options) {
   options->exposure_delay.angular_speed_sd = (*values)[1] * kDegree;
   options->exposure_delay.speed_sd = values->size() == 3 ? (*values)[2] : 0.0;
   return options->Check().WithContext(context);
+}
+
+// --port dome and its flags into options->left_dome, right_dome; one line
+// on a bad value, a flat port's flag with a dome, or
+// --right-dome-decentering without --port dome.
+Status DomesFromFlags(SequenceOptions* options) {
+  const StatusOr<std::optional<DomePort>> dome = DomePortFromFlags();
+  if (!dome.ok()) return dome.status();
+  if (!dome->has_value()) {
+    if (FlagGiven("right_dome_decentering")) {
+      return Status::Error("--right-dome-decentering needs --port dome");
+    }
+    return Status::Ok();
+  }
+  for (const char* flag : {"air_gap", "glass_thickness", "port_tilt"}) {
+    if (FlagGiven(flag)) {
+      std::string name = flag;
+      std::replace(name.begin(), name.end(), '_', '-');
+      return Status::Error("--port dome: --" + name +
+                           " describes a flat port; a dome has "
+                           "--dome-inner-radius, --dome-thickness and "
+                           "--dome-decentering");
+    }
+  }
+  options->left_dome = **dome;
+  options->right_dome = **dome;
+  if (!FLAGS_right_dome_decentering.empty()) {
+    const std::string context =
+        FlagContext("right-dome-decentering", FLAGS_right_dome_decentering);
+    const StatusOr<std::vector<double>> values =
+        ParseNumberList(FLAGS_right_dome_decentering);
+    if (!values.ok() || values->size() != 3) {
+      return Status::Error(
+          context + ": expected X,Y,Z in meters, e.g. -0.001,0.002,0.008");
+    }
+    options->right_dome->decentering =
+        Eigen::Vector3d((*values)[0], (*values)[1], (*values)[2]);
+    RCM_RETURN_IF_ERROR(options->right_dome->Check().WithContext(context));
+  }
+  return Status::Ok();
+}
+
+// The dome of both cameras for simulation.json: the glass and the truth,
+// decentering_m per camera (left, right).
+nlohmann::json DomesJson(const SequenceOptions& options) {
+  const DomePort& left = *options.left_dome;
+  nlohmann::json decentering = nlohmann::json::array();
+  for (const DomePort* dome : {&left, &*options.right_dome}) {
+    decentering.push_back(
+        {dome->decentering.x(), dome->decentering.y(), dome->decentering.z()});
+  }
+  return {{"type", "dome"},
+          {"inner_radius", left.inner_radius},
+          {"thickness", left.thickness},
+          {"outer_radius", left.outer_radius()},
+          {"glass_index", left.glass_index},
+          {"decentering_m", decentering}};
 }
 
 // --board and --board-distance into options->board, board_motion.
@@ -228,6 +304,10 @@ int RunSimulate() {
     return kExitFailure;
   }
   SequenceOptions& options = simulation.value().options;
+  if (const Status domes = DomesFromFlags(&options); !domes.ok()) {
+    PrintError(command, domes.message());
+    return kExitUsage;
+  }
   options.render_images = FLAGS_images;
   options.matches_per_frame = FLAGS_matches_per_frame;
   options.match_noise_px = FLAGS_match_noise;
@@ -288,6 +368,7 @@ int RunSimulate() {
     return kExitFailure;
   }
   nlohmann::json settings = SimulationFlagsJson(simulation.value());
+  if (options.left_dome) settings["port"] = DomesJson(options);
   settings["matches_per_frame"] = FLAGS_matches_per_frame;
   settings["match_noise"] = FLAGS_match_noise;
   settings["outliers"] = FLAGS_outliers;
@@ -355,10 +436,25 @@ int RunSimulate() {
             << FLAGS_out << "/ in " << FormatFixed(seconds, 1) << " s\n"
             << "  rig      " << simulation.value().rig_name << " ("
             << left.width() << "x" << left.height() << ")\n"
-            << "  media    " << sim.media().ToString() << "\n"
-            << "  port     air gap " << options.left_port.air_gap
-            << " m, glass " << options.left_port.glass_thickness << " m (index "
-            << options.left_port.glass_index << ")\n";
+            << "  media    " << sim.media().ToString() << "\n";
+  if (options.left_dome) {
+    const DomePort& dome = *options.left_dome;
+    const auto millimetres = [](const Eigen::Vector3d& v) {
+      return "(" + FormatFixed(1e3 * v.x(), 2) + ", " +
+             FormatFixed(1e3 * v.y(), 2) + ", " + FormatFixed(1e3 * v.z(), 2) +
+             ") mm";
+    };
+    std::cout << "  port     dome, inner radius " << dome.inner_radius
+              << " m, glass " << dome.thickness << " m (index "
+              << dome.glass_index << "), centred at "
+              << millimetres(dome.decentering) << " (cam0), "
+              << millimetres(options.right_dome->decentering)
+              << " (cam1); camchain.yaml has no port block\n";
+  } else {
+    std::cout << "  port     air gap " << options.left_port.air_gap
+              << " m, glass " << options.left_port.glass_thickness
+              << " m (index " << options.left_port.glass_index << ")\n";
+  }
   if (!options.cam1_drift.IsZero()) {
     std::cout << "  drift    cam1 turned "
               << FormatFixed(options.cam1_drift.rotation.norm() / kDegree, 3)

@@ -14,6 +14,7 @@
 #include "cli/cli_runner.h"
 #include "rcm/calib/calibration_target.h"
 #include "rcm/calib/target_detector.h"
+#include "rcm/camera/dome_port_camera.h"
 #include "rcm/camera/flat_port_camera.h"
 #include "rcm/io/image_file.h"
 #include "rcm/sim/reference_rigs.h"
@@ -388,6 +389,121 @@ TEST(SimulateCli, NarrowRigWithDriftAndABoard) {
             test::ReadWholeFile(calibrated + "/camchain.yaml"));
 }
 
+// The 4-inch acrylic dome of issue 33, each camera decentered 1-3 mm
+// laterally and 5-10 mm axially.
+constexpr char kDomeFlags[] =
+    "--port dome --dome-inner-radius 0.04355 --dome-thickness 0.00375 "
+    "--glass-index 1.495 --dome-decentering 0.002,-0.001,0.007 "
+    "--right-dome-decentering -0.0015,0.0025,0.009";
+
+TEST(SimulateCli, DomePortDiveWritesTheTruthAndTheAirCamchain) {
+  // A board dive through two decentered domes (3 frames at 1 Hz, small
+  // images): the images exist, the truth (each camera's decentering) is in
+  // simulation.json, camchain.yaml is the air calibration a user has (no
+  // port block: the same bytes as a flat-port run's), and rcm::calib finds
+  // the board where the dome puts it.
+  const std::string folder = Folder("dome_board");
+  const RunResult result = Simulate(
+      folder, std::string("--rig narrow --frames 3 --frame-rate 1 "
+                          "--supersampling 1 --n 1.34 --board chessboard "
+                          "--cols 9 --rows 6 --square 0.03 ") +
+                  kDomeFlags);
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("port     dome"), std::string::npos) << result.out;
+  for (int f = 0; f < 3; ++f) {
+    for (const char* side : {"left", "right"}) {
+      const std::string path =
+          folder + "/" + side + "/00000" + std::to_string(f) + ".png";
+      ASSERT_TRUE(fs::exists(path)) << path;
+    }
+  }
+  const nlohmann::json settings =
+      nlohmann::json::parse(test::ReadWholeFile(folder + "/simulation.json"));
+  const nlohmann::json& port = settings["port"];
+  EXPECT_EQ(port["type"], "dome");
+  EXPECT_EQ(port["inner_radius"], 0.04355);
+  EXPECT_EQ(port["thickness"], 0.00375);
+  EXPECT_EQ(port["glass_index"], 1.495);
+  EXPECT_EQ(port["decentering_m"],
+            nlohmann::json::parse("[[0.002, -0.001, 0.007], "
+                                  "[-0.0015, 0.0025, 0.009]]"));
+  const std::string camchain = test::ReadWholeFile(folder + "/camchain.yaml");
+  EXPECT_EQ(camchain.find("port"), std::string::npos) << camchain;
+  const std::string flat = Folder("dome_board_flat");
+  ASSERT_EQ(Simulate(flat,
+                     "--rig narrow --frames 1 --noimages "
+                     "--matches-per-frame 5")
+                .exit_code,
+            0);
+  EXPECT_EQ(camchain, test::ReadWholeFile(flat + "/camchain.yaml"));
+
+  // Frame 0's board pose, read back, puts the corners where rcm::calib
+  // finds them in the left image through the left dome.
+  const std::string board = test::ReadWholeFile(folder + "/board.csv");
+  const size_t row = board.find("\n0,0.0,");
+  ASSERT_NE(row, std::string::npos) << board;
+  std::istringstream fields(board.substr(row + 1));
+  std::vector<double> values;
+  for (std::string field;
+       values.size() < 11 && std::getline(fields, field, ',');) {
+    values.push_back(std::stod(field));
+  }
+  ASSERT_EQ(values.size(), 11u);
+  ASSERT_EQ(values[9], 1.0);
+  Rigid3d cam0_from_target;
+  cam0_from_target.translation =
+      Eigen::Vector3d(values[2], values[3], values[4]);
+  cam0_from_target.rotation =
+      Eigen::Quaterniond(values[8], values[5], values[6], values[7])
+          .toRotationMatrix();
+  const calib::CalibrationTarget target =
+      calib::MakeCheckerboardTarget(9, 6, 0.03).value();
+  const std::optional<calib::TargetObservation> seen = calib::DetectTarget(
+      ReadImage(folder + "/left/000000.png", true).value(), target);
+  ASSERT_TRUE(seen.has_value());
+  EXPECT_EQ(seen->size(), 54);
+  DomePort dome;
+  dome.inner_radius = 0.04355;
+  dome.thickness = 0.00375;
+  dome.glass_index = 1.495;
+  dome.decentering = Eigen::Vector3d(0.002, -0.001, 0.007);
+  const DomePortCamera camera =
+      DomePortCamera::Create(NarrowFieldCam0(), dome, 1.34).value();
+  const std::vector<Eigen::Vector3d> corners = calib::TargetPoints(target);
+  for (int k = 0; k < seen->size(); ++k) {
+    const Eigen::Vector2d truth =
+        camera.ImageFromPoint(cam0_from_target * corners[seen->point_ids[k]])
+            .value();
+    EXPECT_LT((seen->pixels[k] - truth).norm(), 0.3) << "corner " << k;
+  }
+}
+
+TEST(SimulateCli, BadDomeFlagsGiveOneLine) {
+  const std::string folder = Folder("bad_dome");
+  const std::string dome = kDomeFlags;
+  ExpectFailsWithOneLine(Simulate(folder, dome + " --air-gap 0.01"), 2,
+                         "--air-gap describes a flat port");
+  ExpectFailsWithOneLine(Simulate(folder, dome + " --port-tilt 2"), 2,
+                         "--port-tilt describes a flat port");
+  ExpectFailsWithOneLine(
+      Simulate(folder, "--right-dome-decentering 0.001,0,0.005"), 2,
+      "--right-dome-decentering needs --port dome");
+  ExpectFailsWithOneLine(
+      Simulate(folder, "--port dome --dome-inner-radius 0.04355"), 2,
+      "--dome-thickness");
+  ExpectFailsWithOneLine(
+      Simulate(folder, dome + " --right-dome-decentering 0,0,0.05"), 2,
+      "outside the inner sphere");
+  ExpectFailsWithOneLine(
+      Simulate(folder, dome + " --right-dome-decentering 1,2"), 2,
+      "expected X,Y,Z");
+  ExpectFailsWithOneLine(
+      Simulate(folder, dome + " --noimages --matches-per-frame 5 "
+                              "--depth-range 0.5,2"),
+      2, "not domes");
+  EXPECT_FALSE(fs::exists(folder + "/truth.csv"));
+}
+
 TEST(SimulateCli, DriftAndBoardWithoutImages) {
   const std::string folder = Folder("drift_depths");
   const RunResult result = Simulate(
@@ -455,11 +571,29 @@ TEST(SimulateCli, BadDriftAndBoardFlagsGiveOneLine) {
 TEST(SimulateCli, HelpListsTheFlags) {
   const RunResult result = Rcm({"simulate", "--help"});
   EXPECT_EQ(result.exit_code, 0);
-  for (const char* flag :
-       {"--out", "--media", "--air-gap", "--calib", "--matches-per-frame",
-        "--seed", "--overwrite", "--extrinsic-drift",
-        "--board=", "--cols=", "--rows=", "--square=", "--board-distance",
-        "--board-warp", "board.csv", "narrow"}) {
+  for (const char* flag : {"--out",
+                           "--media",
+                           "--air-gap",
+                           "--calib",
+                           "--matches-per-frame",
+                           "--seed",
+                           "--overwrite",
+                           "--extrinsic-drift",
+                           "--board=",
+                           "--cols=",
+                           "--rows=",
+                           "--square=",
+                           "--board-distance",
+                           "--board-warp",
+                           "board.csv",
+                           "narrow",
+                           "--port",
+                           "--dome-inner-radius",
+                           "--dome-thickness",
+                           "--dome-decentering",
+                           "--right-dome-decentering",
+                           "--glass-index",
+                           "decentering_m"}) {
     EXPECT_NE(result.out.find(flag), std::string::npos) << flag;
   }
 }
