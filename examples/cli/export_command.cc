@@ -3,6 +3,7 @@
 // rig, for VIO frameworks that read raw underwater images.
 #include <gflags/gflags.h>
 
+#include <array>
 #include <chrono>
 #include <filesystem>
 #include <iostream>
@@ -164,10 +165,20 @@ int RunExport() {
     return kExitUsage;
   }
 
-  const StatusOr<StereoRig> rig =
-      ReadStereoRig(FLAGS_calib, FLAGS_left_camera, FLAGS_right_camera);
+  // A camchain's dome blocks: each camera its dome's, central at
+  // --reference-depth.
+  RigFileOptions rig_options;
+  rig_options.domes_allowed = true;
+  const StatusOr<StereoRig> rig = ReadStereoRig(
+      FLAGS_calib, FLAGS_left_camera, FLAGS_right_camera, rig_options);
   if (!rig.ok()) {
     PrintError(command, rig.status().message());
+    return kExitFailure;
+  }
+  const StatusOr<std::optional<std::array<DomePort, 2>>> domes =
+      ReadStereoRigDomes(FLAGS_calib, FLAGS_left_camera, FLAGS_right_camera);
+  if (!domes.ok()) {
+    PrintError(command, domes.status().message());
     return kExitFailure;
   }
 
@@ -176,7 +187,7 @@ int RunExport() {
   std::vector<WaterSideModelFit> fits;
   for (int k = 0; k < 2; ++k) {
     const StatusOr<RefractiveCamera> camera =
-        RefractiveCameraOfRig(*rig, k == 0, *n, FLAGS_reference_depth);
+        RefractiveCameraOfRig(*rig, k == 0, *n, FLAGS_reference_depth, *domes);
     if (!camera.ok()) {
       PrintError(command, camera.status().message());
       return kExitFailure;
@@ -219,8 +230,15 @@ int RunExport() {
   json["calib"] = FLAGS_calib;
   json["model"] = std::string(LensModelName(*model));
   json["fit_inset"] = options.fit_inset;
-  json["port"] = rig->HasThickPort() ? "thick" : "thin";
-  if (rig->HasThickPort()) json["reference_depth_m"] = FLAGS_reference_depth;
+  json["port"] = domes->has_value()    ? "dome"
+                 : rig->HasThickPort() ? "thick"
+                                       : "thin";
+  if (domes->has_value()) {
+    json["dome_parallax_px"] = DomeParallaxJson(*rig, **domes, *n);
+  }
+  if (rig->HasThickPort() || domes->has_value()) {
+    json["reference_depth_m"] = FLAGS_reference_depth;
+  }
   for (int k = 0; k < 2; ++k) {
     const std::string name = names[k];
     if (!CheckCameraInfoModel(fits[k].camera).ok()) {
@@ -277,6 +295,9 @@ int RunExport() {
             << " water-side models of " << FLAGS_calib << " at n = " << *n
             << "\n";
   if (rig->HasThickPort()) std::cout << "  " << ThickPortNote(*rig) << "\n";
+  if (domes->has_value()) {
+    std::cout << "  " << DomeNote(*rig, **domes, *n) << "\n";
+  }
   for (int k = 0; k < 2; ++k) {
     const WaterSideModelFit& fit = fits[k];
     const Camera& camera = fit.camera;

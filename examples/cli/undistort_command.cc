@@ -3,6 +3,7 @@
 #include <gflags/gflags.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -502,10 +503,20 @@ int RunUndistort() {
     }
   }
 
-  const StatusOr<StereoRig> rig =
-      ReadStereoRig(FLAGS_calib, FLAGS_left_camera, FLAGS_right_camera);
+  // A camchain's dome blocks: each camera its dome's, central at
+  // --reference-depth.
+  RigFileOptions rig_options;
+  rig_options.domes_allowed = true;
+  const StatusOr<StereoRig> rig = ReadStereoRig(
+      FLAGS_calib, FLAGS_left_camera, FLAGS_right_camera, rig_options);
   if (!rig.ok()) {
     PrintError(command, rig.status().message());
+    return kExitFailure;
+  }
+  const StatusOr<std::optional<std::array<DomePort, 2>>> domes =
+      ReadStereoRigDomes(FLAGS_calib, FLAGS_left_camera, FLAGS_right_camera);
+  if (!domes.ok()) {
+    PrintError(command, domes.status().message());
     return kExitFailure;
   }
   // Open the input before building the maps: a wrong path fails fast.
@@ -527,8 +538,10 @@ int RunUndistort() {
     return kExitFailure;
 #endif
   }
+  VirtualPinholeRigOptions rig_view_options = *options;
+  rig_view_options.domes = *domes;
   const StatusOr<VirtualPinholeRig> corrected =
-      VirtualPinholeRig::Create(*rig, *n, *options);
+      VirtualPinholeRig::Create(*rig, *n, rig_view_options);
   if (!corrected.ok()) {
     PrintError(command, corrected.status().message());
     return kExitFailure;
@@ -567,9 +580,15 @@ int RunUndistort() {
                   {"remap_per_image_mean", Mean(report->remap_ms)},
                   {"per_pair", report->total_ms / pairs}};
     json["out"] = FLAGS_out;
-    json["port"] = rig->HasThickPort() ? "thick" : "thin";
-    if (rig->HasThickPort())
+    json["port"] = domes->has_value()    ? "dome"
+                   : rig->HasThickPort() ? "thick"
+                                         : "thin";
+    if (domes->has_value()) {
+      json["dome_parallax_px"] = DomeParallaxJson(*rig, **domes, *n);
+    }
+    if (rig->HasThickPort() || domes->has_value()) {
       json["reference_depth_m"] = options->reference_depth;
+    }
     json.update(report->extra);
     std::cout << json.dump(2) << std::endl;
     return kExitOk;
@@ -580,6 +599,8 @@ int RunUndistort() {
        << "  input  " << report->source << "\n"
        << (rig->HasThickPort() ? "  port   " + ThickPortNote(*rig) + "\n"
                                : std::string())
+       << (domes->has_value() ? "  port   " + DomeNote(*rig, **domes, *n) + "\n"
+                              : std::string())
        << CameraLine("left   ", corrected->left()) << "\n"
        << CameraLine("right  ", corrected->right()) << "\n"
        << "  images " << report->images << " written (" << report->pairs

@@ -8,6 +8,7 @@
 
 #include "rcm/camera/dome_port_camera.h"
 #include "rcm/camera/dome_port_refraction.h"
+#include "rcm/camera/refractive_camera.h"
 #include "support/test_rigs.h"
 
 namespace rcm::dome_port_test {
@@ -360,6 +361,74 @@ TEST(DomePortRefraction, RayDerivativesMatchCentralDifferences) {
                   kDerivativeTolerance * (1.0 + std::abs(numeric[r])));
     }
   }
+}
+
+// The central camera of a dome (RefractiveCamera::CreateWithDome) images
+// every point at its reference depth exactly: pixel -> bearing -> the point
+// at the reference depth -> pixel, and through the virtual pinhole and
+// back, to the round trip's 1e-9 px.
+TEST(RefractiveCameraWithDome, ExactAtTheReferenceDepth) {
+  const Camera camera = ::rcm::test::AlphasenseCam0();
+  constexpr double kReferenceDepth = 1.5;
+  const RefractiveCamera central =
+      RefractiveCamera::CreateWithDome(
+          camera, 1.333, AcrylicDome({0.002, -0.001, 0.007}), kReferenceDepth)
+          .value();
+  EXPECT_EQ(central.VirtualFocalScale(), 1.0);
+  EXPECT_TRUE(central.CentralOnlyAtReferenceDepth());
+  int checked = 0;
+  for (const Eigen::Vector2d& pixel : ImageGrid(camera, 40.0)) {
+    const std::optional<Eigen::Vector3d> bearing =
+        central.BearingInWaterFromImage(pixel);
+    if (!bearing || !(bearing->z() > 0.05)) continue;
+    const Eigen::Vector3d point = *bearing * (kReferenceDepth / bearing->z());
+    EXPECT_LT((*central.ImageFromPointInWater(point) - pixel).norm(),
+              kRoundTripTolerancePx);
+    const std::optional<Eigen::Vector2d> virtual_pixel =
+        central.VirtualPinholeFromImage(pixel);
+    ASSERT_TRUE(virtual_pixel);
+    EXPECT_LT((*central.ImageFromVirtualPinhole(*virtual_pixel) - pixel).norm(),
+              kRoundTripTolerancePx);
+    ++checked;
+  }
+  EXPECT_GT(checked, 100);
+}
+
+// A centred dome's central camera is the air camera at every depth: its
+// virtual pinhole is the air camera's K applied to the air ray.
+TEST(RefractiveCameraWithDome, CentredDomeIsTheAirPinhole) {
+  const Camera camera = ::rcm::test::AlphasenseCam0();
+  const RefractiveCamera central =
+      RefractiveCamera::CreateWithDome(
+          camera, 1.333, AcrylicDome(Eigen::Vector3d::Zero()), 2.0)
+          .value();
+  const Eigen::Matrix3d k = central.VirtualPinholeMatrix();
+  EXPECT_EQ(k(0, 0), camera.fx());
+  EXPECT_EQ(k(1, 1), camera.fy());
+  for (const Eigen::Vector2d& pixel : ImageGrid(camera, 60.0)) {
+    const std::optional<Eigen::Vector2d> normalized =
+        camera.NormalizedFromImage(pixel);
+    if (!normalized) continue;
+    const std::optional<Eigen::Vector2d> virtual_pixel =
+        central.VirtualPinholeFromImage(pixel);
+    ASSERT_TRUE(virtual_pixel);
+    const Eigen::Vector2d expected(camera.fx() * normalized->x() + camera.cx(),
+                                   camera.fy() * normalized->y() + camera.cy());
+    EXPECT_LT((*virtual_pixel - expected).norm(),
+              1e-9 * (1.0 + expected.norm()));
+  }
+}
+
+TEST(RefractiveCameraWithDome, ReferenceDepthInsideTheDomeIsRefused) {
+  const StatusOr<RefractiveCamera> inside = RefractiveCamera::CreateWithDome(
+      PinholeCamera(), 1.333, AcrylicDome({0.0, 0.0, 0.007}), 0.04);
+  ASSERT_FALSE(inside.ok());
+  EXPECT_NE(inside.status().message().find("is not beyond the dome"),
+            std::string::npos)
+      << inside.status().message();
+  EXPECT_FALSE(RefractiveCamera::CreateWithDome(PinholeCamera(), 1.333,
+                                                AcrylicDome({0, 0, 0.05}), 2.0)
+                   .ok());
 }
 
 }  // namespace

@@ -5,6 +5,8 @@
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <random>
 #include <string>
 #include <vector>
@@ -285,6 +287,55 @@ TEST(CalibrateDomeCli, BadInputIsOneLine) {
       "has one camera (cam0)");
   EXPECT_FALSE(fs::exists(dive.dir + "/bad.yaml"));
   EXPECT_FALSE(fs::exists(dive.dir + "/bad2.yaml"));
+}
+
+// A camchain with dome blocks through the tools that need a central camera:
+// rcm export and rcm undistort make each camera central at
+// --reference-depth and report the parallax at other depths.
+TEST(DomeRigCli, ExportAndUndistortAtTheReferenceDepth) {
+  const std::string dir = test::TempFilePath("dome_rig");
+  fs::remove_all(dir);
+  fs::create_directories(dir + "/left");
+  fs::create_directories(dir + "/right");
+  Camchain camchain =
+      CamchainFromStereoRig(rcm::test::AlphasenseRealisticRig());
+  camchain.cameras[0].port.reset();
+  camchain.cameras[1].port.reset();
+  camchain.cameras[0].dome = Dome(Eigen::Vector3d(0.001, 0.0, 0.007));
+  camchain.cameras[1].dome = Dome(Eigen::Vector3d(-0.001, 0.0, 0.006));
+  ASSERT_TRUE(WriteCamchain(dir + "/rig.yaml", camchain).ok());
+  const RunResult exported =
+      Rcm({"export", "--calib", dir + "/rig.yaml", "--n", "1.333",
+           "--reference-depth", "1.5", "--out", dir + "/water.yaml", "--json"});
+  ASSERT_EQ(exported.exit_code, 0) << exported.err;
+  const nlohmann::json json = nlohmann::json::parse(exported.out);
+  EXPECT_EQ(json["port"], "dome");
+  EXPECT_EQ(json["reference_depth_m"], 1.5);
+  ASSERT_EQ(json["dome_parallax_px"].size(), 2u);
+  // Exact at 1.5 m, off at the other depths (the smallest sampled is the
+  // nearest, 0.3 m).
+  const nlohmann::json& left = json["dome_parallax_px"][0];
+  EXPECT_GT(left.front()["max_px"].get<double>(), 0.1);
+  EXPECT_TRUE(fs::exists(dir + "/water.yaml"));
+
+  const cv::Mat gray(540, 720, CV_8UC1, cv::Scalar(128));
+  ASSERT_TRUE(cv::imwrite(dir + "/left/0.png", gray));
+  ASSERT_TRUE(cv::imwrite(dir + "/right/0.png", gray));
+  const RunResult undistorted =
+      Rcm({"undistort", "--calib", dir + "/rig.yaml", "--n", "1.333", "--left",
+           dir + "/left", "--right", dir + "/right", "--out", dir + "/out"});
+  ASSERT_EQ(undistorted.exit_code, 0) << undistorted.err;
+  EXPECT_NE(undistorted.out.find("dome (camchain port blocks): exact for "
+                                 "points 2.00 m"),
+            std::string::npos)
+      << undistorted.out;
+  EXPECT_TRUE(fs::exists(dir + "/out/left/0.png"));
+  // A dome on one camera only is one line.
+  camchain.cameras[1].dome.reset();
+  ASSERT_TRUE(WriteCamchain(dir + "/half.yaml", camchain).ok());
+  ExpectOneLineError(Rcm({"export", "--calib", dir + "/half.yaml", "--n",
+                          "1.333", "--out", dir + "/half_water.yaml"}),
+                     "cam1 has no dome port block, cam0 has one");
 }
 
 }  // namespace

@@ -26,8 +26,8 @@ StatusOr<RefractiveCamera> RefractiveCamera::CreateWithPort(
   if (!result.ok()) return result.status();
   RCM_RETURN_IF_ERROR(port.Check());
   if (!std::isfinite(reference_depth) ||
-      !(reference_depth >= port.air_gap + port.glass_thickness +
-                               kMinReferenceDepthBeyondGlass)) {
+      !(reference_depth >=
+        port.air_gap + port.glass_thickness + kMinReferenceDepthBeyondGlass)) {
     std::ostringstream message;
     message << "reference depth " << reference_depth
             << " m is not beyond the port's glass ("
@@ -48,6 +48,34 @@ StatusOr<RefractiveCamera> RefractiveCamera::CreateWithPort(
     if (!thick.ok()) return thick.status();
     result->thick_ = std::move(thick).value();
   }
+  return result;
+}
+
+StatusOr<RefractiveCamera> RefractiveCamera::CreateWithDome(
+    const Camera& camera, double n, const DomePort& dome,
+    double reference_depth) {
+  StatusOr<RefractiveCamera> result = Create(camera, n);
+  if (!result.ok()) return result.status();
+  StatusOr<DomePortCamera> through = DomePortCamera::Create(camera, dome, n);
+  if (!through.ok()) return through.status();
+  const double outer = dome.decentering.z() + dome.outer_radius();
+  if (!std::isfinite(reference_depth) ||
+      !(reference_depth >= outer + kMinReferenceDepthBeyondGlass)) {
+    std::ostringstream message;
+    message << "reference depth " << reference_depth
+            << " m is not beyond the dome (" << outer << " m) by "
+            << kMinReferenceDepthBeyondGlass * 1e3 << " mm at least";
+    return Status::Error(message.str());
+  }
+  if (reference_depth > kMaxReferenceDepth) {
+    std::ostringstream message;
+    message << "reference depth " << reference_depth
+            << " m is beyond the accepted " << kMaxReferenceDepth << " m";
+    return Status::Error(message.str());
+  }
+  result->dome_ = dome;
+  result->dome_camera_ = std::move(through).value();
+  result->reference_depth_ = reference_depth;
   return result;
 }
 
@@ -74,10 +102,12 @@ std::optional<Eigen::Vector3d> UnitOrNothing(const Eigen::Vector3d& direction) {
 
 std::optional<Eigen::Vector3d> RefractiveCamera::BearingInWaterFromImage(
     const Eigen::Vector2d& pixel) const {
-  if (const FlatPortCamera* thick = this->thick()) {
+  if (CentralOnlyAtReferenceDepth()) {
     // Where the pixel's ray reaches the reference depth, seen from the
     // center.
-    const std::optional<RayInMedium> ray = thick->RayFromImage(pixel);
+    const std::optional<RayInMedium> ray =
+        dome_camera_ ? dome_camera_->RayFromImage(pixel)
+                     : thick()->RayFromImage(pixel);
     if (!ray || !(ray->direction.z() > 0.0)) return std::nullopt;
     const double along =
         (reference_depth_ - ray->origin.z()) / ray->direction.z();
@@ -95,6 +125,7 @@ std::optional<Eigen::Vector3d> RefractiveCamera::BearingInWaterFromImage(
 
 std::optional<Eigen::Vector2d> RefractiveCamera::ImageFromPointInWater(
     const Eigen::Vector3d& point_in_camera) const {
+  if (dome_camera_) return dome_camera_->ImageFromPoint(point_in_camera);
   if (const FlatPortCamera* thick = this->thick()) {
     return thick->ImageFromPoint(point_in_camera);
   }
@@ -108,8 +139,8 @@ std::optional<Eigen::Vector2d> RefractiveCamera::ImageFromPointInWater(
 
 Eigen::Matrix3d RefractiveCamera::VirtualPinholeMatrix() const {
   Eigen::Matrix3d k = Eigen::Matrix3d::Identity();
-  k(0, 0) = n_ * camera_.fx();
-  k(1, 1) = n_ * camera_.fy();
+  k(0, 0) = VirtualFocalScale() * camera_.fx();
+  k(1, 1) = VirtualFocalScale() * camera_.fy();
   k(0, 2) = camera_.cx();
   k(1, 2) = camera_.cy();
   return k;
@@ -117,14 +148,15 @@ Eigen::Matrix3d RefractiveCamera::VirtualPinholeMatrix() const {
 
 std::optional<Eigen::Vector2d> RefractiveCamera::VirtualPinholeFromImage(
     const Eigen::Vector2d& pixel) const {
-  if (thick() != nullptr) {
-    // K_n applied to the bearing: u = n fx X / Z + cx (eq. 9).
+  if (CentralOnlyAtReferenceDepth()) {
+    // K_n applied to the bearing: u = s fx X / Z + cx (eq. 9).
     const std::optional<Eigen::Vector3d> bearing =
         BearingInWaterFromImage(pixel);
     if (!bearing || !(bearing->z() > 0.0)) return std::nullopt;
+    const double s = VirtualFocalScale();
     return IfFinite<2>(Eigen::Vector2d(
-        n_ * camera_.fx() * bearing->x() / bearing->z() + camera_.cx(),
-        n_ * camera_.fy() * bearing->y() / bearing->z() + camera_.cy()));
+        s * camera_.fx() * bearing->x() / bearing->z() + camera_.cx(),
+        s * camera_.fy() * bearing->y() / bearing->z() + camera_.cy()));
   }
   const std::optional<Eigen::Vector2d> normalized =
       camera_.NormalizedFromImage(pixel);
@@ -140,11 +172,12 @@ std::optional<Eigen::Vector2d> RefractiveCamera::ImageFromVirtualPinhole(
     const Eigen::Vector2d& virtual_pixel) const {
   const double xv = (virtual_pixel.x() - camera_.cx()) / camera_.fx();
   const double yv = (virtual_pixel.y() - camera_.cy()) / camera_.fy();
-  if (thick() != nullptr) {
-    // The virtual point (xv, yv) is the ray (xv, yv, n) (eq. 10): the
+  if (CentralOnlyAtReferenceDepth()) {
+    // The virtual point (xv, yv) is the ray (xv, yv, s) (eq. 10): the
     // point at the reference depth along it.
-    return ImageFromPointInWater(Eigen::Vector3d(xv, yv, n_) *
-                                 (reference_depth_ / n_));
+    const double s = VirtualFocalScale();
+    return ImageFromPointInWater(Eigen::Vector3d(xv, yv, s) *
+                                 (reference_depth_ / s));
   }
   Eigen::Vector2d normalized;
   if (!FlatPortRefraction::NormalizedFromVirtual(n_, xv, yv, &normalized.x(),

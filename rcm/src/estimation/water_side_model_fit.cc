@@ -98,8 +98,8 @@ StatusOr<WaterSideModelFit> FitWaterSideModel(
   }
 
   std::array<double, kMaxLensParams> params{};
-  params[0] = camera.n() * lens.fx();
-  params[1] = camera.n() * lens.fy();
+  params[0] = camera.VirtualFocalScale() * lens.fx();
+  params[1] = camera.VirtualFocalScale() * lens.fy();
   params[2] = lens.cx();
   params[3] = lens.cy();
   // Zero distortion, the virtual pinhole; the EUCM's pinhole is alpha = 0

@@ -63,8 +63,12 @@ StatusOr<StereoRig> ReadCamchainRig(const std::string& path,
     if (!index.ok()) return index.status().WithContext(path);
     indices[i] = *index;
   }
+  Camchain lenses = *camchain;
+  if (options.domes_allowed) {
+    for (CamchainCamera& camera : lenses.cameras) camera.dome.reset();
+  }
   const StatusOr<StereoRig> rig =
-      StereoRigFromCamchain(*camchain, indices[0], indices[1]);
+      StereoRigFromCamchain(lenses, indices[0], indices[1]);
   if (!rig.ok()) return rig.status().WithContext(path);
 
   const std::string sidecar = CovarianceSidecarPath(path);
@@ -177,6 +181,33 @@ StatusOr<StereoRig> ReadStereoRig(const std::string& spec,
                          "'left.yaml,right.yaml'");
   }
   return ReadCamchainRig(spec, file->text, left, right, options);
+}
+
+StatusOr<std::optional<std::array<DomePort, 2>>> ReadStereoRigDomes(
+    const std::string& spec, const std::string& left,
+    const std::string& right) {
+  using Domes = std::optional<std::array<DomePort, 2>>;
+  if (spec.find(',') != std::string::npos) return Domes();
+  const StatusOr<RigFile> file = ReadRigFile(spec);
+  if (!file.ok()) return file.status();
+  if (file->format == CalibrationFileFormat::kCameraInfo) return Domes();
+  const StatusOr<Camchain> camchain = ParseCamchain(file->text, spec);
+  if (!camchain.ok()) return camchain.status();
+  const std::string* names[2] = {&left, &right};
+  std::optional<DomePort> domes[2];
+  for (int i = 0; i < 2; ++i) {
+    const StatusOr<int> index = FindCamchainCamera(*camchain, *names[i]);
+    if (!index.ok()) return index.status().WithContext(spec);
+    domes[i] = camchain->cameras[*index].dome;
+  }
+  if (!domes[0] && !domes[1]) return Domes();
+  if (!domes[0] || !domes[1]) {
+    const int with = domes[0] ? 0 : 1;
+    return Status::Error(spec + ": " + *names[1 - with] +
+                         " has no dome port block, " + *names[with] +
+                         " has one: give both cameras one");
+  }
+  return Domes(std::array<DomePort, 2>{*domes[0], *domes[1]});
 }
 
 }  // namespace rcm

@@ -131,10 +131,22 @@ Status VirtualPinholeRigOptions::Check() const {
   return Status::Ok();
 }
 
-StatusOr<RefractiveCamera> RefractiveCameraOfRig(const StereoRig& rig,
-                                                 bool left, double n,
-                                                 double reference_depth) {
+StatusOr<RefractiveCamera> RefractiveCameraOfRig(
+    const StereoRig& rig, bool left, double n, double reference_depth,
+    const std::optional<std::array<DomePort, 2>>& domes) {
   const Camera& camera = left ? rig.left() : rig.right();
+  if (domes.has_value()) {
+    if (rig.ports().has_value()) {
+      return Status::Error(
+          "a rig with flat ports cannot also look through domes");
+    }
+    StatusOr<RefractiveCamera> result = RefractiveCamera::CreateWithDome(
+        camera, n, (*domes)[left ? 0 : 1], reference_depth);
+    if (!result.ok()) {
+      return result.status().WithContext(left ? "left camera" : "right camera");
+    }
+    return result;
+  }
   if (!rig.HasThickPort()) return RefractiveCamera::Create(camera, n);
   const FlatPort& port = left ? rig.ports()->left : rig.ports()->right;
   StatusOr<RefractiveCamera> result =
@@ -178,9 +190,9 @@ std::optional<Eigen::Vector2d> VirtualPinholeCamera::RawFromCorrected(
   const Eigen::Vector3d ray =
       view.camera_from_view *
       (view.k.inverse() * corrected_pixel.homogeneous());
-  if (camera.port().has_value()) {
-    // A thick port is central only at its reference depth: the point
-    // there (any point of the ray for a thin port).
+  if (camera.port().has_value() || camera.dome().has_value()) {
+    // A thick port or a dome is central only at its reference depth: the
+    // point there (any point of the ray for a thin port).
     if (!(ray.z() > 0.0)) return std::nullopt;
     return camera.ImageFromPointInWater(ray *
                                         (camera.reference_depth() / ray.z()));
@@ -192,11 +204,11 @@ StatusOr<VirtualPinholeRig> VirtualPinholeRig::Create(
     const StereoRig& rig, double n, const VirtualPinholeRigOptions& options) {
   RCM_RETURN_IF_ERROR(options.Check());
   const auto start = std::chrono::steady_clock::now();
-  const StatusOr<RefractiveCamera> left =
-      RefractiveCameraOfRig(rig, /*left=*/true, n, options.reference_depth);
+  const StatusOr<RefractiveCamera> left = RefractiveCameraOfRig(
+      rig, /*left=*/true, n, options.reference_depth, options.domes);
   if (!left.ok()) return left.status();
-  const StatusOr<RefractiveCamera> right =
-      RefractiveCameraOfRig(rig, /*left=*/false, n, options.reference_depth);
+  const StatusOr<RefractiveCamera> right = RefractiveCameraOfRig(
+      rig, /*left=*/false, n, options.reference_depth, options.domes);
   if (!right.ok()) return right.status();
 
   VirtualPinholeView left_view;

@@ -9,6 +9,8 @@
 #include <optional>
 
 #include "rcm/camera/camera.h"
+#include "rcm/camera/dome_port_camera.h"
+#include "rcm/camera/dome_port_geometry.h"
 #include "rcm/camera/flat_port_camera.h"
 #include "rcm/camera/flat_port_geometry.h"
 #include "rcm/util/status.h"
@@ -52,9 +54,34 @@ class RefractiveCamera {
                                                    double n,
                                                    const FlatPort& port,
                                                    double reference_depth);
+  // The camera behind a dome port (dome_port_camera.h), made central at
+  // `reference_depth` as CreateWithPort does for a thick flat port: a
+  // pixel's bearing is the direction from the camera centre to the point
+  // where its ray in the water reaches that depth. The virtual pinhole of a
+  // dome is the air camera's K (no factor n: a centred dome does not
+  // refract, and a decentered one is a weak lens, so its bearings are
+  // within a few percent of the air rays). A point at another depth Z' is
+  // seen through the bearings off by the parallax of the rays' offsets from
+  // the camera centre, about f |C_perp| |1/Z' - 1/Z| pixels
+  // (rcm/estimation/dome_port_error.h maps it). Errors: an invalid n or
+  // dome, a reference depth that is not finite, not
+  // kMinReferenceDepthBeyondGlass beyond the dome's outer surface (C_z +
+  // r2), or beyond kMaxReferenceDepth.
+  static StatusOr<RefractiveCamera> CreateWithDome(const Camera& camera,
+                                                   double n,
+                                                   const DomePort& dome,
+                                                   double reference_depth);
+
   // The port and reference depth of CreateWithPort; nullopt for Create.
   const std::optional<FlatPort>& port() const { return port_; }
+  // The dome of CreateWithDome; nullopt otherwise.
+  const std::optional<DomePort>& dome() const { return dome_; }
   double reference_depth() const { return reference_depth_; }
+  // True for a camera that is central only at its reference depth (a
+  // thick port or a dome).
+  bool CentralOnlyAtReferenceDepth() const {
+    return thick_.has_value() || dome_camera_.has_value();
+  }
 
   const Camera& camera() const { return camera_; }
   double n() const { return n_; }
@@ -72,8 +99,10 @@ class RefractiveCamera {
   std::optional<Eigen::Vector2d> ImageFromPointInWater(
       const Eigen::Vector3d& point_in_camera) const;
 
-  // The virtual pinhole K_n = [n fx, 0, cx; 0, n fy, cy; 0, 0, 1] (eq. 9).
+  // The virtual pinhole K_n = [s fx, 0, cx; 0, s fy, cy; 0, 0, 1] with
+  // s = n behind a flat port (eq. 9) and s = 1 behind a dome.
   Eigen::Matrix3d VirtualPinholeMatrix() const;
+  double VirtualFocalScale() const { return dome_camera_ ? 1.0 : n_; }
   // Virtual pinhole pixel of a raw pixel (refraction and lens removed);
   // nullopt as for BearingInWaterFromImage.
   std::optional<Eigen::Vector2d> VirtualPinholeFromImage(
@@ -95,6 +124,8 @@ class RefractiveCamera {
   double n_;
   std::optional<FlatPort> port_;
   std::optional<FlatPortCamera> thick_;
+  std::optional<DomePort> dome_;
+  std::optional<DomePortCamera> dome_camera_;
   double reference_depth_ = 0.0;
 };
 

@@ -26,10 +26,12 @@
 #ifndef RCM_IO_STEREO_RIG_FILE_H_
 #define RCM_IO_STEREO_RIG_FILE_H_
 
+#include <array>
 #include <optional>
 #include <string>
 #include <utility>
 
+#include "rcm/camera/dome_port_geometry.h"
 #include "rcm/stereo/stereo_rig.h"
 #include "rcm/util/status.h"
 
@@ -38,6 +40,11 @@ namespace rcm {
 struct RigFileOptions {
   std::optional<std::pair<double, double>> drift_prior;
   std::optional<double> focal_drift;
+  // Read a camchain whose cameras have dome port blocks (the tools that
+  // model domes, which take them from ReadStereoRigDomes): the rig is the
+  // cameras' without them. Otherwise such a camchain is an error
+  // (StereoRigFromCamchain).
+  bool domes_allowed = false;
 };
 
 // `rig` with what ReadStereoRig gives a rig file without a sidecar: the
@@ -50,6 +57,15 @@ StatusOr<StereoRig> ReadStereoRig(const std::string& spec,
                                   const std::string& left = "cam0",
                                   const std::string& right = "cam1",
                                   const RigFileOptions& options = {});
+
+// The dome port blocks of the rig's two cameras (camchain.h), left then
+// right: nullopt when neither has one (or the spec is a camera_info pair).
+// Errors: those of reading the camchain, an unknown camera name, and only
+// one of the two cameras with a dome ("cam1 has no dome port block, cam0
+// has one: give both cameras one").
+StatusOr<std::optional<std::array<DomePort, 2>>> ReadStereoRigDomes(
+    const std::string& spec, const std::string& left = "cam0",
+    const std::string& right = "cam1");
 
 }  // namespace rcm
 

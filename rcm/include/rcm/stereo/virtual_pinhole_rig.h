@@ -66,11 +66,13 @@
 #define RCM_STEREO_VIRTUAL_PINHOLE_RIG_H_
 
 #include <Eigen/Core>
+#include <array>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <utility>
 
 #include "rcm/camera/camera.h"
+#include "rcm/camera/dome_port_geometry.h"
 #include "rcm/camera/refractive_camera.h"
 #include "rcm/camera/virtual_pinhole_remap.h"
 #include "rcm/stereo/stereo_rig.h"
@@ -98,16 +100,23 @@ struct VirtualPinholeRigOptions {
   // (RefractiveCamera::CreateWithPort); points nearer or farther are off
   // by the port's parallax. Finite and > 0; unused for thin ports.
   double reference_depth = 2.0;
+  // Dome ports in front of the cameras (a camchain's dome blocks; the rig
+  // then has no flat ports): each camera is its dome's camera made central
+  // at reference_depth (RefractiveCamera::CreateWithDome), whose virtual
+  // pinhole is the air camera's K. Both or neither.
+  std::optional<std::array<DomePort, 2>> domes;
 
   Status Check() const;
 };
 
-// The camera of one side of `rig` in the water at index n: its ports'
-// thick-port camera at the reference depth when the rig has a thick port
-// (RefractiveCamera::CreateWithPort), the paper's camera otherwise.
-StatusOr<RefractiveCamera> RefractiveCameraOfRig(const StereoRig& rig,
-                                                 bool left, double n,
-                                                 double reference_depth);
+// The camera of one side of `rig` in the water at index n: its dome's
+// camera at the reference depth when `domes` are given
+// (RefractiveCamera::CreateWithDome), its ports' thick-port camera there
+// when the rig has a thick port (RefractiveCamera::CreateWithPort), the
+// paper's camera otherwise.
+StatusOr<RefractiveCamera> RefractiveCameraOfRig(
+    const StereoRig& rig, bool left, double n, double reference_depth,
+    const std::optional<std::array<DomePort, 2>>& domes = std::nullopt);
 
 // One corrected camera: its camera in the medium, its view, the maps from
 // its raw images, and the pinhole camera its corrected images are.
