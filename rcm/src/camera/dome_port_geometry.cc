@@ -50,7 +50,11 @@ StatusOr<double> DomeThicknessFromRadii(double inner_radius,
             << " m is not beyond the inner radius " << inner_radius << " m";
     return Status::Error(message.str());
   }
-  const double from_radii = outer_radius - inner_radius;
+  // To the nanometre: radii are known to micrometres at best, and the
+  // difference of two decimal radii (0.0473 - 0.04355) carries rounding
+  // (0.0037500000000000033) that a camchain would print.
+  const double from_radii =
+      std::round((outer_radius - inner_radius) * 1e9) / 1e9;
   // Radii and thickness written to 1 micrometre agree to that.
   constexpr double kAgreement = 1e-6;
   if (thickness >= 0.0 && std::abs(from_radii - thickness) > kAgreement) {

@@ -63,8 +63,9 @@ struct DomePort {
   bool operator!=(const DomePort& other) const { return !(*this == other); }
 };
 
-// The thickness of a dome given by its two radii, with the check that
-// they agree with a thickness given too (`thickness` < 0: not given).
+// The thickness of a dome given by its two radii (rounded to the
+// nanometre), with the check that they agree with a thickness given too
+// (`thickness` < 0: not given).
 // Errors: "dome outer radius 0.0473 m is not beyond the inner radius
 // 0.04355 m", "dome radii 0.04355 m and 0.0473 m give a thickness of
 // 0.00375 m, not the 0.005 m given".
