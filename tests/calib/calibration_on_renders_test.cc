@@ -186,15 +186,6 @@ constexpr double kMaxDomeDecenteringError = 2e-4;  // meters
 constexpr double kMaxDomeDecenteringSigmas = 3.0;
 constexpr double kDomeWaterIndex = 1.333;
 
-DomePort RenderedDome(const Eigen::Vector3d& decentering) {
-  DomePort dome;
-  dome.inner_radius = 0.04355;
-  dome.thickness = 0.00375;
-  dome.glass_index = 1.495;
-  dome.decentering = decentering;
-  return dome;
-}
-
 // Renders `num_poses` views of the board through each camera's dome
 // (cam0 = rig.left(); the right camera when `decentering` has two), detects
 // them and calibrates the decentering; prints and checks it.
@@ -210,12 +201,13 @@ void ExpectDomeDiveRecovered(const StereoRig& rig,
   std::vector<DomeCameraInput> inputs;
   for (int c = 0; c < num_cameras; ++c) {
     const DomePortCamera through =
-        DomePortCamera::Create(*lenses[c], RenderedDome(decentering[c]),
-                               kDomeWaterIndex)
+        DomePortCamera::Create(
+            *lenses[c], rcm::test::AcrylicDome(decentering[c]), kDomeWaterIndex)
             .value();
     renderers.push_back(TargetRenderer::Create(through, texture).value());
     // The start: the dome's glass, centred.
-    inputs.push_back({*lenses[c], RenderedDome(Eigen::Vector3d::Zero())});
+    inputs.push_back(
+        {*lenses[c], rcm::test::AcrylicDome(Eigen::Vector3d::Zero())});
   }
   TargetRenderOptions render;
   render.noise_sigma = 2.0;

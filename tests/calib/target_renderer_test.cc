@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -17,6 +18,7 @@
 #include "rcm/calib/target_image.h"
 #include "rcm/camera/dome_port_camera.h"
 #include "rcm/sim/reference_rigs.h"
+#include "support/test_rigs.h"
 
 namespace rcm::calib::target_renderer_test {
 namespace {
@@ -65,6 +67,37 @@ Eigen::Vector2d TargetSeenAt(const Camera& camera, const Rigid3d& pose,
   return normalized * pose.translation.z() - pose.translation.head<2>();
 }
 
+// Every pixel of `image` whose four corners see one texture pixel (where
+// `seen_at` puts them on the target) has exactly its value, or
+// `background` off the texture; and there are many of both.
+void ExpectUniformPixelsAreTheirSquare(
+    const cv::Mat& image, const TargetImage& texture,
+    const std::function<Eigen::Vector2d(const Eigen::Vector2d&)>& seen_at,
+    int background) {
+  int uniform = 0;
+  int off_target = 0;
+  for (int y = 0; y < image.rows; ++y) {
+    for (int x = 0; x < image.cols; ++x) {
+      // The texture values at the pixel's four corners.
+      int values[4];
+      for (int k = 0; k < 4; ++k) {
+        values[k] = TextureAt(
+            texture,
+            seen_at(Eigen::Vector2d(x - 0.5 + (k & 1), y - 0.5 + k / 2)));
+      }
+      const bool same = values[0] == values[1] && values[1] == values[2] &&
+                        values[2] == values[3];
+      if (!same) continue;
+      const int expected = values[0] < 0 ? background : values[0];
+      EXPECT_EQ(image.at<uint8_t>(y, x), expected) << x << ", " << y;
+      ++(values[0] < 0 ? off_target : uniform);
+    }
+  }
+  // The test saw squares of both colours and the background.
+  EXPECT_GT(uniform, 1000);
+  EXPECT_GT(off_target, 100);
+}
+
 TEST(TargetRenderer, PixelInsideOneSquareHasExactlyItsColour) {
   const Camera camera = SmallPinhole();
   const TargetImage texture = DrawTargetImage(Checkerboard(), 2000.0);
@@ -77,33 +110,12 @@ TEST(TargetRenderer, PixelInsideOneSquareHasExactlyItsColour) {
   ASSERT_EQ(image.type(), CV_8UC1);
   ASSERT_EQ(image.cols, 160);
   ASSERT_EQ(image.rows, 120);
-  int uniform = 0;
-  int off_target = 0;
-  for (int y = 0; y < image.rows; ++y) {
-    for (int x = 0; x < image.cols; ++x) {
-      // The texture values at the pixel's four corners.
-      int values[4];
-      for (int k = 0; k < 4; ++k) {
-        values[k] = TextureAt(
-            texture,
-            TargetSeenAt(camera, pose,
-                         Eigen::Vector2d(x - 0.5 + (k & 1), y - 0.5 + k / 2)));
-      }
-      const bool same = values[0] == values[1] && values[1] == values[2] &&
-                        values[2] == values[3];
-      if (!same) continue;
-      if (values[0] < 0) {
-        EXPECT_EQ(image.at<uint8_t>(y, x), 77) << x << ", " << y;
-        ++off_target;
-      } else {
-        EXPECT_EQ(image.at<uint8_t>(y, x), values[0]) << x << ", " << y;
-        ++uniform;
-      }
-    }
-  }
-  // The test saw squares of both colours and the background.
-  EXPECT_GT(uniform, 1000);
-  EXPECT_GT(off_target, 100);
+  ExpectUniformPixelsAreTheirSquare(
+      image, texture,
+      [&](const Eigen::Vector2d& pixel) {
+        return TargetSeenAt(camera, pose, pixel);
+      },
+      77);
 }
 
 TEST(TargetRenderer, BoardBehindCameraIsBackground) {
@@ -123,14 +135,20 @@ TEST(TargetRenderer, BoardBehindCameraIsBackground) {
   EXPECT_EQ(cv::countNonZero(renderer.Render(edge_on, options) != 33), 0);
 }
 
-TEST(TargetRenderer, ProjectTargetPointsAgreesWithCamera) {
-  const Camera camera = AlphasenseFrontCam0();
-  const CalibrationTarget target = Checkerboard();
+// The board turned by 0.4 rad about a skew axis, 0.4 m ahead.
+Rigid3d Oblique() {
   Rigid3d pose;
   pose.rotation =
       Eigen::AngleAxisd(0.4, Eigen::Vector3d(0.3, 1.0, 0.2).normalized())
           .toRotationMatrix();
   pose.translation = Eigen::Vector3d(-0.1, -0.05, 0.4);
+  return pose;
+}
+
+TEST(TargetRenderer, ProjectTargetPointsAgreesWithCamera) {
+  const Camera camera = AlphasenseFrontCam0();
+  const CalibrationTarget target = Checkerboard();
+  const Rigid3d pose = Oblique();
   const std::vector<std::optional<Eigen::Vector2d>> pixels =
       ProjectTargetPoints(camera, pose, target);
   const std::vector<Eigen::Vector3d> points = TargetPoints(target);
@@ -217,12 +235,9 @@ TEST(TargetRenderer, RenderTimeIsReported) {
 // 7 mm) in water.
 DomePortCamera BehindDome(const Camera& camera,
                           const Eigen::Vector3d& decentering) {
-  DomePort dome;
-  dome.inner_radius = 0.04355;
-  dome.thickness = 0.00375;
-  dome.glass_index = 1.495;
-  dome.decentering = decentering;
-  return DomePortCamera::Create(camera, dome, 1.333).value();
+  return DomePortCamera::Create(camera, ::rcm::test::AcrylicDome(decentering),
+                                1.333)
+      .value();
 }
 
 const Eigen::Vector3d kDecentering(0.002, -0.001, 0.007);
@@ -250,27 +265,12 @@ TEST(TargetRenderer, DomePixelInsideOneSquareHasExactlyItsColour) {
   TargetRenderOptions options;
   options.background = 77;
   const cv::Mat image = renderer.Render(pose, options);
-  int uniform = 0;
-  int off_target = 0;
-  for (int y = 0; y < image.rows; ++y) {
-    for (int x = 0; x < image.cols; ++x) {
-      int values[4];
-      for (int k = 0; k < 4; ++k) {
-        values[k] = TextureAt(
-            texture, TargetSeenThroughDomeAt(
-                         camera, pose,
-                         Eigen::Vector2d(x - 0.5 + (k & 1), y - 0.5 + k / 2)));
-      }
-      const bool same = values[0] == values[1] && values[1] == values[2] &&
-                        values[2] == values[3];
-      if (!same) continue;
-      const int expected = values[0] < 0 ? 77 : values[0];
-      EXPECT_EQ(image.at<uint8_t>(y, x), expected) << x << ", " << y;
-      ++(values[0] < 0 ? off_target : uniform);
-    }
-  }
-  EXPECT_GT(uniform, 1000);
-  EXPECT_GT(off_target, 100);
+  ExpectUniformPixelsAreTheirSquare(
+      image, texture,
+      [&](const Eigen::Vector2d& pixel) {
+        return TargetSeenThroughDomeAt(camera, pose, pixel);
+      },
+      77);
   // Behind the camera: background.
   options.background = 33;
   EXPECT_EQ(cv::countNonZero(renderer.Render(Frontal(-0.8), options) != 33), 0);
@@ -363,11 +363,7 @@ TEST(TargetRenderer, DomeCornersAreDetectedWhereTheyProject) {
 TEST(TargetRenderer, ProjectTargetPointsThroughADomeAgreesWithTheDome) {
   const DomePortCamera camera = BehindDome(AlphasenseFrontCam0(), kDecentering);
   const CalibrationTarget target = Checkerboard();
-  Rigid3d pose;
-  pose.rotation =
-      Eigen::AngleAxisd(0.4, Eigen::Vector3d(0.3, 1.0, 0.2).normalized())
-          .toRotationMatrix();
-  pose.translation = Eigen::Vector3d(-0.1, -0.05, 0.4);
+  const Rigid3d pose = Oblique();
   const Eigen::Vector2d warp(0.001, 0.0005);
   const std::vector<std::optional<Eigen::Vector2d>> pixels =
       ProjectTargetPoints(camera, pose, target, warp);

@@ -19,6 +19,7 @@
 #include "rcm/io/image_file.h"
 #include "rcm/sim/reference_rigs.h"
 #include "support/temp_file.h"
+#include "support/test_rigs.h"
 
 namespace rcm::simulate_cli_test {
 namespace {
@@ -66,6 +67,44 @@ std::vector<std::vector<std::string>> ReadCsv(const std::string& path) {
     rows.push_back(fields);
   }
   return rows;
+}
+
+// The 11 numbers of the board.csv row at the start of `text`.
+std::vector<double> BoardRow(const std::string& text) {
+  std::istringstream fields(text);
+  std::vector<double> values;
+  for (std::string field;
+       values.size() < 11 && std::getline(fields, field, ',');) {
+    values.push_back(std::stod(field));
+  }
+  return values;
+}
+
+// cam0_from_target of a board.csv row (tx, ty, tz, qx, qy, qz, qw at 2-8).
+Rigid3d Cam0FromTarget(const std::vector<double>& values) {
+  Rigid3d cam0_from_target;
+  cam0_from_target.translation =
+      Eigen::Vector3d(values[2], values[3], values[4]);
+  cam0_from_target.rotation =
+      Eigen::Quaterniond(values[8], values[5], values[6], values[7])
+          .toRotationMatrix();
+  return cam0_from_target;
+}
+
+// Each detected corner within the detector's 0.3 px of where `camera`
+// (FlatPortCamera or DomePortCamera) images the truth corner.
+template <typename PortCamera>
+void ExpectCornersWhereTheyProject(const calib::TargetObservation& seen,
+                                   const calib::CalibrationTarget& target,
+                                   const Rigid3d& cam0_from_target,
+                                   const PortCamera& camera) {
+  const std::vector<Eigen::Vector3d> corners = calib::TargetPoints(target);
+  for (int k = 0; k < seen.size(); ++k) {
+    const Eigen::Vector2d truth =
+        camera.ImageFromPoint(cam0_from_target * corners[seen.point_ids[k]])
+            .value();
+    EXPECT_LT((seen.pixels[k] - truth).norm(), 0.3) << "corner " << k;
+  }
 }
 
 void ExpectFailsWithOneLine(const RunResult& result, int exit_code,
@@ -346,21 +385,11 @@ TEST(SimulateCli, NarrowRigWithDriftAndABoard) {
   // away, see tests/sim/board_rendering_test.cc).
   const size_t row = board.find("\n1,0.05,");
   ASSERT_NE(row, std::string::npos) << board;
-  std::istringstream fields(board.substr(row + 1));
-  std::vector<double> values;
-  for (std::string field;
-       values.size() < 11 && std::getline(fields, field, ',');) {
-    values.push_back(std::stod(field));
-  }
+  const std::vector<double> values = BoardRow(board.substr(row + 1));
   ASSERT_EQ(values.size(), 11u);
   EXPECT_EQ(values[9], 1.0);
   EXPECT_EQ(values[10], 1.0);
-  Rigid3d cam0_from_target;
-  cam0_from_target.translation =
-      Eigen::Vector3d(values[2], values[3], values[4]);
-  cam0_from_target.rotation =
-      Eigen::Quaterniond(values[8], values[5], values[6], values[7])
-          .toRotationMatrix();
+  const Rigid3d cam0_from_target = Cam0FromTarget(values);
   const cv::Mat left = ReadImage(folder + "/left/000001.png", true).value();
   EXPECT_EQ(left.size(), cv::Size(640, 480));
   const calib::CalibrationTarget target =
@@ -371,13 +400,7 @@ TEST(SimulateCli, NarrowRigWithDriftAndABoard) {
   EXPECT_EQ(seen->size(), 54);
   const FlatPortCamera camera =
       FlatPortCamera::Create(NarrowFieldCam0(), FlatPort(), 1.34).value();
-  const std::vector<Eigen::Vector3d> corners = calib::TargetPoints(target);
-  for (int k = 0; k < seen->size(); ++k) {
-    const Eigen::Vector2d truth =
-        camera.ImageFromPoint(cam0_from_target * corners[seen->point_ids[k]])
-            .value();
-    EXPECT_LT((seen->pixels[k] - truth).norm(), 0.3) << "corner " << k;
-  }
+  ExpectCornersWhereTheyProject(*seen, target, cam0_from_target, camera);
 
   // The camchain is that of the same run without drift.
   const std::string calibrated = Folder("narrow_calibrated");
@@ -442,40 +465,22 @@ TEST(SimulateCli, DomePortDiveWritesTheTruthAndTheAirCamchain) {
   const std::string board = test::ReadWholeFile(folder + "/board.csv");
   const size_t row = board.find("\n0,0.0,");
   ASSERT_NE(row, std::string::npos) << board;
-  std::istringstream fields(board.substr(row + 1));
-  std::vector<double> values;
-  for (std::string field;
-       values.size() < 11 && std::getline(fields, field, ',');) {
-    values.push_back(std::stod(field));
-  }
+  const std::vector<double> values = BoardRow(board.substr(row + 1));
   ASSERT_EQ(values.size(), 11u);
   ASSERT_EQ(values[9], 1.0);
-  Rigid3d cam0_from_target;
-  cam0_from_target.translation =
-      Eigen::Vector3d(values[2], values[3], values[4]);
-  cam0_from_target.rotation =
-      Eigen::Quaterniond(values[8], values[5], values[6], values[7])
-          .toRotationMatrix();
+  const Rigid3d cam0_from_target = Cam0FromTarget(values);
   const calib::CalibrationTarget target =
       calib::MakeCheckerboardTarget(9, 6, 0.03).value();
   const std::optional<calib::TargetObservation> seen = calib::DetectTarget(
       ReadImage(folder + "/left/000000.png", true).value(), target);
   ASSERT_TRUE(seen.has_value());
   EXPECT_EQ(seen->size(), 54);
-  DomePort dome;
-  dome.inner_radius = 0.04355;
-  dome.thickness = 0.00375;
-  dome.glass_index = 1.495;
-  dome.decentering = Eigen::Vector3d(0.002, -0.001, 0.007);
   const DomePortCamera camera =
-      DomePortCamera::Create(NarrowFieldCam0(), dome, 1.34).value();
-  const std::vector<Eigen::Vector3d> corners = calib::TargetPoints(target);
-  for (int k = 0; k < seen->size(); ++k) {
-    const Eigen::Vector2d truth =
-        camera.ImageFromPoint(cam0_from_target * corners[seen->point_ids[k]])
-            .value();
-    EXPECT_LT((seen->pixels[k] - truth).norm(), 0.3) << "corner " << k;
-  }
+      DomePortCamera::Create(
+          NarrowFieldCam0(),
+          test::AcrylicDome(Eigen::Vector3d(0.002, -0.001, 0.007)), 1.34)
+          .value();
+  ExpectCornersWhereTheyProject(*seen, target, cam0_from_target, camera);
 }
 
 TEST(SimulateCli, BadDomeFlagsGiveOneLine) {

@@ -25,6 +25,7 @@
 #include "rcm/sim/stereo_renderer.h"
 #include "rcm/sim/trajectory.h"
 #include "sim/test_pool.h"
+#include "support/test_rigs.h"
 
 namespace rcm::board_rendering_test {
 namespace {
@@ -61,20 +62,10 @@ Rigid3d BoardPose(const StereoRig& rig, const SceneBoard& board,
   return pose;
 }
 
-// The 4-inch acrylic dome, decentered.
-DomePort Dome(const Eigen::Vector3d& decentering) {
-  DomePort dome;
-  dome.inner_radius = 0.04355;
-  dome.thickness = 0.00375;
-  dome.glass_index = 1.495;
-  dome.decentering = decentering;
-  return dome;
-}
-
 // Decenterings of 1-3 mm laterally and 5-10 mm axially, one per camera.
 const std::array<std::optional<DomePort>, 2> kDomes = {
-    Dome(Eigen::Vector3d(0.002, -0.001, 0.007)),
-    Dome(Eigen::Vector3d(-0.0015, 0.0025, 0.009))};
+    rcm::test::AcrylicDome(Eigen::Vector3d(0.002, -0.001, 0.007)),
+    rcm::test::AcrylicDome(Eigen::Vector3d(-0.0015, 0.0025, 0.009))};
 
 struct Scene {
   StereoImages images;

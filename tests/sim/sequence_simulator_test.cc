@@ -11,6 +11,7 @@
 #include "rcm/estimation/batch_refinement.h"
 #include "rcm/sim/reference_rigs.h"
 #include "rcm/sim/scene_intersection.h"
+#include "support/test_rigs.h"
 
 namespace rcm::sequence_simulator_test {
 namespace {
@@ -495,16 +496,6 @@ TEST(SequenceSimulator, SameSeedSameFramesWithABoard) {
 namespace rcm::sequence_simulator_test {
 namespace {
 
-// The 4-inch acrylic dome, decentered.
-DomePort Dome(const Eigen::Vector3d& decentering) {
-  DomePort dome;
-  dome.inner_radius = 0.04355;
-  dome.thickness = 0.00375;
-  dome.glass_index = 1.495;
-  dome.decentering = decentering;
-  return dome;
-}
-
 // The distance between two rays (origin, unit direction) at their closest.
 double RayGap(const RayInMedium& a, const RayInMedium& b) {
   const Eigen::Vector3d normal = a.direction.cross(b.direction);
@@ -520,8 +511,10 @@ TEST(SequenceSimulator, DomesMakeTheBoardAndTheMatches) {
   const StereoRig rig = NarrowFieldRig();
   SequenceOptions options = MatchesOnly({{kN, 3}}, 200);
   options.board = SceneBoard();
-  options.left_dome = Dome(Eigen::Vector3d(0.002, -0.001, 0.007));
-  options.right_dome = Dome(Eigen::Vector3d(-0.0015, 0.0025, 0.009));
+  options.left_dome =
+      rcm::test::AcrylicDome(Eigen::Vector3d(0.002, -0.001, 0.007));
+  options.right_dome =
+      rcm::test::AcrylicDome(Eigen::Vector3d(-0.0015, 0.0025, 0.009));
   std::unique_ptr<SequenceSimulator> simulator =
       SequenceSimulator::Create(rig, options).value();
   const DomePortCamera left =
@@ -564,7 +557,8 @@ TEST(SequenceSimulator, DomesMakeTheBoardAndTheMatches) {
   options = MatchesOnly({{kN, 1}}, 10);
   options.match_min_depth = 0.5;
   options.match_max_depth = 2.0;
-  options.right_dome = Dome(Eigen::Vector3d(0.001, 0.0, 0.005));
+  options.right_dome =
+      rcm::test::AcrylicDome(Eigen::Vector3d(0.001, 0.0, 0.005));
   EXPECT_FALSE(SequenceSimulator::Create(rig, options).ok());
 }
 
