@@ -12,16 +12,19 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
 
+#include "rcm/io/stereo_image_folders.h"
 #include "rcm/rosbag/bag_image_writer.h"
 #include "support/temp_file.h"
 
 namespace rcm::bag_stereo_source_test {
 namespace {
 
+using ::testing::AllOf;
 using ::testing::HasSubstr;
 using ::testing::Not;
 using ::testing::StartsWith;
@@ -474,6 +477,177 @@ TEST(BagStereoSource, TimeRangeCountsFromTheFirstPair) {
                 ": no stereo pair between 5.000 s and the end: the sequence "
                 "lasts 2.250 s");
   std::remove(path.c_str());
+}
+
+BagStereoOptions LeftOnlyOptions() {
+  BagStereoOptions options;
+  options.left_topic = kLeft;
+  options.left_only = true;
+  return options;
+}
+
+// One camera's topic alone: every message of it a "pair" in stamp order
+// (recorded out of order here), an empty right image and name, the
+// other topics (a right camera with fewer messages, an IMU) ignored and
+// nothing unpaired.
+TEST(BagStereoSource, LeftOnlyGivesEveryMessageOfTheLeftTopic) {
+  const std::string path = test::TempFilePath("left.bag");
+  WriteRawBag(path, [&](rosbag::Bag& bag) {
+    int record = 0;
+    for (const int k : {1, 0, 2, 3}) {
+      const cv::Mat image = TestImage(CV_8UC1, k, cv::Size(4, 2));
+      const ros::Time recorded(2000.0 + record++);
+      bag.write(kLeft, recorded,
+                RawImage(Stamp(k), 4, 2, "mono8", 4, Bytes(image, 4)));
+      if (k == 0) {
+        bag.write(kRight, recorded,
+                  RawImage(Stamp(k), 4, 2, "mono8", 4, Bytes(image, 4)));
+      }
+    }
+    sensor_msgs::Imu imu;
+    imu.header.stamp = ros::Time(Stamp(0));
+    bag.write("/imu0", ros::Time(2000.0), imu);
+  });
+  StatusOr<std::unique_ptr<StereoImageSource>> source =
+      Open(path, LeftOnlyOptions());
+  ASSERT_TRUE(source.ok()) << source.status().message();
+  EXPECT_EQ((*source)->Describe(),
+            "bag " + path + " (" + kLeft + ", left camera only): 4 images");
+  const std::vector<StereoImagePair> pairs = ReadAll(**source);
+  ASSERT_EQ(pairs.size(), 4u);
+  const std::string stamp_text[] = {"1000.000000", "1000.250000", "1000.500000",
+                                    "1000.750000"};
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_EQ(pairs[k].frame, k);
+    ASSERT_TRUE(pairs[k].timestamp.has_value());
+    EXPECT_EQ(*pairs[k].timestamp, Stamp(k));
+    EXPECT_EQ(pairs[k].left_name, std::string(kLeft) + " @ " + stamp_text[k]);
+    EXPECT_EQ(
+        MaxDifference(pairs[k].left, TestImage(CV_8UC1, k, cv::Size(4, 2))),
+        0.0);
+    EXPECT_TRUE(pairs[k].right.empty());
+    EXPECT_EQ(pairs[k].right_name, "");
+  }
+
+  // The same topic as the left of a pair still pairs (one right message).
+  source = Open(path);
+  ASSERT_TRUE(source.ok()) << source.status().message();
+  EXPECT_EQ((*source)->NumPairs(), 1u);
+  std::remove(path.c_str());
+}
+
+// A bag of one camera (no right topic at all), colour and compressed,
+// with a stride and a time range as for pairs.
+TEST(BagStereoSource, LeftOnlyReadsABagOfOneCameraWithASelection) {
+  const std::string path = test::TempFilePath("one.bag");
+  {
+    StatusOr<BagImageWriter> writer = BagImageWriter::Create(path);
+    ASSERT_TRUE(writer.ok()) << writer.status().message();
+    for (int k = 0; k < 10; ++k) {
+      ASSERT_TRUE(writer
+                      ->WriteCompressed(kLeft, Stamp(k),
+                                        TestImage(CV_8UC3, k, cv::Size(8, 6)),
+                                        "png", "cam0")
+                      .ok());
+    }
+    ASSERT_TRUE(writer->Close().ok());
+  }
+  BagStereoOptions options = LeftOnlyOptions();
+  options.selection.from_s = 0.5;
+  options.selection.stride = 3;
+  StatusOr<std::unique_ptr<StereoImageSource>> source = Open(path, options);
+  ASSERT_TRUE(source.ok()) << source.status().message();
+  EXPECT_EQ((*source)->Describe(),
+            "bag " + path + " (" + kLeft +
+                ", left camera only): 3 images (every 3rd of 10, 0.500 s to "
+                "the end)");
+  const std::vector<StereoImagePair> pairs = ReadAll(**source);
+  ASSERT_EQ(pairs.size(), 3u);
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    const int k = 2 + 3 * static_cast<int>(i);
+    EXPECT_EQ(pairs[i].frame, k);
+    EXPECT_EQ(*pairs[i].timestamp, Stamp(k));
+    EXPECT_EQ(
+        MaxDifference(pairs[i].left, TestImage(CV_8UC3, k, cv::Size(8, 6))),
+        0.0);
+    EXPECT_TRUE(pairs[i].right.empty());
+    EXPECT_EQ(pairs[i].right_name, "");
+  }
+
+  // Two topics on a bag of one camera: the missing right topic is named.
+  options = Options();
+  source = Open(path, options);
+  ASSERT_FALSE(source.ok());
+  EXPECT_THAT(source.status().message(),
+              AllOf(StartsWith(path), HasSubstr(kRight)));
+  // And one topic that is not there.
+  options = LeftOnlyOptions();
+  options.left_topic = kRight;
+  source = Open(path, options);
+  ASSERT_FALSE(source.ok());
+  EXPECT_THAT(source.status().message(), HasSubstr(kRight));
+  std::remove(path.c_str());
+}
+
+// The calibration input treats one camera's bag as one camera's folder:
+// the two sources' pairs hold the same fields (the names aside).
+TEST(BagStereoSource, LeftOnlyPairsAreTheFolderSourcesPairs) {
+  const std::string path = test::TempFilePath("same.bag");
+  const std::string folder = test::TempFilePath("cam0");
+  std::filesystem::remove_all(folder);
+  std::filesystem::create_directories(folder);
+  {
+    StatusOr<BagImageWriter> writer = BagImageWriter::Create(path);
+    ASSERT_TRUE(writer.ok()) << writer.status().message();
+    for (int k = 0; k < 3; ++k) {
+      const cv::Mat image = TestImage(CV_8UC1, k, cv::Size(8, 6));
+      ASSERT_TRUE(
+          writer->WriteImage(kLeft, Stamp(k), image, "mono8", "cam0").ok());
+      ASSERT_TRUE(cv::imwrite(
+          folder + "/" + std::to_string(Stamp(k)).substr(0, 7) + ".png",
+          image));
+    }
+    ASSERT_TRUE(writer->Close().ok());
+  }
+  StatusOr<std::unique_ptr<StereoImageSource>> bag =
+      Open(path, LeftOnlyOptions());
+  ASSERT_TRUE(bag.ok()) << bag.status().message();
+  StereoFolderOptions folder_options;
+  folder_options.left_dir = folder;
+  folder_options.left_only = true;
+  StatusOr<std::unique_ptr<StereoImageSource>> files =
+      OpenStereoImageFolders(folder_options);
+  ASSERT_TRUE(files.ok()) << files.status().message();
+  const std::vector<StereoImagePair> from_bag = ReadAll(**bag);
+  const std::vector<StereoImagePair> from_files = ReadAll(**files);
+  ASSERT_EQ(from_bag.size(), 3u);
+  ASSERT_EQ(from_files.size(), 3u);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(from_bag[k].frame, from_files[k].frame);
+    EXPECT_EQ(from_bag[k].timestamp, from_files[k].timestamp);
+    EXPECT_EQ(MaxDifference(from_bag[k].left, from_files[k].left), 0.0);
+    EXPECT_TRUE(from_files[k].right.empty());
+    EXPECT_TRUE(from_bag[k].right.empty());
+    EXPECT_EQ(from_bag[k].right_name, from_files[k].right_name);
+  }
+  std::filesystem::remove_all(folder);
+  std::remove(path.c_str());
+}
+
+TEST(BagStereoSource, LeftOnlyOptionsCheck) {
+  BagStereoOptions options = LeftOnlyOptions();
+  EXPECT_TRUE(options.Check().ok());
+  options.right_topic = kRight;
+  EXPECT_EQ(options.Check().message(),
+            "one camera's images are read from the left topic alone, got a "
+            "right topic too (/cam1/image_raw)");
+  options = LeftOnlyOptions();
+  options.left_topic.clear();
+  EXPECT_EQ(options.Check().message(),
+            "one camera's images need its (left) image topic");
+  options = LeftOnlyOptions();
+  options.selection.stride = 0;
+  EXPECT_EQ(options.Check().message(), "stride must be at least 1, got 0");
 }
 
 TEST(BagStereoSource, MissingTopicListsTheImageTopics) {

@@ -68,11 +68,13 @@ StatusOr<double> HeaderStamp(const rosbag::MessageInstance& message) {
                        message.getMD5Sum() + ")");
 }
 
-// One left and one right message, by index into their TopicMessages.
+// One left and one right message, by index into their TopicMessages;
+// right kNoRight for one camera (BagStereoOptions::left_only).
 struct Pair {
   size_t left;
   size_t right;
 };
+constexpr size_t kNoRight = static_cast<size_t>(-1);
 
 // Pairs messages whose stamps differ by at most `tolerance`, each message
 // at most once: walking both topics in stamp order, a left and a right
@@ -146,6 +148,14 @@ class BagStereoSource final : public StereoImageSource {
     result.frame = static_cast<int64_t>(frame);
     result.timestamp = left_.stamps[pair.left];
     result.left_name = Name(options_.left_topic, left_.stamps[pair.left]);
+    if (pair.right == kNoRight) {
+      // One camera only: the right image and name stay empty.
+      StatusOr<cv::Mat> left =
+          Decode(left_.messages[pair.left], result.left_name);
+      if (!left.ok()) return left.status();
+      result.left = std::move(left).value();
+      return result;
+    }
     result.right_name = Name(options_.right_topic, right_.stamps[pair.right]);
     StatusOr<cv::Mat> left =
         Decode(left_.messages[pair.left], result.left_name);
@@ -165,9 +175,21 @@ class BagStereoSource final : public StereoImageSource {
   }
 
   std::string Describe() const override {
-    std::string text = "bag " + path_ + " (" + options_.left_topic + ", " +
-                       options_.right_topic +
-                       "): " + Count(selected_.size(), "pair");
+    if (options_.left_only) {
+      // "bag dive.bag (/cam0/image_raw, left camera only): 8 images".
+      return "bag " + path_ + " (" + options_.left_topic +
+             ", left camera only): " + Count(selected_.size(), "image") +
+             SelectionText();
+    }
+    return "bag " + path_ + " (" + options_.left_topic + ", " +
+           options_.right_topic + "): " + Count(selected_.size(), "pair") +
+           SelectionText() + ", " + Count(num_unpaired_, "unpaired message");
+  }
+
+ private:
+  // " (every 2nd of 240, 10.000 s to the end)", or "" without a selection.
+  std::string SelectionText() const {
+    std::string text;
     const FrameSelection& selection = options_.selection;
     if (selection.stride > 1 || selection.HasTimeRange()) {
       text += " (";
@@ -183,10 +205,9 @@ class BagStereoSource final : public StereoImageSource {
       }
       text += ")";
     }
-    return text + ", " + Count(num_unpaired_, "unpaired message");
+    return text;
   }
 
- private:
   static std::string Name(const std::string& topic, double stamp_s) {
     return StampedName(topic, stamp_s);
   }
@@ -241,10 +262,19 @@ class BagStereoSource final : public StereoImageSource {
 }  // namespace
 
 Status BagStereoOptions::Check() const {
-  if (left_topic.empty() || right_topic.empty()) {
+  if (left_only) {
+    if (left_topic.empty()) {
+      return Status::Error("one camera's images need its (left) image topic");
+    }
+    if (!right_topic.empty()) {
+      return Status::Error(
+          "one camera's images are read from the left topic alone, got a "
+          "right topic too (" +
+          right_topic + ")");
+    }
+  } else if (left_topic.empty() || right_topic.empty()) {
     return Status::Error("a bag needs a left and a right image topic");
-  }
-  if (left_topic == right_topic) {
+  } else if (left_topic == right_topic) {
     return Status::Error("left and right topic are both " + left_topic);
   }
   if (!std::isfinite(stamp_tolerance_s) || stamp_tolerance_s < 0.0) {
@@ -268,10 +298,13 @@ StatusOr<std::unique_ptr<StereoImageSource>> OpenBagStereoSource(
     bag->open(path, rosbag::bagmode::Read);
     const BagTopicTypes types = ReadTopicTypes(*bag);
     RCM_RETURN_IF_ERROR(CheckImageTopic(path, options.left_topic, types));
-    RCM_RETURN_IF_ERROR(CheckImageTopic(path, options.right_topic, types));
+    std::vector<std::string> topics = {options.left_topic};
+    if (!options.left_only) {
+      RCM_RETURN_IF_ERROR(CheckImageTopic(path, options.right_topic, types));
+      topics.push_back(options.right_topic);
+    }
 
-    rosbag::View view(*bag, rosbag::TopicQuery(std::vector<std::string>{
-                                options.left_topic, options.right_topic}));
+    rosbag::View view(*bag, rosbag::TopicQuery(topics));
     for (const rosbag::MessageInstance& message : view) {
       const StatusOr<double> stamp = HeaderStamp(message);
       if (!stamp.ok()) {
@@ -289,14 +322,20 @@ StatusOr<std::unique_ptr<StereoImageSource>> OpenBagStereoSource(
   for (const auto& [topic, messages] :
        {std::pair{&options.left_topic, &left},
         std::pair{&options.right_topic, &right}}) {
-    if (messages->stamps.empty()) {
+    // (left_only: no right topic, no right messages.)
+    if (messages->stamps.empty() && !topic->empty()) {
       return Status::Error(path + ": no messages on " + *topic);
     }
   }
   const std::vector<size_t> left_order = StampOrder(left);
   const std::vector<size_t> right_order = StampOrder(right);
-  std::vector<Pair> pairs = PairByStamp(left.stamps, left_order, right.stamps,
-                                        right_order, options.stamp_tolerance_s);
+  std::vector<Pair> pairs;
+  if (options.left_only) {
+    for (const size_t i : left_order) pairs.push_back({i, kNoRight});
+  } else {
+    pairs = PairByStamp(left.stamps, left_order, right.stamps, right_order,
+                        options.stamp_tolerance_s);
+  }
   if (pairs.empty()) {
     return Status::Error(
         path + ": no left/right messages within " +
@@ -309,7 +348,9 @@ StatusOr<std::unique_ptr<StereoImageSource>> OpenBagStereoSource(
         "); raise --stamp-tolerance");
   }
   const size_t num_unpaired =
-      left.stamps.size() + right.stamps.size() - 2 * pairs.size();
+      options.left_only
+          ? 0
+          : left.stamps.size() + right.stamps.size() - 2 * pairs.size();
 
   std::vector<double> timestamps;
   timestamps.reserve(pairs.size());

@@ -3,7 +3,9 @@
 // opened: every message of the two topics is read once for its header
 // stamp, and left and right messages are paired by those stamps, since
 // the two drivers publish independently and a bag may drop a message of
-// either camera. Pixels are decoded only when a pair is read.
+// either camera. Pixels are decoded only when a pair is read. One camera's
+// topic alone (BagStereoOptions::left_only) gives each of its messages as
+// a "pair" without a right image.
 //
 // Reads sensor_msgs/Image (encodings mono8, 8UC1, bgr8, 8UC3, rgb8, bgra8,
 // rgba8; colour becomes BGR) and sensor_msgs/CompressedImage (any format
@@ -25,6 +27,11 @@ struct BagStereoOptions {
   // The two image topics, e.g. "/cam0/image_raw" and "/cam1/image_raw".
   std::string left_topic;
   std::string right_topic;
+  // One camera only (rcm calibrate --bag B --left-topic T alone): left_topic
+  // alone, right_topic empty; each message of it a "pair" with an empty
+  // right image and an empty right name, as StereoFolderOptions::left_only
+  // gives a folder's images. stamp_tolerance_s is not used.
+  bool left_only = false;
   // Largest difference of header stamps, in seconds, for a left and a
   // right message to form a pair. 5 ms: hardware-triggered cameras stamp
   // the two images of a pair within about 1 ms, and 5 ms is at most half
@@ -36,8 +43,8 @@ struct BagStereoOptions {
   // pair's left stamp).
   FrameSelection selection;
 
-  // Errors: an empty or repeated topic, a negative or non-finite
-  // tolerance, selection.Check().
+  // Errors: an empty or repeated topic, a right topic with left_only, a
+  // negative or non-finite tolerance, selection.Check().
   Status Check() const;
 };
 
@@ -47,6 +54,8 @@ struct BagStereoOptions {
 // are counted as unpaired (Describe() reports them). A pair's `frame` is
 // its index among all pairs, its `timestamp` the left header stamp in
 // seconds, its names "TOPIC @ STAMP" (stamp in seconds, 6 decimals).
+// With options.left_only, every message of the left topic is a pair, in
+// stamp order (equal stamps in the bag's order), and none is unpaired.
 // Errors, each one line starting with `path`: options.Check(); a missing
 // file; a file that is not a readable ROS1 bag (truncated, unindexed, not
 // a bag); a topic that is not in the bag (the message lists the image
