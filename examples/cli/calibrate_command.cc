@@ -18,16 +18,16 @@
 
 #include "air_flag.h"
 #include "air_gap_flag.h"
-#include "calibrate_dome.h"
-#include "dome_port_flags.h"
-#include "glass_index_flag.h"
-#include "index_flag.h"
 #include "air_views_flags.h"
+#include "calibrate_dome.h"
 #include "calibrate_underwater.h"
 #include "calibration_input.h"
 #include "calibration_run.h"
 #include "command.h"
+#include "dome_port_flags.h"
+#include "glass_index_flag.h"
 #include "image_input_flags.h"
+#include "index_flag.h"
 #include "lens_model_flag.h"
 #include "medium_flag.h"
 #include "progress.h"
@@ -88,7 +88,10 @@ constexpr char kCalibrateUsage[] =
     "      --out camera.yaml                      (one camera)\n"
     "  rcm calibrate --bag FILE.bag --left-topic T0 --right-topic T1 "
     "--target april.yaml\n"
-    "      --model equidistant --out camchain.yaml\n\n"
+    "      --model equidistant --out camchain.yaml\n"
+    "  rcm calibrate --bag FILE.bag --left-topic T0 --target april.yaml "
+    "--out camera.yaml\n"
+    "                                             (one camera)\n\n"
     "Detects the target in every pair, calibrates both cameras' lenses, the\n"
     "extrinsics cam1_from_cam0 (cam0 = left) and every target pose by a\n"
     "Ceres bundle adjustment (with the board's bow, two parameters shared\n"
@@ -98,9 +101,10 @@ constexpr char kCalibrateUsage[] =
     "uncertainty over each image (mrcal's mean-frames method, through the\n"
     "board poses, at --uncertainty-distance, default infinity; and the\n"
     "intrinsics-only figure), per-view RMS, calibration.json.\n"
-    "--left alone (or --corners with --left only) calibrates one camera the\n"
-    "same way, without the extrinsics, and writes a camchain with cam0 only\n"
-    "(the stereo subcommands refuse it: they need a pair).\n"
+    "--left alone (or --corners with --left only, or --bag with --left-topic\n"
+    "alone) calibrates one camera the same way, without the extrinsics, and\n"
+    "writes a camchain with cam0 only (the stereo subcommands refuse it:\n"
+    "they need a pair).\n"
     "--out names the camchain file (.yaml) or a folder that gets\n"
     "camchain.yaml and report/; camchain-covariance.yaml beside the camchain\n"
     "tells rcm estimate how well it is known.\n\n"
@@ -173,9 +177,9 @@ extern const Subcommand kCalibrateCommand = {
     kCalibrateUsage,
     {__FILE__, kImageInputFlagsSource, kCalibrationInputFlagsSource,
      kTargetFlagsSource, kLensModelFlagSource, kUnderwaterFlagsSource,
-     kAirGapFlagSource, kAirFlagSource, kAirViewsFlagsSource,
-     kMediumFlagSource, kDomeCalibrationFlagsSource, kDomePortFlagsSource,
-     kGlassIndexFlagSource, kIndexFlagSource},
+     kAirGapFlagSource, kAirFlagSource, kAirViewsFlagsSource, kMediumFlagSource,
+     kDomeCalibrationFlagsSource, kDomePortFlagsSource, kGlassIndexFlagSource,
+     kIndexFlagSource},
     RunCalibrate};
 
 namespace {
@@ -193,7 +197,7 @@ int RunCalibrate() {
     PrintError(command,
                "no images: give --left DIR --right DIR (--left DIR alone: one "
                "camera), --pairs FILE or --bag FILE with "
-               "--left-topic/--right-topic");
+               "--left-topic/--right-topic (--left-topic alone: one camera)");
     return kExitUsage;
   }
   const StatusOr<LensModelId> model = LensModelFromFlag(LensModelId::kRadTan);
@@ -293,9 +297,9 @@ int RunCalibrate() {
   }
   const Detections* detections = &input->detections;
   const std::vector<StereoView>& views = detections->views;
-  // --left alone (folders or a corners file): one camera.
-  const bool one_camera = FLAGS_right.empty() && FLAGS_pairs.empty() &&
-                          FLAGS_bag.empty() && !detections->sizes[1];
+  // --left alone (folders or a corners file) or --left-topic alone (a
+  // bag): one camera.
+  const bool one_camera = OneCameraImageInputGiven() && !detections->sizes[1];
   const int num_cameras = one_camera ? 1 : 2;
   if (const Status status = CheckDetections(*detections, one_camera);
       !status.ok()) {
@@ -378,6 +382,7 @@ int RunCalibrate() {
     camchain.cameras.push_back(
         CamchainCamera{calibration->cam0.camera, std::nullopt, std::nullopt,
                        std::nullopt, std::vector<int>(), std::string()});
+    if (!FLAGS_bag.empty()) camchain.cameras[0].rostopic = FLAGS_left_topic;
   } else {
     StatusOr<StereoRig> rig =
         StereoRig::Create(calibration->cam0.camera, calibration->cam1.camera,

@@ -307,8 +307,8 @@ int RunCalibrateUnderwater(const Subcommand& command,
   }
   const Detections* detections = &input->detections;
   const bool one_camera = !detections->sizes[1].has_value() &&
-                          detections->right_only == 0 && FLAGS_right.empty() &&
-                          FLAGS_pairs.empty() && FLAGS_bag.empty();
+                          detections->right_only == 0 &&
+                          OneCameraImageInputGiven();
   if (const Status status = CheckDetections(*detections, one_camera);
       !status.ok()) {
     PrintError(command, "under water: " + status.message());

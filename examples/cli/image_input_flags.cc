@@ -15,7 +15,8 @@ DEFINE_string(pairs, "",
 DEFINE_string(bag, "", "ROS1 bag with the two image topics");
 DEFINE_string(left_topic, "",
               "bag: topic of the left images (sensor_msgs/Image mono8, "
-              "bgr8, rgb8, or sensor_msgs/CompressedImage)");
+              "bgr8, rgb8, or sensor_msgs/CompressedImage); rcm calibrate: "
+              "alone, without --right-topic, one camera");
 DEFINE_string(right_topic, "", "bag: topic of the right images");
 DEFINE_double(stamp_tolerance, 0.005,
               "bag: largest difference of header stamps, seconds, of a "
@@ -45,6 +46,13 @@ FrameSelection SelectionFromFlags() {
 
 }  // namespace
 
+bool OneCameraImageInputGiven() {
+  if (!FLAGS_bag.empty()) {
+    return !FLAGS_left_topic.empty() && FLAGS_right_topic.empty();
+  }
+  return !FLAGS_left.empty() && FLAGS_right.empty() && FLAGS_pairs.empty();
+}
+
 bool ImageInputGiven() {
   return !FLAGS_left.empty() || !FLAGS_right.empty() || !FLAGS_pairs.empty() ||
          !FLAGS_bag.empty();
@@ -62,11 +70,24 @@ StatusOr<std::unique_ptr<StereoImageSource>> OpenImageInputFromFlags(
           "give either --bag or image folders (--left/--right, --pairs), "
           "not both");
     }
-    if (FLAGS_left_topic.empty() || FLAGS_right_topic.empty()) {
-      return Status::Error("--bag needs --left-topic and --right-topic");
+    const bool left_only = allow_left_only && OneCameraImageInputGiven();
+    if (FLAGS_left_topic.empty() && FLAGS_right_topic.empty()) {
+      return Status::Error(allow_left_only
+                               ? "--bag needs --left-topic (and "
+                                 "--right-topic for a stereo pair)"
+                               : "--bag needs --left-topic and --right-topic");
+    }
+    if (FLAGS_left_topic.empty()) {
+      return Status::Error("--right-topic needs --left-topic");
+    }
+    if (FLAGS_right_topic.empty() && !left_only) {
+      return Status::Error(
+          "--bag needs --right-topic too: this command reads stereo pairs "
+          "(only rcm calibrate takes one camera's --left-topic alone)");
     }
 #ifdef RCM_HAVE_ROSBAG
     BagStereoOptions options;
+    options.left_only = left_only;
     options.left_topic = FLAGS_left_topic;
     options.right_topic = FLAGS_right_topic;
     options.stamp_tolerance_s = FLAGS_stamp_tolerance;

@@ -31,12 +31,18 @@ extern const char kImageInputFlagsSource[];
 // True when any of --left, --right, --pairs, --bag is set.
 bool ImageInputGiven();
 
+// True when the flags name one camera's images: --left without --right
+// and --pairs, or --bag with --left-topic and without --right-topic.
+bool OneCameraImageInputGiven();
+
 // Opens the sequence the flags name. Errors: no input or two kinds of
 // input, a missing topic flag, a bag given to a build without bag
 // support, and the sources' own errors (stereo_image_folders.h,
 // bag_stereo_source.h).
-// With `allow_left_only`, --left alone opens one camera's images
-// (StereoFolderOptions::left_only: empty right images).
+// With `allow_left_only`, --left alone or --bag with --left-topic alone
+// opens one camera's images (StereoFolderOptions::left_only,
+// BagStereoOptions::left_only: empty right images); without it, those are
+// errors.
 StatusOr<std::unique_ptr<StereoImageSource>> OpenImageInputFromFlags(
     bool allow_left_only = false);
 

@@ -1,6 +1,7 @@
 // rcm calibrate --left DIR alone: one camera, end to end on OpenCV's sample
 // left images (opencv-doc; scripts/setup.sh installs it), its one-camera
-// camchain, and that camchain refused by the stereo subcommands.
+// camchain, and that camchain refused by the stereo subcommands; and
+// rcm calibrate --bag with --left-topic alone, on rendered views.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -17,10 +18,15 @@
 #include "cli/cli_runner.h"
 #include "rcm/calib/calibration_target.h"
 #include "rcm/calib/corners_file.h"
+#include "rcm/calib/target_image.h"
+#include "rcm/calib/target_renderer.h"
 #include "rcm/io/calibration_covariance_file.h"
 #include "rcm/io/camchain.h"
 #include "support/temp_file.h"
 #include "support/test_rigs.h"
+#ifdef RCM_HAVE_ROSBAG
+#include "rcm/rosbag/bag_image_writer.h"
+#endif
 
 namespace rcm::calibrate_mono_cli_test {
 namespace {
@@ -239,6 +245,92 @@ TEST(CalibrateMonoCli, BadInputIsOneLine) {
       1, "--left and --right go together");
   EXPECT_FALSE(fs::exists(out + "/one.yaml"));
 }
+
+#ifdef RCM_HAVE_ROSBAG
+// One camera from a bag: --left-topic without --right-topic, as --left
+// alone from a folder. 8 rendered views of a 480x360 camera (its right
+// camera's topic in the bag too, and not read); about a second.
+TEST(CalibrateMonoCli, BagWithTheLeftTopicAloneCalibratesOneCamera) {
+  const Camera truth =
+      Camera::Create(LensModelId::kRadTan, 480, 360,
+                     {300.0, 301.0, 242.0, 178.0}, {-0.2, 0.05, 4e-4, -3e-4})
+          .value();
+  const calib::CalibrationTarget board =
+      calib::MakeCheckerboardTarget(7, 5, 0.04).value();
+  const calib::TargetRenderer renderer =
+      calib::TargetRenderer::Create(truth,
+                                    calib::DrawTargetImage(board, 3000.0))
+          .value();
+  calib::TargetRenderOptions render_options;
+  render_options.noise_sigma = 2.0;
+  const std::string out = test::TempFilePath("out");
+  fs::remove_all(out);
+  fs::create_directories(out);
+  const std::string bag = out + "/one.bag";
+  StatusOr<BagImageWriter> writer = BagImageWriter::Create(bag);
+  ASSERT_TRUE(writer.ok()) << writer.status().message();
+  const std::vector<Rigid3d> poses =
+      calib::test::BoardPoses(truth, board, 8, 5, 0.5, 0.8, 30.0);
+  for (size_t i = 0; i < poses.size(); ++i) {
+    const double stamp = 1700000000.0 + 0.5 * static_cast<double>(i);
+    render_options.seed = static_cast<unsigned>(i);
+    ASSERT_TRUE(writer
+                    ->WriteImage("/cam0/image_raw", stamp,
+                                 renderer.Render(poses[i], render_options),
+                                 "mono8", "cam0")
+                    .ok());
+    ASSERT_TRUE(writer
+                    ->WriteImage("/cam1/image_raw", stamp,
+                                 cv::Mat(360, 480, CV_8UC1, cv::Scalar(90)),
+                                 "mono8", "cam1")
+                    .ok());
+  }
+  ASSERT_TRUE(writer->Close().ok());
+
+  const RunResult result =
+      Rcm({"calibrate", "--bag", bag, "--left-topic", "/cam0/image_raw",
+           "--board", "chessboard", "--cols", "7", "--rows", "5", "--square",
+           "0.04", "--folds", "0", "--out", out + "/one.yaml"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("(/cam0/image_raw, left camera only): 8 images"),
+            std::string::npos)
+      << result.out;
+  EXPECT_NE(result.out.find("8 views used (one camera)"), std::string::npos)
+      << result.out;
+  EXPECT_EQ(result.out.find("cam1"), std::string::npos) << result.out;
+  const Camchain camchain = ReadCamchain(out + "/one.yaml").value();
+  ASSERT_EQ(camchain.cameras.size(), 1u);
+  const Camera& camera = camchain.cameras[0].camera;
+  EXPECT_EQ(camchain.cameras[0].rostopic, "/cam0/image_raw");
+  EXPECT_EQ(camera.width(), 480);
+  EXPECT_EQ(camera.height(), 360);
+  // Rendered views, 2 grey levels of noise: the focal lengths within 1 %.
+  EXPECT_NEAR(camera.fx() / truth.fx(), 1.0, 1e-2);
+  EXPECT_NEAR(camera.fy() / truth.fy(), 1.0, 1e-2);
+  EXPECT_EQ(
+      ReadCalibrationCovariance(out + "/one-covariance.yaml")->cameras.size(),
+      1u);
+
+  // The stereo subcommands read pairs: the left topic alone is one line.
+  const std::string rig = out + "/rig.yaml";
+  ASSERT_TRUE(
+      WriteCamchain(rig, CamchainFromStereoRig(test::EurocRadtanTwinRig()))
+          .ok());
+  ExpectOneLineError(
+      Rcm({"estimate", "--calib", rig, "--bag", bag, "--left-topic",
+           "/cam0/image_raw"}),
+      1,
+      "--bag needs --right-topic too: this command reads stereo pairs (only "
+      "rcm calibrate takes one camera's --left-topic alone)");
+  // --right-topic alone is no camera.
+  ExpectOneLineError(
+      Rcm({"calibrate", "--bag", bag, "--right-topic", "/cam1/image_raw",
+           "--board", "chessboard", "--cols", "7", "--rows", "5", "--square",
+           "0.04", "--out", out + "/right.yaml"}),
+      1, "--right-topic needs --left-topic");
+  EXPECT_FALSE(fs::exists(out + "/right.yaml"));
+}
+#endif  // RCM_HAVE_ROSBAG
 
 // A one-camera camchain given to the subcommands that need a stereo pair:
 // one line that says so, exit 1.
