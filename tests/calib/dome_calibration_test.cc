@@ -26,19 +26,9 @@ CalibrationTarget Checkerboard() {
   return MakeCheckerboardTarget(9, 6, 0.04).value();
 }
 
-// The 4-inch acrylic dome.
-DomePort Dome(const Eigen::Vector3d& decentering) {
-  DomePort dome;
-  dome.inner_radius = 0.04355;
-  dome.thickness = 0.00375;
-  dome.glass_index = 1.495;
-  dome.decentering = decentering;
-  return dome;
-}
-
 // What the calibration starts from: the dome's glass, the centred dome.
 DomeCameraInput Input(const Camera& camera) {
-  return {camera, Dome(Eigen::Vector3d::Zero())};
+  return {camera, ::rcm::test::AcrylicDome(Eigen::Vector3d::Zero())};
 }
 
 // Board poses at 0.4-1.4 m: the axial decentering needs distances.
@@ -88,7 +78,8 @@ TEST(DomeCalibration, NoiseFreeRecoversDecenteringOneCamera) {
   const std::vector<Rigid3d> poses = Poses(camera, 12, 3);
   for (const Eigen::Vector3d& truth : Decenterings()) {
     const DomePortCamera through =
-        DomePortCamera::Create(camera, Dome(truth), 1.333).value();
+        DomePortCamera::Create(camera, ::rcm::test::AcrylicDome(truth), 1.333)
+            .value();
     const StatusOr<DomeCalibration> result =
         CalibrateDome(OneCameraViews(through, poses, 0.0, 1), {Input(camera)},
                       Rigid3d(), Checkerboard(), Exact());
@@ -107,9 +98,13 @@ TEST(DomeCalibration, NoiseFreeRecoversDecenteringStereo) {
   const Eigen::Vector3d truth_left(0.002, -0.001, 0.007);
   const Eigen::Vector3d truth_right(-0.001, 0.003, 0.005);
   const DomePortCamera left =
-      DomePortCamera::Create(rig.left(), Dome(truth_left), 1.34).value();
+      DomePortCamera::Create(rig.left(), ::rcm::test::AcrylicDome(truth_left),
+                             1.34)
+          .value();
   const DomePortCamera right =
-      DomePortCamera::Create(rig.right(), Dome(truth_right), 1.34).value();
+      DomePortCamera::Create(rig.right(), ::rcm::test::AcrylicDome(truth_right),
+                             1.34)
+          .value();
   const std::vector<StereoView> views = test::ObserveStereoWith(
       rig.left(),
       [&](const Eigen::Vector3d& p) { return left.ImageFromPoint(p); },
@@ -134,7 +129,8 @@ TEST(DomeCalibration, NoiseFreeRecoversNWithTheDecentering) {
   const Camera camera = ::rcm::test::AlphasenseCam0();
   const Eigen::Vector3d truth(0.0015, -0.001, 0.0072);
   const DomePortCamera through =
-      DomePortCamera::Create(camera, Dome(truth), 1.341).value();
+      DomePortCamera::Create(camera, ::rcm::test::AcrylicDome(truth), 1.341)
+          .value();
   DomeCalibrationOptions options = Exact();
   options.estimate_n = true;
   options.n = 1.333;
@@ -162,7 +158,8 @@ TEST(DomeCalibration, NoisyDecenteringWithinItsSigma) {
   const Camera camera = ::rcm::test::AlphasenseCam0();
   const Eigen::Vector3d truth(0.002, 0.001, 0.008);
   const DomePortCamera through =
-      DomePortCamera::Create(camera, Dome(truth), 1.333).value();
+      DomePortCamera::Create(camera, ::rcm::test::AcrylicDome(truth), 1.333)
+          .value();
   DomeCalibrationOptions options;
   const StatusOr<DomeCalibration> result =
       CalibrateDome(OneCameraViews(through, Poses(camera, 20, 11), 0.1, 2),
@@ -190,7 +187,8 @@ void ExpectHonestSigma(const Eigen::Vector2d& board_warp) {
   const Camera camera = ::rcm::test::AlphasenseCam0();
   const Eigen::Vector3d truth(0.0025, -0.0015, 0.0075);
   const DomePortCamera through =
-      DomePortCamera::Create(camera, Dome(truth), 1.333).value();
+      DomePortCamera::Create(camera, ::rcm::test::AcrylicDome(truth), 1.333)
+          .value();
   const std::vector<Rigid3d> poses = Poses(camera, 20, 13);
   DomeCalibrationOptions options;
   options.fit_conventional_model = false;
@@ -240,9 +238,11 @@ TEST(DomeCalibration, NoiseFreeAirViewsThroughTheDomeUnbiasTheLens) {
   const Eigen::Vector3d truth(0.0001, -0.00005, 0.0072);
   const CalibrationTarget board = Checkerboard();
   const DomePortCamera in_air =
-      DomePortCamera::Create(camera, Dome(truth), 1.0).value();
+      DomePortCamera::Create(camera, ::rcm::test::AcrylicDome(truth), 1.0)
+          .value();
   const DomePortCamera in_water =
-      DomePortCamera::Create(camera, Dome(truth), 1.333).value();
+      DomePortCamera::Create(camera, ::rcm::test::AcrylicDome(truth), 1.333)
+          .value();
   const std::vector<StereoView> water_views =
       OneCameraViews(in_water, Poses(camera, 12, 5), 0.0, 1);
   AirTargetViews air;
@@ -283,7 +283,9 @@ TEST(DomeCalibration, NoiseFreeAirViewsThroughTheDomeUnbiasTheLens) {
 TEST(DomeCalibration, BadInputIsOneLine) {
   const Camera camera = ::rcm::test::AlphasenseCam0();
   const DomePortCamera through =
-      DomePortCamera::Create(camera, Dome({0.0, 0.0, 0.005}), 1.333).value();
+      DomePortCamera::Create(camera,
+                             ::rcm::test::AcrylicDome({0.0, 0.0, 0.005}), 1.333)
+          .value();
   const std::vector<StereoView> views =
       OneCameraViews(through, Poses(camera, 6, 3), 0.0, 1);
   const auto message = [&](const std::vector<DomeCameraInput>& cameras,

@@ -34,15 +34,6 @@ calib::CalibrationTarget Board() {
   return calib::MakeCheckerboardTarget(9, 6, 0.04).value();
 }
 
-DomePort Dome(const Eigen::Vector3d& decentering) {
-  DomePort dome;
-  dome.inner_radius = 0.04355;
-  dome.thickness = 0.00375;
-  dome.glass_index = 1.495;
-  dome.decentering = decentering;
-  return dome;
-}
-
 std::vector<std::string> With(std::vector<std::string> args,
                               const std::vector<std::string>& more) {
   args.insert(args.end(), more.begin(), more.end());
@@ -96,7 +87,9 @@ DomeDive WriteDomeDive(const std::string& name,
   std::mt19937 rng(1);
   for (size_t c = 0; c < decentering.size(); ++c) {
     const DomePortCamera through =
-        DomePortCamera::Create(cameras[c], Dome(decentering[c]), 1.333).value();
+        DomePortCamera::Create(cameras[c],
+                               ::rcm::test::AcrylicDome(decentering[c]), 1.333)
+            .value();
     const Rigid3d cam_from_cam0 = c == 0 ? Rigid3d() : rig.right_from_left();
     for (size_t v = 0; v < poses.size(); ++v) {
       images.push_back(
@@ -168,7 +161,8 @@ TEST(CalibrateDomeCli, AirViewsThroughTheDomeEstimateTheLens) {
   const DomeDive dive = WriteDomeDive("dome_joint", {truth});
   const Camera camera = rcm::test::AlphasenseRealisticRig().left();
   const DomePortCamera in_air =
-      DomePortCamera::Create(camera, Dome(truth), 1.0).value();
+      DomePortCamera::Create(camera, ::rcm::test::AcrylicDome(truth), 1.0)
+          .value();
   std::vector<calib::CornersFileImage> images;
   std::mt19937 rng(2);
   const std::vector<Eigen::Vector3d> points = calib::TargetPoints(Board());
@@ -301,8 +295,10 @@ TEST(DomeRigCli, ExportAndUndistortAtTheReferenceDepth) {
       CamchainFromStereoRig(rcm::test::AlphasenseRealisticRig());
   camchain.cameras[0].port.reset();
   camchain.cameras[1].port.reset();
-  camchain.cameras[0].dome = Dome(Eigen::Vector3d(0.001, 0.0, 0.007));
-  camchain.cameras[1].dome = Dome(Eigen::Vector3d(-0.001, 0.0, 0.006));
+  camchain.cameras[0].dome =
+      ::rcm::test::AcrylicDome(Eigen::Vector3d(0.001, 0.0, 0.007));
+  camchain.cameras[1].dome =
+      ::rcm::test::AcrylicDome(Eigen::Vector3d(-0.001, 0.0, 0.006));
   ASSERT_TRUE(WriteCamchain(dir + "/rig.yaml", camchain).ok());
   const RunResult exported =
       Rcm({"export", "--calib", dir + "/rig.yaml", "--n", "1.333",

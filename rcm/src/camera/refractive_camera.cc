@@ -8,6 +8,34 @@
 
 namespace rcm {
 
+namespace {
+
+// A reference depth beyond the port's farthest point `nearest` (meters) by
+// kMinReferenceDepthBeyondGlass and at most kMaxReferenceDepth; `what`
+// names the port in the error ("the port's glass", "the dome").
+Status CheckReferenceDepth(double reference_depth, double nearest,
+                           const char* what) {
+  std::ostringstream message;
+  if (!std::isfinite(reference_depth) ||
+      !(reference_depth >=
+        nearest + RefractiveCamera::kMinReferenceDepthBeyondGlass)) {
+    message << "reference depth " << reference_depth << " m is not beyond "
+            << what << " (" << nearest << " m) by "
+            << RefractiveCamera::kMinReferenceDepthBeyondGlass * 1e3
+            << " mm at least";
+    return Status::Error(message.str());
+  }
+  if (reference_depth > RefractiveCamera::kMaxReferenceDepth) {
+    message << "reference depth " << reference_depth
+            << " m is beyond the accepted "
+            << RefractiveCamera::kMaxReferenceDepth << " m";
+    return Status::Error(message.str());
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
 StatusOr<RefractiveCamera> RefractiveCamera::Create(const Camera& camera,
                                                     double n) {
   if (!std::isfinite(n) || n < kMinIndex || n > kMaxIndex) {
@@ -25,22 +53,9 @@ StatusOr<RefractiveCamera> RefractiveCamera::CreateWithPort(
   StatusOr<RefractiveCamera> result = Create(camera, n);
   if (!result.ok()) return result.status();
   RCM_RETURN_IF_ERROR(port.Check());
-  if (!std::isfinite(reference_depth) ||
-      !(reference_depth >=
-        port.air_gap + port.glass_thickness + kMinReferenceDepthBeyondGlass)) {
-    std::ostringstream message;
-    message << "reference depth " << reference_depth
-            << " m is not beyond the port's glass ("
-            << port.air_gap + port.glass_thickness << " m) by "
-            << kMinReferenceDepthBeyondGlass * 1e3 << " mm at least";
-    return Status::Error(message.str());
-  }
-  if (reference_depth > kMaxReferenceDepth) {
-    std::ostringstream message;
-    message << "reference depth " << reference_depth
-            << " m is beyond the accepted " << kMaxReferenceDepth << " m";
-    return Status::Error(message.str());
-  }
+  RCM_RETURN_IF_ERROR(CheckReferenceDepth(reference_depth,
+                                          port.air_gap + port.glass_thickness,
+                                          "the port's glass"));
   result->port_ = port;
   result->reference_depth_ = reference_depth;
   if (!port.IsThin()) {
@@ -58,21 +73,8 @@ StatusOr<RefractiveCamera> RefractiveCamera::CreateWithDome(
   if (!result.ok()) return result.status();
   StatusOr<DomePortCamera> through = DomePortCamera::Create(camera, dome, n);
   if (!through.ok()) return through.status();
-  const double outer = dome.decentering.z() + dome.outer_radius();
-  if (!std::isfinite(reference_depth) ||
-      !(reference_depth >= outer + kMinReferenceDepthBeyondGlass)) {
-    std::ostringstream message;
-    message << "reference depth " << reference_depth
-            << " m is not beyond the dome (" << outer << " m) by "
-            << kMinReferenceDepthBeyondGlass * 1e3 << " mm at least";
-    return Status::Error(message.str());
-  }
-  if (reference_depth > kMaxReferenceDepth) {
-    std::ostringstream message;
-    message << "reference depth " << reference_depth
-            << " m is beyond the accepted " << kMaxReferenceDepth << " m";
-    return Status::Error(message.str());
-  }
+  RCM_RETURN_IF_ERROR(CheckReferenceDepth(
+      reference_depth, dome.decentering.z() + dome.outer_radius(), "the dome"));
   result->dome_ = dome;
   result->dome_camera_ = std::move(through).value();
   result->reference_depth_ = reference_depth;

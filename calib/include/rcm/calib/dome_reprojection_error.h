@@ -40,57 +40,6 @@
 
 namespace rcm::calib {
 
-template <typename LensModel>
-struct DomeReprojectionError {
-  DomeReprojectionError(const std::array<double, kMaxLensParams>& lens,
-                        const DomePort& dome,
-                        const Eigen::Vector3d& point_in_target,
-                        const Eigen::Vector2d& warp_basis,
-                        const Eigen::Vector2d& pixel)
-      : lens(lens),
-        dome(dome),
-        point_in_target(point_in_target),
-        warp_basis(warp_basis),
-        pixel(pixel) {}
-
-  template <typename T>
-  bool operator()(const T* n, const T* cam0_from_target, const T* cam_from_cam0,
-                  const T* decentering, const T* board_warp,
-                  T* residuals) const {
-    T point_in_camera[3];
-    board_internal::WarpedPointInCam1(point_in_target, warp_basis, board_warp,
-                                      cam0_from_target, cam_from_cam0,
-                                      point_in_camera);
-    T normalized[2];
-    if (!DomePortRefraction::NormalizedFromPoint(n[0], decentering, dome,
-                                                 point_in_camera, normalized)) {
-      return false;
-    }
-    T lens_params[LensModel::kNumParams];
-    for (int i = 0; i < LensModel::kNumParams; ++i) {
-      lens_params[i] = T(lens[i]);
-    }
-    board_internal::NormalizedPointResidual<LensModel>(
-        lens_params, normalized[0], normalized[1], pixel, residuals);
-    return true;
-  }
-
-  static ceres::CostFunction* Create(
-      const std::array<double, kMaxLensParams>& lens, const DomePort& dome,
-      const Eigen::Vector3d& point_in_target, const Eigen::Vector2d& warp_basis,
-      const Eigen::Vector2d& pixel) {
-    return new ceres::AutoDiffCostFunction<DomeReprojectionError, 2, 1, 6, 6, 3,
-                                           2>(new DomeReprojectionError(
-        lens, dome, point_in_target, warp_basis, pixel));
-  }
-
-  const std::array<double, kMaxLensParams> lens;
-  const DomePort dome;  // its decentering is not read (a parameter block)
-  const Eigen::Vector3d point_in_target;
-  const Eigen::Vector2d warp_basis;
-  const Eigen::Vector2d pixel;
-};
-
 // The joint calibration of air and water through the dome
 // (dome_calibration.h, air views) estimates the lens too: the same
 // residual with the lens as the first block, [fx, fy, cx, cy, d...]
@@ -141,6 +90,42 @@ struct DomeLensReprojectionError {
   const Eigen::Vector3d point_in_target;
   const Eigen::Vector2d warp_basis;
   const Eigen::Vector2d pixel;
+};
+
+// The residual with the air calibration's lens held: the same as
+// DomeLensReprojectionError's with the lens a constant.
+template <typename LensModel>
+struct DomeReprojectionError {
+  DomeReprojectionError(const std::array<double, kMaxLensParams>& lens,
+                        const DomePort& dome,
+                        const Eigen::Vector3d& point_in_target,
+                        const Eigen::Vector2d& warp_basis,
+                        const Eigen::Vector2d& pixel)
+      : lens(lens), with_lens(dome, point_in_target, warp_basis, pixel) {}
+
+  template <typename T>
+  bool operator()(const T* n, const T* cam0_from_target, const T* cam_from_cam0,
+                  const T* decentering, const T* board_warp,
+                  T* residuals) const {
+    T lens_params[LensModel::kNumParams];
+    for (int i = 0; i < LensModel::kNumParams; ++i) {
+      lens_params[i] = T(lens[i]);
+    }
+    return with_lens(lens_params, n, cam0_from_target, cam_from_cam0,
+                     decentering, board_warp, residuals);
+  }
+
+  static ceres::CostFunction* Create(
+      const std::array<double, kMaxLensParams>& lens, const DomePort& dome,
+      const Eigen::Vector3d& point_in_target, const Eigen::Vector2d& warp_basis,
+      const Eigen::Vector2d& pixel) {
+    return new ceres::AutoDiffCostFunction<DomeReprojectionError, 2, 1, 6, 6, 3,
+                                           2>(new DomeReprojectionError(
+        lens, dome, point_in_target, warp_basis, pixel));
+  }
+
+  const std::array<double, kMaxLensParams> lens;
+  const DomeLensReprojectionError<LensModel> with_lens;
 };
 
 }  // namespace rcm::calib
