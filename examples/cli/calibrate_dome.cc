@@ -141,39 +141,18 @@ int RunCalibrateDome(const Subcommand& command,
     return kExitFailure;
   }
   // The air views of the joint calibration (the lenses estimated, the air
-  // views traced through the dome at n = 1), read before anything is
-  // written.
-  std::optional<AirViewsInput> air_views;
-  if (AirViewsGiven() || FLAGS_same_board || !FLAGS_air_target.empty()) {
-    StatusOr<AirViewsInput> read =
-        ReadAirViews(target, run.estimate_board_warp,
-                     /*allow_left_only=*/FLAGS_right.empty());
-    if (!read.ok()) {
-      PrintError(command, read.status().message());
-      return kExitFailure;
-    }
-    air_views = *std::move(read);
-    if (!FLAGS_json) {
-      std::cout << "rcm calibrate --underwater --port dome: "
-                << air_views->description
-                << " (lenses from air and water together, the air views "
-                   "through the dome)"
-                << std::endl;
-    }
-  }
-  StatusOr<CalibrationInput> input = ReadCalibrationInput(
-      target, /*allow_left_only=*/true, paths,
-      [&target](const std::string& description) {
-        if (!FLAGS_json) {
-          std::cout << "rcm calibrate --underwater --port dome: " << description
-                    << "; target " << calib::DescribeTarget(target)
-                    << "; air calibration " << FLAGS_air << std::endl;
-        }
-      });
-  if (!input.ok()) {
-    PrintError(command, input.status().message());
+  // views traced through the dome at n = 1) and the water views.
+  StatusOr<UnderwaterInputs> inputs = ReadUnderwaterInputs(
+      target, paths, run.estimate_board_warp,
+      /*allow_left_only_air=*/FLAGS_right.empty(),
+      "rcm calibrate --underwater --port dome",
+      "lenses from air and water together, the air views through the dome");
+  if (!inputs.ok()) {
+    PrintError(command, inputs.status().message());
     return kExitFailure;
   }
+  const std::optional<AirViewsInput>& air_views = inputs->air_views;
+  const CalibrationInput* input = &inputs->input;
   const Detections& detections = input->detections;
   const bool one_camera =
       !detections.sizes[1].has_value() && detections.right_only == 0;
@@ -277,8 +256,7 @@ int RunCalibrateDome(const Subcommand& command,
   const calib::ConventionalFit& conventional = result->conventional;
   // As the flat-port path: the pixel noise accounts for the conventional
   // fit's more unknowns; 10 % below the dome's is a better fit.
-  if (conventional.ok &&
-      conventional.pixel_sigma < 0.9 * result->pixel_sigma) {
+  if (conventional.ok && conventional.pixel_sigma < 0.9 * result->pixel_sigma) {
     warnings.push_back(
         "a conventional " + std::string(LensModelName(conventional.model)) +
         " model fitted freely to the same corners fits them better (pixel "

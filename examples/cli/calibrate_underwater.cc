@@ -145,6 +145,36 @@ Status WriteUnderwaterReport(const std::string& folder,
                              calib::FormatPerViewCsv(*report));
 }
 
+StatusOr<UnderwaterInputs> ReadUnderwaterInputs(
+    const calib::CalibrationTarget& target, const CalibrationOutputPaths& paths,
+    bool estimate_board_warp, bool allow_left_only_air,
+    const std::string& banner, const std::string& air_note) {
+  UnderwaterInputs inputs;
+  // The air views first: nothing is detected in the water when they fail.
+  if (AirViewsGiven() || FLAGS_same_board || !FLAGS_air_target.empty()) {
+    StatusOr<AirViewsInput> read =
+        ReadAirViews(target, estimate_board_warp, allow_left_only_air);
+    if (!read.ok()) return read.status();
+    inputs.air_views = *std::move(read);
+    if (!FLAGS_json) {
+      std::cout << banner << ": " << inputs.air_views->description << " ("
+                << air_note << ")" << std::endl;
+    }
+  }
+  StatusOr<CalibrationInput> input = ReadCalibrationInput(
+      target, /*allow_left_only=*/true, paths,
+      [&](const std::string& description) {
+        if (!FLAGS_json) {
+          std::cout << banner << ": " << description << "; target "
+                    << calib::DescribeTarget(target) << "; air calibration "
+                    << FLAGS_air << std::endl;
+        }
+      });
+  if (!input.ok()) return input.status();
+  inputs.input = *std::move(input);
+  return inputs;
+}
+
 namespace {
 
 // The candidates as the JSON lists them.
@@ -276,35 +306,15 @@ int RunCalibrateUnderwater(const Subcommand& command,
       return kExitFailure;
     }
   }
-  // The air views of the joint calibration, read before anything is
-  // written.
-  std::optional<AirViewsInput> air_views;
-  if (AirViewsGiven() || FLAGS_same_board || !FLAGS_air_target.empty()) {
-    StatusOr<AirViewsInput> read =
-        ReadAirViews(target, run.estimate_board_warp);
-    if (!read.ok()) {
-      PrintError(command, read.status().message());
-      return kExitFailure;
-    }
-    air_views = *std::move(read);
-    if (!FLAGS_json) {
-      std::cout << "rcm calibrate --underwater: " << air_views->description
-                << " (lenses from air and water together)" << std::endl;
-    }
-  }
-  StatusOr<CalibrationInput> input = ReadCalibrationInput(
-      target, /*allow_left_only=*/true, paths,
-      [&target](const std::string& description) {
-        if (!FLAGS_json) {
-          std::cout << "rcm calibrate --underwater: " << description
-                    << "; target " << calib::DescribeTarget(target)
-                    << "; air calibration " << FLAGS_air << std::endl;
-        }
-      });
-  if (!input.ok()) {
-    PrintError(command, input.status().message());
+  StatusOr<UnderwaterInputs> inputs = ReadUnderwaterInputs(
+      target, paths, run.estimate_board_warp, /*allow_left_only_air=*/false,
+      "rcm calibrate --underwater", "lenses from air and water together");
+  if (!inputs.ok()) {
+    PrintError(command, inputs.status().message());
     return kExitFailure;
   }
+  const std::optional<AirViewsInput>& air_views = inputs->air_views;
+  const CalibrationInput* input = &inputs->input;
   const Detections* detections = &input->detections;
   const bool one_camera = !detections->sizes[1].has_value() &&
                           detections->right_only == 0 &&

@@ -6,9 +6,12 @@
 
 #include <gflags/gflags.h>
 
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "air_views_flags.h"
+#include "calibration_input.h"
 #include "calibration_run.h"
 #include "command.h"
 #include "rcm/calib/calibration_report.h"
@@ -48,6 +51,21 @@ Status WriteUnderwaterReport(const std::string& folder,
                              const std::vector<calib::StereoView>& views,
                              const calib::ImageSize sizes[2], bool one_camera,
                              calib::CalibrationReport* report);
+
+// What an underwater calibration reads, before anything is written: the
+// air views of a joint calibration (when --air-left, --air-corners,
+// --same-board or --air-target are given; --air-left alone for one camera
+// when `allow_left_only_air`) and the water views. `banner` starts the
+// lines that say what is read ("rcm calibrate --underwater"), `air_note`
+// ends the air views' line.
+struct UnderwaterInputs {
+  std::optional<AirViewsInput> air_views;
+  CalibrationInput input;
+};
+StatusOr<UnderwaterInputs> ReadUnderwaterInputs(
+    const calib::CalibrationTarget& target, const CalibrationOutputPaths& paths,
+    bool estimate_board_warp, bool allow_left_only_air,
+    const std::string& banner, const std::string& air_note);
 
 }  // namespace rcm::cli
 
