@@ -149,6 +149,28 @@ void StoreResidualStatistics(ResidualStatistics statistics, Result* result) {
   result->num_outliers = statistics.num_outliers;
 }
 
+// The options of the conventional fit beside an underwater calibration
+// (the air model's lens free, no port): the robust-fit settings of
+// `options` (an UnderwaterCalibrationOptions or DomeCalibrationOptions),
+// no covariance.
+template <typename Options>
+StereoCalibrationOptions ConventionalFitOptions(LensModelId model,
+                                                const Options& options,
+                                                bool estimate_board_warp) {
+  StereoCalibrationOptions fit;
+  fit.model = model;
+  fit.huber_px = options.huber_px;
+  fit.outlier_sigmas = options.outlier_sigmas;
+  fit.min_outlier_threshold_px = options.min_outlier_threshold_px;
+  fit.max_outlier_rounds = options.max_outlier_rounds;
+  fit.max_num_iterations = options.max_num_iterations;
+  fit.min_corners_per_view = options.min_corners_per_view;
+  fit.compute_covariance = false;
+  fit.estimate_board_warp = estimate_board_warp;
+  fit.num_threads = options.num_threads;
+  return fit;
+}
+
 // The target poses of the views `used`, nullopt for the others.
 std::vector<std::optional<Rigid3d>> UsedViewPoses(
     const std::vector<Pose>& poses, const std::vector<bool>& used);

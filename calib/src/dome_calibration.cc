@@ -599,17 +599,8 @@ StatusOr<DomeCalibration> CalibrateDome(
   if (options.fit_conventional_model) {
     ConventionalFit& conventional = result.conventional;
     conventional.model = cameras[0].camera.model();
-    StereoCalibrationOptions free_fit;
-    free_fit.model = conventional.model;
-    free_fit.huber_px = options.huber_px;
-    free_fit.outlier_sigmas = options.outlier_sigmas;
-    free_fit.min_outlier_threshold_px = options.min_outlier_threshold_px;
-    free_fit.max_outlier_rounds = options.max_outlier_rounds;
-    free_fit.max_num_iterations = options.max_num_iterations;
-    free_fit.min_corners_per_view = options.min_corners_per_view;
-    free_fit.compute_covariance = false;
-    free_fit.estimate_board_warp = result.board_warp_estimated;
-    free_fit.num_threads = options.num_threads;
+    const StereoCalibrationOptions free_fit = internal::ConventionalFitOptions(
+        conventional.model, options, result.board_warp_estimated);
     const Camera& cam0 = cameras[0].camera;
     const auto fit_freely = [&]() -> StatusOr<StereoCalibration> {
       if (num_cameras == 1) {

@@ -1376,18 +1376,9 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
           "conventional fit: both cameras use cam0's lens model (" +
           std::string(LensModelName(fit.model)) + ")");
     }
-    StereoCalibrationOptions conventional;
-    conventional.model = fit.model;
-    conventional.huber_px = options.huber_px;
-    conventional.outlier_sigmas = options.outlier_sigmas;
-    conventional.min_outlier_threshold_px = options.min_outlier_threshold_px;
-    conventional.max_outlier_rounds = options.max_outlier_rounds;
-    conventional.max_num_iterations = options.max_num_iterations;
+    StereoCalibrationOptions conventional = internal::ConventionalFitOptions(
+        fit.model, options, options.estimate_board_warp);
     conventional.use_single_camera_views = options.use_single_camera_views;
-    conventional.min_corners_per_view = options.min_corners_per_view;
-    conventional.compute_covariance = false;
-    conventional.estimate_board_warp = options.estimate_board_warp;
-    conventional.num_threads = options.num_threads;
     const StatusOr<StereoCalibration> calibration = CalibrateStereo(
         target, views, {cameras[0]->width(), cameras[0]->height()},
         {cameras[1]->width(), cameras[1]->height()}, conventional);
