@@ -12,8 +12,10 @@
 //
 //   build/bin/dome_monte_carlo [--trials 50] [--threads 2] [--seed 1]
 //                              [--views 14] [--dive one|stereo|both]
+//                              [--verbose]
 //
-// Prints a markdown table, with progress on stderr. Trials run in parallel
+// Prints a markdown table, with progress on stderr (--verbose: and each
+// dive's errors and sigmas). Trials run in parallel
 // (--threads), each on one thread.
 #include <Eigen/Core>
 #include <algorithm>
@@ -52,6 +54,7 @@ struct Trial {
   int views_used = 0;
   int corners = 0;
   bool flat_plausible = false;  // the spread widened sigma
+  Eigen::Vector2d board_warp = Eigen::Vector2d::Zero();  // meters
 };
 
 // The dome of test::AcrylicDome (43.55 mm inside, 3.75 mm of acrylic).
@@ -88,10 +91,16 @@ Trial RunTrial(const rcm::StereoRig& rig, const DiveConfig& config, int views,
   }
   trial.rms_px = result->rms_px;
   trial.views_used = result->num_views_used;
+  trial.board_warp = result->board_warp;
   for (const rcm::calib::DomeCandidate& candidate : result->candidates) {
     trial.flat_plausible |= !candidate.board_warp && candidate.plausible;
   }
   return trial;
+}
+
+// Distinct board poses and noise per dive and per configuration.
+uint64_t TrialSeed(uint64_t seed, size_t config, int64_t trial) {
+  return (seed * 4 + config) * 100003 + trial;
 }
 
 // Mean and sample standard deviation (N - 1).
@@ -104,6 +113,32 @@ Eigen::Vector2d MeanSd(const std::vector<double>& x) {
 
 std::string Cell(double value, int digits) {
   return rcm::FormatFixed(value, digits);
+}
+
+std::string Millimetres(const Eigen::Vector3d& v) {
+  return "(" + Cell(1e3 * v.x(), 3) + ", " + Cell(1e3 * v.y(), 3) + ", " +
+         Cell(1e3 * v.z(), 3) + ")";
+}
+
+// --verbose: one line per dive on stderr.
+void PrintTrial(const std::string& dive, int index, uint64_t seed,
+                const Trial& t) {
+  std::cerr << dive << " dive " << index << " (seed " << seed << "): ";
+  if (!t.failure.empty()) {
+    std::cerr << "failed: " << t.failure << "\n";
+    return;
+  }
+  std::cerr << t.views_used << " views, " << t.corners << " corners, rms "
+            << Cell(t.rms_px, 3) << " px, warp ("
+            << Cell(1e3 * t.board_warp.x(), 3) << ", "
+            << Cell(1e3 * t.board_warp.y(), 3) << ") mm"
+            << (t.flat_plausible ? ", flat plausible" : "");
+  for (size_t c = 0; c < t.error.size(); ++c) {
+    std::cerr << "; cam" << c << " error " << Millimetres(t.error[c])
+              << " mm, sigma " << Millimetres(t.sigma[c]) << " mm, noise "
+              << Millimetres(t.sigma_noise[c]) << " mm";
+  }
+  std::cerr << "\n";
 }
 
 // The table's rows of one camera's component over the successful trials.
@@ -137,6 +172,7 @@ int main(int argc, char** argv) {
   int views = 14;
   uint64_t seed = 1;
   std::string which = "both";
+  bool verbose = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     const bool has_value = i + 1 < argc;
@@ -150,9 +186,12 @@ int main(int argc, char** argv) {
       seed = std::strtoull(argv[++i], nullptr, 10);
     } else if (arg == "--dive" && has_value) {
       which = argv[++i];
+    } else if (arg == "--verbose") {
+      verbose = true;
     } else {
       std::cerr << "usage: dome_monte_carlo [--trials 50] [--threads 2] "
-                   "[--seed 1] [--views 14] [--dive one|stereo|both]\n";
+                   "[--seed 1] [--views 14] [--dive one|stereo|both] "
+                   "[--verbose]\n";
       return arg == "--help" ? 0 : 2;
     }
   }
@@ -182,9 +221,7 @@ int main(int argc, char** argv) {
     const auto start = std::chrono::steady_clock::now();
     rcm::ParallelForChunks(trials, threads, 1, [&](int64_t begin, int64_t end) {
       for (int64_t t = begin; t < end; ++t) {
-        // Distinct poses and noise per dive and per configuration.
-        const uint64_t trial_seed = (seed * 4 + k) * 100003 + t;
-        results[t] = RunTrial(rig, config, views, trial_seed);
+        results[t] = RunTrial(rig, config, views, TrialSeed(seed, k, t));
         const std::lock_guard<std::mutex> lock(progress);
         std::cerr << "\rdome_monte_carlo: " << config.name << " dive " << ++done
                   << " of " << trials << std::flush;
@@ -194,6 +231,9 @@ int main(int argc, char** argv) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
             .count();
     std::cerr << "\n";
+    for (int t = 0; verbose && t < trials; ++t) {
+      PrintTrial(config.name, t, TrialSeed(seed, k, t), results[t]);
+    }
     const int cameras = static_cast<int>(config.decentering.size());
     for (int c = 0; c < cameras; ++c) {
       for (int axis = 0; axis < 3; ++axis) {

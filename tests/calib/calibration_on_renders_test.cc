@@ -11,17 +11,16 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <optional>
 #include <string>
 #include <vector>
 
+#include "calib/rendered_dome_dive.h"
 #include "calib/synthetic_target_views.h"
 #include "rcm/calib/dome_calibration.h"
 #include "rcm/calib/stereo_calibration.h"
 #include "rcm/calib/target_detector.h"
 #include "rcm/calib/target_image.h"
 #include "rcm/calib/target_renderer.h"
-#include "rcm/camera/dome_port_camera.h"
 #include "support/projection_error.h"
 #include "support/test_rigs.h"
 
@@ -173,18 +172,16 @@ TEST(CalibrationOnRenders, ChessboardEucmRecoversTheTruth) {
   ExpectUnifiedModelRecovered(LensModelId::kEucm);
 }
 
-// Rendered dome dives (issue 33): the 4-inch acrylic dome (inner radius
-// 43.55 mm, 3.75 mm thick, n_glass 1.495) in water (n = 1.333, held at
-// the truth), each camera decentered 1-3 mm laterally and 5-10 mm
-// axially. Views of a 9x6 chessboard of 40 mm squares at 0.4-1.4 m (the
-// axial decentering needs distances), rendered through the dome with a
-// 0.5 px blur and 2 gray levels of noise, detected, and calibrated with
-// the true air lenses held, the board's bow estimated as on a real dive.
-// Each component within 0.2 mm of the truth and within 3 of its reported
-// sigmas.
+// Rendered dome dives (issue 33, calib/rendered_dome_dive.h): the 4-inch
+// acrylic dome in water (n = 1.333, held at the truth), each camera
+// decentered 1-3 mm laterally and 5-10 mm axially, a 9x6 chessboard of
+// 40 mm squares at 0.4-1.4 m rendered through the dome with a 0.5 px blur
+// and 2 gray levels of noise, detected, and calibrated with the true air
+// lenses held, the board's bow estimated as on a real dive. Each component
+// within 0.2 mm of the truth and within 3 of its reported sigmas
+// (benchmarks/dome_monte_carlo.cc checks the sigmas over many dives).
 constexpr double kMaxDomeDecenteringError = 2e-4;  // meters
 constexpr double kMaxDomeDecenteringSigmas = 3.0;
-constexpr double kDomeWaterIndex = 1.333;
 
 // Renders `num_poses` views of the board through each camera's dome
 // (cam0 = rig.left(); the right camera when `decentering` has two), detects
@@ -193,51 +190,22 @@ void ExpectDomeDiveRecovered(const StereoRig& rig,
                              const std::vector<Eigen::Vector3d>& decentering,
                              int num_poses, unsigned seed,
                              bool check_accuracy = true) {
-  const CalibrationTarget target = MakeCheckerboardTarget(9, 6, 0.04).value();
-  const TargetImage texture = DrawTargetImage(target, 4000.0);
   const int num_cameras = static_cast<int>(decentering.size());
-  const Camera* lenses[2] = {&rig.left(), &rig.right()};
-  std::vector<TargetRenderer> renderers;
-  std::vector<DomeCameraInput> inputs;
-  for (int c = 0; c < num_cameras; ++c) {
-    const DomePortCamera through =
-        DomePortCamera::Create(
-            *lenses[c], rcm::test::AcrylicDome(decentering[c]), kDomeWaterIndex)
-            .value();
-    renderers.push_back(TargetRenderer::Create(through, texture).value());
-    // The start: the dome's glass, centred.
-    inputs.push_back(
-        {*lenses[c], rcm::test::AcrylicDome(Eigen::Vector3d::Zero())});
+  std::vector<DomePort> domes;
+  for (const Eigen::Vector3d& c : decentering) {
+    domes.push_back(rcm::test::AcrylicDome(c));
   }
-  TargetRenderOptions render;
-  render.noise_sigma = 2.0;
-  render.blur_sigma_px = 0.5;
-  const std::vector<Rigid3d> poses = test::BoardPoses(
-      rig.left(), target, num_poses, seed, 0.4, 1.4, 35.0, kDomeWaterIndex);
-  std::vector<StereoView> views;
-  int corners = 0;
-  for (size_t v = 0; v < poses.size(); ++v) {
-    StereoView view;
-    std::optional<TargetObservation>* sides[2] = {&view.left, &view.right};
-    for (int c = 0; c < num_cameras; ++c) {
-      render.seed = 2 * v + c;
-      const Rigid3d pose = c == 0 ? poses[v] : rig.right_from_left() * poses[v];
-      *sides[c] = DetectTarget(renderers[c].Render(pose, render), target);
-      corners += *sides[c] ? (*sides[c])->size() : 0;
-    }
-    views.push_back(std::move(view));
-  }
-  DomeCalibrationOptions options;
-  options.n = kDomeWaterIndex;
-  options.fit_conventional_model = false;
-  const StatusOr<DomeCalibration> result =
-      CalibrateDome(views, inputs, rig.right_from_left(), target, options);
+  test::DomeDiveOptions dive_options;
+  dive_options.num_poses = num_poses;
+  dive_options.pose_seed = seed;
+  const test::DomeDive dive = test::RenderDomeDive(rig, domes, dive_options);
+  const StatusOr<DomeCalibration> result = test::CalibrateDomeDive(dive, rig);
   ASSERT_TRUE(result.ok()) << result.status().message();
   ASSERT_EQ(result->decentering.size(), decentering.size());
   std::printf(
       "%d camera(s), %d views used, %d corners detected, %d inliers, "
       "rms %.3f px, %s\n",
-      num_cameras, result->num_views_used, corners, result->num_inliers,
+      num_cameras, result->num_views_used, dive.corners, result->num_inliers,
       result->rms_px, result->candidates[result->chosen].name.c_str());
   for (int c = 0; c < num_cameras; ++c) {
     const Eigen::Vector3d error = result->decentering[c] - decentering[c];
