@@ -37,7 +37,7 @@ struct DomeDiveOptions {
   unsigned pose_seed = 0;
   // View v of camera c is rendered with noise seed noise_seed + 2 v + c.
   uint64_t noise_seed = 0;
-  // Threads of the renderer and of the calibration.
+  // The renderer's threads (CalibrateDomeDive takes its own).
   int num_threads = 2;
 };
 
