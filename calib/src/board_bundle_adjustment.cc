@@ -281,4 +281,16 @@ std::vector<std::optional<Rigid3d>> UsedViewPoses(
   return out;
 }
 
+double LeaveOutOrCovarianceSigma(double covariance_sigma,
+                                 double leave_out_sigma, int replicates) {
+  if (!(covariance_sigma > 0.0)) return leave_out_sigma;
+  const double dof = replicates - 1.0;
+  if (dof < 1.0 || !std::isfinite(leave_out_sigma)) return covariance_sigma;
+  constexpr double kZ95 = 1.6448536269514722;
+  const double a = 2.0 / (9.0 * dof);
+  const double quantile = dof * std::pow(1.0 - a + kZ95 * std::sqrt(a), 3);
+  const double ratio = leave_out_sigma / covariance_sigma;
+  return ratio * ratio * dof > quantile ? leave_out_sigma : covariance_sigma;
+}
+
 }  // namespace rcm::calib::internal

@@ -171,6 +171,17 @@ StereoCalibrationOptions ConventionalFitOptions(LensModelId model,
   return fit;
 }
 
+// The noise sigma of an estimate with a covariance sigma and a
+// leave-views-out (grouped jackknife) sigma from `replicates` replicates:
+// the leave-out sigma when it exceeds the covariance's by more than its
+// own sampling error allows (a one-sided 95 % chi-square test with
+// replicates - 1 degrees of freedom; Wilson-Hilferty's quantile), else the
+// covariance's. The leave-out counts errors shared within a view (a
+// detector's, on a steep or crowded board), which the covariance does
+// not; from 5-10 replicates it is too noisy to take whenever larger.
+double LeaveOutOrCovarianceSigma(double covariance_sigma,
+                                 double leave_out_sigma, int replicates);
+
 // The target poses of the views `used`, nullopt for the others.
 std::vector<std::optional<Rigid3d>> UsedViewPoses(
     const std::vector<Pose>& poses, const std::vector<bool>& used);

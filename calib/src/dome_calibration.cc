@@ -105,10 +105,13 @@ std::vector<double*> DomeBlocks(const DomeProblem& problem, DomeState* state,
   return blocks;
 }
 
+// `replicate`: a leave-out replicate, refitted from the solution on its
+// inliers (no outlier rounds) without a covariance.
 StatusOr<DomeFit> FitDomeCandidate(const DomeProblem& description,
                                    const std::vector<Corner>& start_corners,
                                    const DomeState& start, bool board_warp,
-                                   const DomeCalibrationOptions& options) {
+                                   const DomeCalibrationOptions& options,
+                                   bool replicate = false) {
   DomeFit fit;
   fit.state = start;
   fit.corners = start_corners;
@@ -177,7 +180,7 @@ StatusOr<DomeFit> FitDomeCandidate(const DomeProblem& description,
   rejection.huber_px = options.huber_px;
   rejection.outlier_sigmas = options.outlier_sigmas;
   rejection.min_outlier_threshold_px = options.min_outlier_threshold_px;
-  rejection.max_outlier_rounds = options.max_outlier_rounds;
+  rejection.max_outlier_rounds = replicate ? 0 : options.max_outlier_rounds;
   ceres::Problem problem;
   RCM_RETURN_IF_ERROR(internal::FitWithOutlierRejection(
       rejection,
@@ -220,6 +223,7 @@ StatusOr<DomeFit> FitDomeCandidate(const DomeProblem& description,
     ssr = (std::isnan(ssr) ? 0.0 : ssr) + corner.residual.squaredNorm();
   }
 
+  if (replicate) return fit;
   // The covariance of the blocks reported.
   std::vector<internal::CovarianceBlockRef> blocks;
   int offset = 0;
@@ -313,6 +317,10 @@ Status DomeCalibrationOptions::Check() const {
   }
   if (!(evidence_sigmas > 0.0) || !std::isfinite(evidence_sigmas)) {
     return Status::Error("evidence_sigmas must be positive and finite");
+  }
+  if (folds < 0 || folds == 1) {
+    return Status::Error("folds = " + std::to_string(folds) +
+                         " must be 0 (no leave-out) or at least 2");
   }
   return Status::Ok();
 }
@@ -486,10 +494,77 @@ StatusOr<DomeCalibration> CalibrateDome(
     }
   }
   const double share = weight / (1.0 + weight);
+
+  // The leave-views-out replicates of the chosen model: the used water
+  // views in g = min(folds, V) groups (the k-th in group k mod g), each left
+  // out in turn and the rest refitted from the solution on its inliers.
+  std::vector<bool> water_view_used(num_water_views, false);
+  for (const Corner& corner : fit.corners) {
+    if (corner.view < num_water_views) water_view_used[corner.view] = true;
+  }
+  std::vector<int> used_views;
+  for (int v = 0; v < num_water_views; ++v) {
+    if (water_view_used[v]) used_views.push_back(v);
+  }
+  const int groups = std::min<int>(options.folds, used_views.size());
+  std::vector<std::vector<Eigen::Vector3d>> replicates(num_cameras);
+  std::vector<double> n_replicates;
+  if (options.folds >= 2 && groups >= 2) {
+    for (int g = 0; g < groups; ++g) {
+      std::vector<bool> left_out(description.num_views, false);
+      for (size_t k = g; k < used_views.size(); k += groups) {
+        left_out[used_views[k]] = true;
+      }
+      std::vector<Corner> kept;
+      for (const Corner& corner : fit.corners) {
+        if (corner.inlier && !left_out[corner.view]) kept.push_back(corner);
+      }
+      const StatusOr<DomeFit> refit = FitDomeCandidate(
+          description, kept, fit.state, result.chosen == 1 && bowed, options,
+          /*replicate=*/true);
+      if (!refit.ok()) {
+        ++result.failed_folds;
+        continue;
+      }
+      for (int c = 0; c < num_cameras; ++c) {
+        const std::array<double, 3>& centre = refit->state.centre[c];
+        replicates[c].emplace_back(centre[0], centre[1], centre[2]);
+      }
+      n_replicates.push_back(refit->state.n);
+    }
+    result.folds = groups;
+  }
+  const int num_replicates = static_cast<int>(n_replicates.size());
+  const bool leave_out = num_replicates >= 2;
+  // sqrt((g - 1) / g sum (x_k - mean x)^2) of each component.
+  const auto jackknife = [num_replicates](const std::vector<double>& x) {
+    double mean = 0.0;
+    for (double value : x) mean += value;
+    mean /= num_replicates;
+    double sum = 0.0;
+    for (double value : x) sum += (value - mean) * (value - mean);
+    return std::sqrt((num_replicates - 1.0) / num_replicates * sum);
+  };
+
   for (int c = 0; c < num_cameras; ++c) {
     result.decentering.push_back(best.decentering[c]);
     const int o = fit.centre_offset[c];
     result.decentering_covariance.push_back(fit.covariance.block<3, 3>(o, o));
+    Eigen::Vector3d noise = best.decentering_sigma[c];
+    Eigen::Vector3d leave_out_sigma = Eigen::Vector3d::Zero();
+    if (leave_out) {
+      for (int i = 0; i < 3; ++i) {
+        std::vector<double> component;
+        for (const Eigen::Vector3d& replicate : replicates[c]) {
+          component.push_back(replicate[i]);
+        }
+        leave_out_sigma[i] = jackknife(component);
+        noise[i] = internal::LeaveOutOrCovarianceSigma(
+            noise[i], leave_out_sigma[i], num_replicates);
+      }
+    }
+    result.decentering_sigma_leave_out.push_back(leave_out_sigma);
+    result.decentering_sigma_noise.push_back(noise);
     Eigen::Vector3d model = Eigen::Vector3d::Zero();
     if (other != nullptr) {
       for (int i = 0; i < 3; ++i) {
@@ -502,8 +577,7 @@ StatusOr<DomeCalibration> CalibrateDome(
     }
     result.decentering_sigma_model.push_back(model);
     result.decentering_sigma.push_back(
-        (best.decentering_sigma[c].array().square() + model.array().square())
-            .sqrt());
+        (noise.array().square() + model.array().square()).sqrt());
     Eigen::Vector3d correlation = Eigen::Vector3d::Zero();
     if (fit.n_offset >= 0) {
       for (int i = 0; i < 3; ++i) {
@@ -524,7 +598,13 @@ StatusOr<DomeCalibration> CalibrateDome(
             ? std::sqrt(share * SpreadSquared(other->n, best.n, other->sigma_n,
                                               best.sigma_n))
             : 0.0;
-    result.sigma_n = std::hypot(best.sigma_n, result.sigma_n_model);
+    double noise = best.sigma_n;
+    if (leave_out) {
+      result.sigma_n_leave_out = jackknife(n_replicates);
+      noise = internal::LeaveOutOrCovarianceSigma(
+          noise, result.sigma_n_leave_out, num_replicates);
+    }
+    result.sigma_n = std::hypot(noise, result.sigma_n_model);
   }
   if (fit.warp_offset >= 0) {
     result.board_warp_estimated = true;
@@ -534,14 +614,10 @@ StatusOr<DomeCalibration> CalibrateDome(
             .diagonal()
             .cwiseSqrt();
   }
-  std::vector<bool> view_used(num_water_views, false);
-  for (const Corner& corner : fit.corners) {
-    if (corner.view < num_water_views) view_used[corner.view] = true;
-  }
   result.cam0_from_target = internal::UsedViewPoses(
       std::vector<Pose>(fit.state.poses.begin(),
                         fit.state.poses.begin() + num_water_views),
-      view_used);
+      water_view_used);
   result.num_views_used = num_views_used;
   result.num_air_views_used = num_air_views_used;
   // The water corners' statistics (the air views' apart).

@@ -7,6 +7,7 @@
 #include <string>
 #include <utility>
 
+#include "board_bundle_adjustment.h"
 #include "rcm/util/number_format.h"
 #include "rcm/util/parallel_for.h"
 
@@ -94,18 +95,12 @@ int WeighEvidence(double evidence_sigmas,
 
 // sigma_n_noise of a fit (header): its leave-out sigma when that exceeds
 // the covariance's by more than the leave-out's own sampling error allows
-// (a one-sided 95 % chi-square test with g - 1 degrees of freedom, g the
-// replicates; Wilson-Hilferty's quantile), else the covariance's.
+// (internal::LeaveOutOrCovarianceSigma), else the covariance's.
 double NoiseSigma(const UnderwaterCalibration& fit) {
   if (!fit.sigma_n_leave_out || !fit.leave_out) return fit.sigma_n;
-  if (!(fit.sigma_n > 0.0)) return *fit.sigma_n_leave_out;
-  const double dof = fit.leave_out->folds - fit.leave_out->failed_folds - 1.0;
-  if (dof < 1.0) return fit.sigma_n;
-  constexpr double kZ95 = 1.6448536269514722;
-  const double a = 2.0 / (9.0 * dof);
-  const double quantile = dof * std::pow(1.0 - a + kZ95 * std::sqrt(a), 3);
-  const double ratio = *fit.sigma_n_leave_out / fit.sigma_n;
-  return ratio * ratio * dof > quantile ? *fit.sigma_n_leave_out : fit.sigma_n;
+  return internal::LeaveOutOrCovarianceSigma(
+      fit.sigma_n, *fit.sigma_n_leave_out,
+      fit.leave_out->folds - fit.leave_out->failed_folds);
 }
 
 // What separates n from the model `other` that spreads it, given the

@@ -131,6 +131,7 @@ int RunCalibrateDome(const Subcommand& command,
   options.huber_px = run.huber_px;
   options.outlier_sigmas = run.outlier_sigmas;
   options.min_corners_per_view = run.min_corners;
+  options.folds = run.folds;
   if (const Status status = options.Check(); !status.ok()) {
     PrintError(command, "--port dome: " + status.message());
     return kExitUsage;
@@ -311,6 +312,13 @@ int RunCalibrateDome(const Subcommand& command,
   json["decentering_m"] = decentering;
   json["decentering_sigma_m"] = decentering_sigma;
   json["decentering_sigma_model_m"] = decentering_sigma_model;
+  nlohmann::json leave_out = nlohmann::json::array();
+  for (int c = 0; c < num_cameras; ++c) {
+    leave_out.push_back(Vector3Json(result->decentering_sigma_leave_out[c]));
+  }
+  json["decentering_sigma_leave_out_m"] = leave_out;
+  json["folds"] = result->folds;
+  json["failed_folds"] = result->failed_folds;
   json["dome"] = dome_json;
   json["n"] = result->n;
   json["n_estimated"] = result->n_estimated;

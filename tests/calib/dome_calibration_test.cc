@@ -192,6 +192,9 @@ void ExpectHonestSigma(const Eigen::Vector2d& board_warp) {
   const std::vector<Rigid3d> poses = Poses(camera, 20, 13);
   DomeCalibrationOptions options;
   options.fit_conventional_model = false;
+  // Independent Gaussian corner noise: the covariance is the sigma (the
+  // leave-out, tested below, replaces it only where views share errors).
+  options.folds = 0;
   const int trials = ::rcm::test::Trials(50);
   std::vector<Eigen::Vector3d> z;
   for (int trial = 0; trial < trials; ++trial) {
@@ -280,6 +283,49 @@ TEST(DomeCalibration, NoiseFreeAirViewsThroughTheDomeUnbiasTheLens) {
   EXPECT_LT(joint->air_rms_px, 1e-9);
 }
 
+// Errors shared within a view (a detector's on a crowded board) are
+// invisible to the covariance, which scales independent corner noise; the
+// leave-views-out sigma counts them and replaces it. Here each view is
+// imaged through a dome displaced by its own 0.6 mm (per axis) from the
+// mean decentering, on 0.05 px of independent noise: every view pulls the
+// estimate its own way while its residuals stay small.
+TEST(DomeCalibration, LeaveOutSigmaCountsErrorsSharedWithinAView) {
+  const Camera camera = ::rcm::test::AlphasenseCam0();
+  const Eigen::Vector3d truth(0.002, 0.001, 0.008);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> shift(0.0, 6e-4);
+  std::vector<StereoView> views;
+  for (const Rigid3d& pose : Poses(camera, 20, 11)) {
+    Eigen::Vector3d displaced = truth;
+    for (int i = 0; i < 3; ++i) displaced[i] += shift(rng);  // in order
+    const DomePortCamera view_dome =
+        DomePortCamera::Create(camera, ::rcm::test::AcrylicDome(displaced),
+                               1.333)
+            .value();
+    views.push_back(
+        OneCameraViews(view_dome, {pose}, 0.05, 100 + views.size())[0]);
+  }
+  DomeCalibrationOptions options = Exact();
+  options.estimate_board_warp = false;
+  const StatusOr<DomeCalibration> result =
+      CalibrateDome(views, {Input(camera)}, Rigid3d(), Checkerboard(), options);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  EXPECT_EQ(result->folds, 10);
+  EXPECT_EQ(result->failed_folds, 0);
+  const Eigen::Vector3d covariance =
+      result->decentering_covariance[0].diagonal().cwiseSqrt();
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_GT(result->decentering_sigma_leave_out[0][i], 1.5 * covariance[i])
+        << i;
+    EXPECT_EQ(result->decentering_sigma_noise[0][i],
+              result->decentering_sigma_leave_out[0][i])
+        << i;
+    EXPECT_LT(std::abs(result->decentering[0][i] - truth[i]),
+              4.0 * result->decentering_sigma[0][i])
+        << i;
+  }
+}
+
 TEST(DomeCalibration, BadInputIsOneLine) {
   const Camera camera = ::rcm::test::AlphasenseCam0();
   const DomePortCamera through =
@@ -301,6 +347,10 @@ TEST(DomeCalibration, BadInputIsOneLine) {
   DomeCameraInput outside = Input(camera);
   outside.dome.decentering = Eigen::Vector3d(0.0, 0.0, 0.05);
   EXPECT_NE(message({outside}, Exact()).find("outside the inner sphere"),
+            std::string::npos);
+  DomeCalibrationOptions one_fold = Exact();
+  one_fold.folds = 1;
+  EXPECT_NE(message({Input(camera)}, one_fold).find("folds = 1"),
             std::string::npos);
   DomeCalibrationOptions bad_n = Exact();
   bad_n.n = 2.5;

@@ -24,7 +24,17 @@
 // each decentering component.
 //
 // Uncertainty. cov = sigma^2 (J^T J)^-1 at the solution, sigma^2 =
-// SSR / (2 m - p) over the m inlier corners and p unknowns. Real boards
+// SSR / (2 m - p) over the m inlier corners and p unknowns. It counts
+// independent corner noise only; a detector's errors are shared within a
+// view (corners crowded on a steep or far board are off together), which
+// on rendered dives made the covariance sigma 1.4-1.9 times too small (a
+// Monte Carlo of 50 dives, benchmarks/dome_monte_carlo). So the used views
+// are also left out in g = min(folds, V) groups, each replicate refitted
+// from the solution on its inliers, and the grouped jackknife
+//   sigma_jk = sqrt((g - 1) / g * sum_k (x_k - mean x)^2)
+// replaces the covariance's sigma where it is larger beyond its sampling
+// error (a one-sided 95 % chi-square test on g - 1 degrees of freedom), as
+// the flat-port path does (underwater_model_selection.h). Real boards
 // are rarely flat, so two candidate models are fitted, the board flat and
 // bowed (when estimate_board_warp), as the flat-port path does
 // (underwater_model_selection.h): with d_v = ln(s_flat(v) / s_bowed(v)),
@@ -71,6 +81,9 @@ struct DomeCalibrationOptions {
   // Evidence (t statistic over the views) above which the flat board is
   // ruled out.
   double evidence_sigmas = 3.0;
+  // Leave-views-out groups of the chosen model's sigma (header); 0: none,
+  // else >= 2 (min(folds, V) groups).
+  int folds = 10;
   // Huber loss scale [px] of the robust solves.
   double huber_px = 1.0;
   // Corners beyond outlier_sigmas robust standard deviations, and at least
@@ -121,12 +134,20 @@ struct DomeCalibration {
   std::vector<Eigen::Matrix3d> decentering_covariance;
   std::vector<Eigen::Vector3d> decentering_sigma;
   std::vector<Eigen::Vector3d> decentering_sigma_model;
+  // Its parts: the noise sigma (the covariance's, or the leave-out's when
+  // that is larger beyond its sampling error) and the leave-out sigma
+  // itself (zero without folds).
+  std::vector<Eigen::Vector3d> decentering_sigma_noise;
+  std::vector<Eigen::Vector3d> decentering_sigma_leave_out;
+  int folds = 0;         // leave-out replicates run
+  int failed_folds = 0;  // of which failed
   // n: estimated or held, its total sigma (0 when held), the spread part,
   // and its correlation with each camera's decentering components.
   bool n_estimated = false;
   double n = 0.0;
   double sigma_n = 0.0;
   double sigma_n_model = 0.0;
+  double sigma_n_leave_out = 0.0;
   std::vector<Eigen::Vector3d> correlation_n_decentering;
   // The board's warp [m] when the chosen model bows it.
   bool board_warp_estimated = false;
