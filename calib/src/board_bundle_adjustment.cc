@@ -281,16 +281,46 @@ std::vector<std::optional<Rigid3d>> UsedViewPoses(
   return out;
 }
 
+namespace {
+
+// The one-sided 95 % quantile of chi-square with `dof` degrees of freedom
+// (Wilson-Hilferty).
+double ChiSquare95(double dof) {
+  constexpr double kZ95 = 1.6448536269514722;
+  const double a = 2.0 / (9.0 * dof);
+  return dof * std::pow(1.0 - a + kZ95 * std::sqrt(a), 3);
+}
+
+}  // namespace
+
 double LeaveOutOrCovarianceSigma(double covariance_sigma,
                                  double leave_out_sigma, int replicates) {
   if (!(covariance_sigma > 0.0)) return leave_out_sigma;
   const double dof = replicates - 1.0;
   if (dof < 1.0 || !std::isfinite(leave_out_sigma)) return covariance_sigma;
-  constexpr double kZ95 = 1.6448536269514722;
-  const double a = 2.0 / (9.0 * dof);
-  const double quantile = dof * std::pow(1.0 - a + kZ95 * std::sqrt(a), 3);
   const double ratio = leave_out_sigma / covariance_sigma;
-  return ratio * ratio * dof > quantile ? leave_out_sigma : covariance_sigma;
+  return ratio * ratio * dof > ChiSquare95(dof) ? leave_out_sigma
+                                                : covariance_sigma;
+}
+
+double PooledLeaveOutScale(const std::vector<double>& covariance_sigmas,
+                           const std::vector<double>& leave_out_sigmas,
+                           int replicates) {
+  double sum = 0.0;
+  int count = 0;
+  for (size_t k = 0; k < covariance_sigmas.size(); ++k) {
+    if (!(covariance_sigmas[k] > 0.0) || !std::isfinite(leave_out_sigmas[k])) {
+      continue;
+    }
+    const double ratio = leave_out_sigmas[k] / covariance_sigmas[k];
+    sum += ratio * ratio;
+    ++count;
+  }
+  const double dof = count * (replicates - 1.0);
+  if (count == 0 || dof < 1.0) return 1.0;
+  const double ratio_squared = sum / count;
+  return ratio_squared * dof > ChiSquare95(dof) ? std::sqrt(ratio_squared)
+                                                : 1.0;
 }
 
 }  // namespace rcm::calib::internal

@@ -559,9 +559,11 @@ StatusOr<DomeCalibration> CalibrateDome(
           component.push_back(replicate[i]);
         }
         leave_out_sigma[i] = jackknife(component);
-        noise[i] = internal::LeaveOutOrCovarianceSigma(
-            noise[i], leave_out_sigma[i], num_replicates);
       }
+      noise *= internal::PooledLeaveOutScale(
+          {noise.x(), noise.y(), noise.z()},
+          {leave_out_sigma.x(), leave_out_sigma.y(), leave_out_sigma.z()},
+          num_replicates);
     }
     result.decentering_sigma_leave_out.push_back(leave_out_sigma);
     result.decentering_sigma_noise.push_back(noise);

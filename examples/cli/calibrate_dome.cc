@@ -43,10 +43,6 @@ using calib::DomeCalibration;
 using calib::ImageSize;
 using calib::StereoView;
 
-nlohmann::json Vector3Json(const Eigen::Vector3d& v) {
-  return nlohmann::json::array({v.x(), v.y(), v.z()});
-}
-
 std::string MillimetresText(const Eigen::Vector3d& value,
                             const Eigen::Vector3d& sigma) {
   std::string text = "(";

@@ -90,10 +90,6 @@ std::string Vector3Text(const Eigen::Vector3d& v, int digits) {
          ", " + FormatFixed(v.z(), digits) + ")";
 }
 
-nlohmann::json Vector3Json(const Eigen::Vector3d& v) {
-  return {v.x(), v.y(), v.z()};
-}
-
 // The report's pictures and table: the underwater corners drawn as the
 // air calibration's are (calibration_report.h), through a StereoCalibration
 // that holds the underwater solution's residuals and poses.
@@ -116,6 +112,10 @@ calib::StereoCalibration UnderwaterDrawing(
 }
 
 }  // namespace
+
+nlohmann::json Vector3Json(const Eigen::Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
 
 Status WriteUnderwaterReport(const std::string& folder,
                              const calib::StereoCalibration& drawing,

@@ -6,6 +6,8 @@
 
 #include <gflags/gflags.h>
 
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -51,6 +53,9 @@ Status WriteUnderwaterReport(const std::string& folder,
                              const std::vector<calib::StereoView>& views,
                              const calib::ImageSize sizes[2], bool one_camera,
                              calib::CalibrationReport* report);
+
+// A 3-vector as the JSON writes it: [x, y, z].
+nlohmann::json Vector3Json(const Eigen::Vector3d& v);
 
 // What an underwater calibration reads, before anything is written: the
 // air views of a joint calibration (when --air-left, --air-corners,
