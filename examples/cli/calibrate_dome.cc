@@ -127,7 +127,10 @@ int RunCalibrateDome(const Subcommand& command,
   options.huber_px = run.huber_px;
   options.outlier_sigmas = run.outlier_sigmas;
   options.min_corners_per_view = run.min_corners;
-  options.folds = run.folds;
+  // The leave-out only when asked for (dome_calibration.h: the covariance
+  // after the outlier views is the honest sigma on rendered dives).
+  options.folds =
+      gflags::GetCommandLineFlagInfoOrDie("folds").is_default ? 0 : run.folds;
   if (const Status status = options.Check(); !status.ok()) {
     PrintError(command, "--port dome: " + status.message());
     return kExitUsage;
@@ -352,6 +355,7 @@ int RunCalibrateDome(const Subcommand& command,
   json["views_used"] = result->num_views_used;
   json["corners"] = result->num_inliers + result->num_outliers;
   json["outliers"] = result->num_outliers;
+  json["outlier_views"] = result->num_outlier_views;
   json["conventional"] = {
       {"model", std::string(LensModelName(conventional.model))},
       {"ok", conventional.ok},
