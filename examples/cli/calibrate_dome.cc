@@ -127,10 +127,7 @@ int RunCalibrateDome(const Subcommand& command,
   options.huber_px = run.huber_px;
   options.outlier_sigmas = run.outlier_sigmas;
   options.min_corners_per_view = run.min_corners;
-  // The leave-out only when asked for (dome_calibration.h: the covariance
-  // after the outlier views is the honest sigma on rendered dives).
-  options.folds =
-      gflags::GetCommandLineFlagInfoOrDie("folds").is_default ? 0 : run.folds;
+  options.folds = run.folds;
   if (const Status status = options.Check(); !status.ok()) {
     PrintError(command, "--port dome: " + status.message());
     return kExitUsage;

@@ -28,26 +28,28 @@
 //
 // Uncertainty. cov = sigma^2 (J^T J)^-1 at the solution, sigma^2 =
 // SSR / (2 m - p) over the m inlier corners and p unknowns. It counts
-// independent corner noise only. A detector's errors are shared within a
-// view: on 50 rendered dives (benchmarks/dome_monte_carlo, one camera, 14
-// views) one view's failed detection made the covariance sigma 1.4-1.8
-// times too small (z sd 1.36, 0.90, 1.46); with the outlier views dropped
-// (above) it is honest (z sd 1.15, 0.86, 1.13 with the board candidates'
-// spread). With folds >= 2 the used views are also left out in
-// g = min(folds, V) groups, each replicate refitted from the solution on
-// its inliers, and the grouped jackknife
+// independent corner noise only, and a detector's errors are shared
+// within a view (corners crowded on a steep or far board err alike). On
+// 50 rendered dives (benchmarks/dome_monte_carlo, 14 views) the covariance
+// sigma, with the outlier views dropped, was honest for one camera (z sd
+// 1.15, 0.86, 1.13) but too small for a pair (1.71, 1.34, 0.96: twice the
+// corners, the same shared errors). So the used views are also left out
+// in g = min(folds, V) groups, each replicate refitted from the solution
+// on its inliers, and the grouped jackknife
 //   sigma_jk = sqrt((g - 1) / g * sum_k (x_k - mean x)^2)
 // scales the covariance's sigmas where it is larger beyond its sampling
 // error: per camera, the mean squared ratio r^2 of the three components'
 // leave-out to covariance sigmas, tested one-sided at 95 % against
 // chi-square on 3 (g - 1) degrees of freedom, multiplies each component's
 // sigma by sqrt(r^2) (the flat-port path's test for n,
-// underwater_model_selection.h, pooled over the components). It is off by
-// default: on the same dives it over-covered (z sd 0.90, 0.67, 0.77); it
-// is the conservative choice for dives whose views share errors the model
-// leaves out. n's sigma takes its own leave-out by the flat-port rule. Real
-// boards are rarely flat, so two candidate models are fitted, the board flat
-// and bowed (when estimate_board_warp), as the flat-port path does
+// underwater_model_selection.h, pooled over the components: one
+// component's leave-out from 10 replicates varies by 25 %). Where the
+// covariance was honest it over-covers a little (one camera: z sd 0.90,
+// 0.67, 0.77): a sigma too large rather than a precise-looking one too
+// small. n's sigma takes its own leave-out by the flat-port rule.
+//
+// Candidates. Real boards are rarely flat, so two models are fitted, the
+// board flat and bowed (when estimate_board_warp), as the flat-port path does
 // (underwater_model_selection.h): with d_v = ln(s_flat(v) / s_bowed(v)),
 // s(v) the view's SSR, the evidence against the flat board is
 // mean(d) / (sd(d) / sqrt(V)) over the V views (in-sample: the bow adds
@@ -92,11 +94,9 @@ struct DomeCalibrationOptions {
   // Evidence (t statistic over the views) above which the flat board is
   // ruled out.
   double evidence_sigmas = 3.0;
-  // Leave-views-out groups of the chosen model's sigma (header); 0: none
-  // (the default: on rendered dives the covariance after the outlier views
-  // was honest and the leave-out over-covered), else >= 2 (min(folds, V)
-  // groups).
-  int folds = 0;
+  // Leave-views-out groups of the chosen model's sigma (header); 0: none,
+  // else >= 2 (min(folds, V) groups).
+  int folds = 10;
   // Huber loss scale [px] of the robust solves.
   double huber_px = 1.0;
   // Corners beyond outlier_sigmas robust standard deviations, and at least
