@@ -154,9 +154,14 @@ std::optional<Eigen::MatrixXd> MeanFramesJacobian(
   for (int k = 0; k < kLens; ++k) {
     lens[k] = k < n ? Jet(b[layout.lens_offset[point.camera] + k], k) : Jet(0.0);
   }
+  // The extrinsics block exists for cam1 only (a one-camera calibration
+  // has none: extrinsics_offset is -1, and cam0's projection never reads
+  // it).
   Jet extrinsics[6];
   for (int k = 0; k < 6; ++k) {
-    extrinsics[k] = Jet(b[layout.extrinsics_offset + k], kLens + k);
+    extrinsics[k] = point.camera == 1
+                        ? Jet(b[layout.extrinsics_offset + k], kLens + k)
+                        : Jet(0.0);
   }
   Jet reference[3];
   for (int k = 0; k < 3; ++k) reference[k] = Jet(p_ref[k], kLens + 6 + k);
