@@ -81,15 +81,12 @@ Status CheckNoDomeFlags(const std::string& where) {
   if (FLAGS_port == "dome") {
     return Status::Error("--port dome goes with --underwater, not " + where);
   }
-  for (const char* name :
-       {"dome_inner_radius", "dome_thickness", "dome_outer_radius",
-        "dome_decentering", "glass_index", "estimate_n", "n"}) {
-    if (!gflags::GetCommandLineFlagInfoOrDie(name).is_default) {
-      std::string flag = std::string("--") + name;
-      for (char& c : flag) c = c == '_' ? '-' : c;
-      return Status::Error(flag + " goes with --underwater --port dome, not " +
-                           where);
-    }
+  const std::string given = FirstGivenFlag(
+      {"dome_inner_radius", "dome_thickness", "dome_outer_radius",
+       "dome_decentering", "glass_index", "estimate_n", "n"});
+  if (!given.empty()) {
+    return Status::Error(given + " goes with --underwater --port dome, not " +
+                         where);
   }
   return Status::Ok();
 }

@@ -1,6 +1,7 @@
 #include "dome_port_flags.h"
 
 #include <cmath>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,16 @@ bool IsDefault(const char* name) {
 
 }  // namespace
 
+std::string FirstGivenFlag(const std::vector<const char*>& names) {
+  for (const char* name : names) {
+    if (IsDefault(name)) continue;
+    std::string flag = std::string("--") + name;
+    for (char& c : flag) c = c == '_' ? '-' : c;
+    return flag;
+  }
+  return "";
+}
+
 bool DomePortRequested() { return FLAGS_port == "dome"; }
 
 StatusOr<std::optional<DomePort>> DomePortFromFlags() {
@@ -48,12 +59,10 @@ StatusOr<std::optional<DomePort>> DomePortFromFlags() {
                               "dome_outer_radius", "glass_index",
                               "dome_decentering"};
   if (FLAGS_port == "flat") {
-    for (const char* name : dome_flags) {
-      if (!IsDefault(name)) {
-        std::string flag = std::string("--") + name;
-        for (char& c : flag) c = c == '_' ? '-' : c;
-        return Status::Error(flag + " describes a dome: give --port dome");
-      }
+    const std::string given = FirstGivenFlag(
+        std::vector<const char*>(std::begin(dome_flags), std::end(dome_flags)));
+    if (!given.empty()) {
+      return Status::Error(given + " describes a dome: give --port dome");
     }
     return std::optional<DomePort>();
   }

@@ -21,6 +21,8 @@
 #include <gflags/gflags.h>
 
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "glass_index_flag.h"
 #include "rcm/camera/dome_port_geometry.h"
@@ -37,6 +39,10 @@ namespace rcm::cli {
 
 // __FILE__ of dome_port_flags.cc, for Subcommand::flag_sources.
 extern const char kDomePortFlagsSource[];
+
+// The first of `names` (gflags names, e.g. "dome_thickness") given on the
+// command line, as it is typed ("--dome-thickness"); empty when none.
+std::string FirstGivenFlag(const std::vector<const char*>& names);
 
 // True when --port dome was given.
 bool DomePortRequested();
