@@ -11,12 +11,14 @@
 // share of dives within 0.2 mm on every component.
 //
 //   build/bin/dome_monte_carlo [--trials 50] [--threads 2] [--seed 1]
-//                              [--views 14] [--dive one|stereo|both]
+//                              [--views 14] [--folds 10]
+//                              [--dive one|stereo|both] [--dump FILE.csv]
 //                              [--verbose]
 //
 // Prints a markdown table, with progress on stderr (--verbose: and each
 // dive's errors and sigmas). Trials run in parallel
-// (--threads), each on one thread.
+// (--threads), each on one thread. --dump writes each dive's errors and
+// sigmas (reported, the covariance's, the leave-out's) as CSV, meters.
 #include <Eigen/Core>
 #include <algorithm>
 #include <atomic>
@@ -24,6 +26,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <fstream>
 #include <iostream>
 #include <mutex>
 #include <string>
@@ -50,6 +53,8 @@ struct Trial {
   std::vector<Eigen::Vector3d> error;
   std::vector<Eigen::Vector3d> sigma;        // reported (noise and spread)
   std::vector<Eigen::Vector3d> sigma_noise;  // the chosen fit's covariance
+  std::vector<Eigen::Vector3d> sigma_leave_out;  // the jackknife's
+  int folds = 0;
   double rms_px = 0.0;
   int views_used = 0;
   int corners = 0;
@@ -63,7 +68,7 @@ rcm::DomePort AcrylicDome(const Eigen::Vector3d& decentering) {
 }
 
 Trial RunTrial(const rcm::StereoRig& rig, const DiveConfig& config, int views,
-               uint64_t seed) {
+               int folds, uint64_t seed) {
   std::vector<rcm::DomePort> domes;
   for (const Eigen::Vector3d& c : config.decentering) {
     domes.push_back(AcrylicDome(c));
@@ -76,7 +81,7 @@ Trial RunTrial(const rcm::StereoRig& rig, const DiveConfig& config, int views,
   const rcm::calib::test::DomeDive dive =
       rcm::calib::test::RenderDomeDive(rig, domes, options);
   const rcm::StatusOr<rcm::calib::DomeCalibration> result =
-      rcm::calib::test::CalibrateDomeDive(dive, rig, 1);
+      rcm::calib::test::CalibrateDomeDive(dive, rig, 1, folds);
   Trial trial;
   trial.corners = dive.corners;
   if (!result.ok()) {
@@ -88,7 +93,9 @@ Trial RunTrial(const rcm::StereoRig& rig, const DiveConfig& config, int views,
     trial.sigma.push_back(result->decentering_sigma[c]);
     trial.sigma_noise.push_back(
         result->decentering_covariance[c].diagonal().cwiseSqrt());
+    trial.sigma_leave_out.push_back(result->decentering_sigma_leave_out[c]);
   }
+  trial.folds = result->folds;
   trial.rms_px = result->rms_px;
   trial.views_used = result->num_views_used;
   trial.board_warp = result->board_warp;
@@ -170,7 +177,9 @@ int main(int argc, char** argv) {
   int trials = 50;
   int threads = 2;
   int views = 14;
+  int folds = 10;
   uint64_t seed = 1;
+  std::string dump;
   std::string which = "both";
   bool verbose = false;
   for (int i = 1; i < argc; ++i) {
@@ -182,6 +191,10 @@ int main(int argc, char** argv) {
       threads = std::atoi(argv[++i]);
     } else if (arg == "--views" && has_value) {
       views = std::atoi(argv[++i]);
+    } else if (arg == "--folds" && has_value) {
+      folds = std::atoi(argv[++i]);
+    } else if (arg == "--dump" && has_value) {
+      dump = argv[++i];
     } else if (arg == "--seed" && has_value) {
       seed = std::strtoull(argv[++i], nullptr, 10);
     } else if (arg == "--dive" && has_value) {
@@ -190,15 +203,16 @@ int main(int argc, char** argv) {
       verbose = true;
     } else {
       std::cerr << "usage: dome_monte_carlo [--trials 50] [--threads 2] "
-                   "[--seed 1] [--views 14] [--dive one|stereo|both] "
-                   "[--verbose]\n";
+                   "[--seed 1] [--views 14] [--folds 10] "
+                   "[--dive one|stereo|both] [--dump FILE.csv] [--verbose]\n";
       return arg == "--help" ? 0 : 2;
     }
   }
-  if (trials < 2 || threads < 1 || views < 3 || seed >= (uint64_t{1} << 40) ||
+  if (trials < 2 || threads < 1 || views < 3 || folds < 0 || seed >= (uint64_t{1} << 40) ||
       (which != "one" && which != "stereo" && which != "both")) {
     std::cerr << "dome_monte_carlo: --trials >= 2, --threads >= 1, "
-                 "--views >= 3, --seed < 2^40, --dive one|stereo|both\n";
+                 "--views >= 3, --folds >= 0, --seed < 2^40, "
+                 "--dive one|stereo|both\n";
     return 2;
   }
   const rcm::StereoRig rig = rcm::AlphasenseFrontUnrectifiedRig();
@@ -212,6 +226,20 @@ int main(int argc, char** argv) {
                "max abs error (mm) |\n"
                "|---|---|---|---|---|---|---|---|---|---|\n";
   std::vector<std::string> summaries;
+  std::ofstream csv;
+  if (!dump.empty()) {
+    csv.open(dump);
+    if (!csv) {
+      std::cerr << "dome_monte_carlo: cannot write " << dump << "\n";
+      return 1;
+    }
+    csv << "dive,trial,camera,views_used,folds";
+    for (const char* name : {"error", "sigma", "sigma_noise", "leave_out"}) {
+      for (const char* axis : {"x", "y", "z"}) csv << "," << name << "_" << axis;
+    }
+    csv << "\n";
+    csv.precision(10);
+  }
   for (size_t k = 0; k < configs.size(); ++k) {
     const DiveConfig& config = configs[k];
     if (which != "both" && which != config.name) continue;
@@ -221,7 +249,7 @@ int main(int argc, char** argv) {
     const auto start = std::chrono::steady_clock::now();
     rcm::ParallelForChunks(trials, threads, 1, [&](int64_t begin, int64_t end) {
       for (int64_t t = begin; t < end; ++t) {
-        results[t] = RunTrial(rig, config, views, TrialSeed(seed, k, t));
+        results[t] = RunTrial(rig, config, views, folds, TrialSeed(seed, k, t));
         const std::lock_guard<std::mutex> lock(progress);
         std::cerr << "\rdome_monte_carlo: " << config.name << " dive " << ++done
                   << " of " << trials << std::flush;
@@ -235,6 +263,19 @@ int main(int argc, char** argv) {
       PrintTrial(config.name, t, TrialSeed(seed, k, t), results[t]);
     }
     const int cameras = static_cast<int>(config.decentering.size());
+    for (int t = 0; csv.is_open() && t < trials; ++t) {
+      const Trial& r = results[t];
+      for (int c = 0; r.failure.empty() && c < cameras; ++c) {
+        csv << config.name << "," << t << "," << c << "," << r.views_used
+            << "," << r.folds;
+        for (const Eigen::Vector3d* v : {&r.error[c], &r.sigma[c],
+                                         &r.sigma_noise[c],
+                                         &r.sigma_leave_out[c]}) {
+          for (int i = 0; i < 3; ++i) csv << "," << (*v)[i];
+        }
+        csv << "\n";
+      }
+    }
     for (int c = 0; c < cameras; ++c) {
       for (int axis = 0; axis < 3; ++axis) {
         PrintComponent(config.name, c, axis, results);

@@ -303,24 +303,4 @@ double LeaveOutOrCovarianceSigma(double covariance_sigma,
                                                 : covariance_sigma;
 }
 
-double PooledLeaveOutScale(const std::vector<double>& covariance_sigmas,
-                           const std::vector<double>& leave_out_sigmas,
-                           int replicates) {
-  double sum = 0.0;
-  int count = 0;
-  for (size_t k = 0; k < covariance_sigmas.size(); ++k) {
-    if (!(covariance_sigmas[k] > 0.0) || !std::isfinite(leave_out_sigmas[k])) {
-      continue;
-    }
-    const double ratio = leave_out_sigmas[k] / covariance_sigmas[k];
-    sum += ratio * ratio;
-    ++count;
-  }
-  const double dof = count * (replicates - 1.0);
-  if (count == 0 || dof < 1.0) return 1.0;
-  const double ratio_squared = sum / count;
-  return ratio_squared * dof > ChiSquare95(dof) ? std::sqrt(ratio_squared)
-                                                : 1.0;
-}
-
 }  // namespace rcm::calib::internal

@@ -182,18 +182,6 @@ StereoCalibrationOptions ConventionalFitOptions(LensModelId model,
 double LeaveOutOrCovarianceSigma(double covariance_sigma,
                                  double leave_out_sigma, int replicates);
 
-// The same test pooled over the K components of one estimate (a dome's
-// decentering): with r^2 = mean_k (leave_out_k / covariance_k)^2 on
-// K (replicates - 1) degrees of freedom, the factor sqrt(r^2) by which to
-// scale every component's covariance sigma when r^2 is larger than 1
-// beyond its sampling error, else 1. Errors shared within views inflate
-// the components alike; pooling them makes the factor three times less
-// noisy than each component's own ratio (a component's leave-out from 10
-// replicates varies by 25 %).
-double PooledLeaveOutScale(const std::vector<double>& covariance_sigmas,
-                           const std::vector<double>& leave_out_sigmas,
-                           int replicates);
-
 // The target poses of the views `used`, nullopt for the others.
 std::vector<std::optional<Rigid3d>> UsedViewPoses(
     const std::vector<Pose>& poses, const std::vector<bool>& used);

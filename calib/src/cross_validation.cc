@@ -101,8 +101,7 @@ StatusOr<CrossValidation> CrossValidateStereo(
     }
   };
   {
-    const int workers =
-        std::clamp(calibration_options.num_threads, 1, groups);
+    const int workers = std::clamp(calibration_options.num_threads, 1, groups);
     std::vector<std::thread> threads;
     for (int w = 1; w < workers; ++w) threads.emplace_back(work);
     work();
@@ -148,6 +147,18 @@ StatusOr<CrossValidation> CrossValidateStereo(
     result.parameters.push_back(spread);
   }
   return result;
+}
+
+double JackknifeNoiseSigma(double covariance_sigma, double jackknife_sigma,
+                           int replicates) {
+  if (replicates < 2 || !std::isfinite(jackknife_sigma)) {
+    return covariance_sigma;
+  }
+  if (replicates < kMinJackknifeReplicates) {
+    return std::max(covariance_sigma, jackknife_sigma);
+  }
+  return std::sqrt(0.5 * (covariance_sigma * covariance_sigma +
+                          jackknife_sigma * jackknife_sigma));
 }
 
 }  // namespace rcm::calib

@@ -11,6 +11,7 @@
 #include "board_bundle_adjustment.h"
 #include "rcm/calib/board_warp.h"
 #include "rcm/calib/calibration_initialization.h"
+#include "rcm/calib/cross_validation.h"
 #include "rcm/calib/dome_reprojection_error.h"
 #include "rcm/calib/mono_calibration.h"
 #include "rcm/camera/refractive_camera.h"
@@ -616,11 +617,9 @@ StatusOr<DomeCalibration> CalibrateDome(
           component.push_back(replicate[i]);
         }
         leave_out_sigma[i] = jackknife(component);
+        noise[i] =
+            JackknifeNoiseSigma(noise[i], leave_out_sigma[i], num_replicates);
       }
-      noise *= internal::PooledLeaveOutScale(
-          {noise.x(), noise.y(), noise.z()},
-          {leave_out_sigma.x(), leave_out_sigma.y(), leave_out_sigma.z()},
-          num_replicates);
     }
     result.decentering_sigma_leave_out.push_back(leave_out_sigma);
     result.decentering_sigma_noise.push_back(noise);
@@ -660,8 +659,8 @@ StatusOr<DomeCalibration> CalibrateDome(
     double noise = best.sigma_n;
     if (leave_out) {
       result.sigma_n_leave_out = jackknife(n_replicates);
-      noise = internal::LeaveOutOrCovarianceSigma(
-          noise, result.sigma_n_leave_out, num_replicates);
+      noise =
+          JackknifeNoiseSigma(noise, result.sigma_n_leave_out, num_replicates);
     }
     result.sigma_n = std::hypot(noise, result.sigma_n_model);
   }

@@ -93,11 +93,13 @@ inline DomeDive RenderDomeDive(const StereoRig& rig,
 
 // The decentering of `dive`'s domes, n held at the truth (default options
 // otherwise: the flat and bowed board candidates), without the
-// conventional fit.
+// conventional fit; `folds` leave-out groups (DomeCalibrationOptions).
 inline StatusOr<DomeCalibration> CalibrateDomeDive(const DomeDive& dive,
                                                    const StereoRig& rig,
-                                                   int num_threads = 2) {
+                                                   int num_threads = 2,
+                                                   int folds = 10) {
   DomeCalibrationOptions options;
+  options.folds = folds;
   options.n = kDomeDiveWaterIndex;
   options.fit_conventional_model = false;
   options.num_threads = num_threads;

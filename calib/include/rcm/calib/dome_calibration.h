@@ -37,16 +37,13 @@
 // in g = min(folds, V) groups, each replicate refitted from the solution
 // on its inliers, and the grouped jackknife
 //   sigma_jk = sqrt((g - 1) / g * sum_k (x_k - mean x)^2)
-// scales the covariance's sigmas where it is larger beyond its sampling
-// error: per camera, the mean squared ratio r^2 of the three components'
-// leave-out to covariance sigmas, tested one-sided at 95 % against
-// chi-square on 3 (g - 1) degrees of freedom, multiplies each component's
-// sigma by sqrt(r^2) (the flat-port path's test for n,
-// underwater_model_selection.h, pooled over the components: one
-// component's leave-out from 10 replicates varies by 25 %). Where the
-// covariance was honest it over-covers a little (one camera: z sd 0.90,
-// 0.67, 0.77): a sigma too large rather than a precise-looking one too
-// small. n's sigma takes its own leave-out by the flat-port rule.
+// counts them; the noise sigma of each component is the root mean square
+// of the two, sqrt((sigma_c^2 + sigma_jk^2) / 2) (JackknifeNoiseSigma,
+// cross_validation.h, which says why and how it was measured; from fewer
+// than 5 replicates the larger of the two). The larger of the two by a
+// 95 % test, the rule before, over-covered (z sd 0.67-0.90); the
+// jackknife alone was too noisy on independent noise (z sd up to 1.42).
+// n's sigma is made the same way from its own leave-out.
 //
 // Candidates. Real boards are rarely flat, so two models are fitted, the
 // board flat and bowed (when estimate_board_warp), as the flat-port path does
@@ -147,9 +144,9 @@ struct DomeCalibration {
   std::vector<Eigen::Matrix3d> decentering_covariance;
   std::vector<Eigen::Vector3d> decentering_sigma;
   std::vector<Eigen::Vector3d> decentering_sigma_model;
-  // Its parts: the noise sigma (the covariance's, scaled by the pooled
-  // leave-out factor when that is significant) and the leave-out sigma
-  // itself (zero without folds).
+  // Its parts: the noise sigma (the root mean square of the covariance's
+  // and the leave-out's, JackknifeNoiseSigma; the covariance's without
+  // folds) and the leave-out sigma itself (zero without folds).
   std::vector<Eigen::Vector3d> decentering_sigma_noise;
   std::vector<Eigen::Vector3d> decentering_sigma_leave_out;
   int folds = 0;         // leave-out replicates run
