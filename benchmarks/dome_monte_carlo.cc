@@ -13,12 +13,13 @@
 //   build/bin/dome_monte_carlo [--trials 50] [--threads 2] [--seed 1]
 //                              [--views 14] [--folds 10]
 //                              [--dive one|stereo|both] [--dump FILE.csv]
-//                              [--verbose]
+//                              [--unweighted] [--verbose]
 //
 // Prints a markdown table, with progress on stderr (--verbose: and each
 // dive's errors and sigmas). Trials run in parallel
 // (--threads), each on one thread. --dump writes each dive's errors and
-// sigmas (reported, the covariance's, the leave-out's) as CSV, meters.
+// sigmas (reported, the covariance's, the leave-out's) as CSV, meters;
+// --unweighted calibrates without weighing the views by their noise.
 #include <Eigen/Core>
 #include <algorithm>
 #include <atomic>
@@ -51,8 +52,8 @@ struct DiveConfig {
 struct Trial {
   std::string failure;  // empty when the calibration succeeded
   std::vector<Eigen::Vector3d> error;
-  std::vector<Eigen::Vector3d> sigma;        // reported (noise and spread)
-  std::vector<Eigen::Vector3d> sigma_noise;  // the chosen fit's covariance
+  std::vector<Eigen::Vector3d> sigma;            // reported (noise and spread)
+  std::vector<Eigen::Vector3d> sigma_noise;      // the chosen fit's covariance
   std::vector<Eigen::Vector3d> sigma_leave_out;  // the jackknife's
   int folds = 0;
   double rms_px = 0.0;
@@ -68,7 +69,7 @@ rcm::DomePort AcrylicDome(const Eigen::Vector3d& decentering) {
 }
 
 Trial RunTrial(const rcm::StereoRig& rig, const DiveConfig& config, int views,
-               int folds, uint64_t seed) {
+               int folds, bool weigh_views, uint64_t seed) {
   std::vector<rcm::DomePort> domes;
   for (const Eigen::Vector3d& c : config.decentering) {
     domes.push_back(AcrylicDome(c));
@@ -81,7 +82,7 @@ Trial RunTrial(const rcm::StereoRig& rig, const DiveConfig& config, int views,
   const rcm::calib::test::DomeDive dive =
       rcm::calib::test::RenderDomeDive(rig, domes, options);
   const rcm::StatusOr<rcm::calib::DomeCalibration> result =
-      rcm::calib::test::CalibrateDomeDive(dive, rig, 1, folds);
+      rcm::calib::test::CalibrateDomeDive(dive, rig, 1, folds, weigh_views);
   Trial trial;
   trial.corners = dive.corners;
   if (!result.ok()) {
@@ -178,6 +179,7 @@ int main(int argc, char** argv) {
   int threads = 2;
   int views = 14;
   int folds = 10;
+  bool weigh_views = true;
   uint64_t seed = 1;
   std::string dump;
   std::string which = "both";
@@ -199,16 +201,20 @@ int main(int argc, char** argv) {
       seed = std::strtoull(argv[++i], nullptr, 10);
     } else if (arg == "--dive" && has_value) {
       which = argv[++i];
+    } else if (arg == "--unweighted") {
+      weigh_views = false;
     } else if (arg == "--verbose") {
       verbose = true;
     } else {
       std::cerr << "usage: dome_monte_carlo [--trials 50] [--threads 2] "
                    "[--seed 1] [--views 14] [--folds 10] "
-                   "[--dive one|stereo|both] [--dump FILE.csv] [--verbose]\n";
+                   "[--dive one|stereo|both] [--dump FILE.csv] [--unweighted] "
+                   "[--verbose]\n";
       return arg == "--help" ? 0 : 2;
     }
   }
-  if (trials < 2 || threads < 1 || views < 3 || folds < 0 || seed >= (uint64_t{1} << 40) ||
+  if (trials < 2 || threads < 1 || views < 3 || folds < 0 ||
+      seed >= (uint64_t{1} << 40) ||
       (which != "one" && which != "stereo" && which != "both")) {
     std::cerr << "dome_monte_carlo: --trials >= 2, --threads >= 1, "
                  "--views >= 3, --folds >= 0, --seed < 2^40, "
@@ -235,7 +241,8 @@ int main(int argc, char** argv) {
     }
     csv << "dive,trial,camera,views_used,folds";
     for (const char* name : {"error", "sigma", "sigma_noise", "leave_out"}) {
-      for (const char* axis : {"x", "y", "z"}) csv << "," << name << "_" << axis;
+      for (const char* axis : {"x", "y", "z"})
+        csv << "," << name << "_" << axis;
     }
     csv << "\n";
     csv.precision(10);
@@ -249,7 +256,8 @@ int main(int argc, char** argv) {
     const auto start = std::chrono::steady_clock::now();
     rcm::ParallelForChunks(trials, threads, 1, [&](int64_t begin, int64_t end) {
       for (int64_t t = begin; t < end; ++t) {
-        results[t] = RunTrial(rig, config, views, folds, TrialSeed(seed, k, t));
+        results[t] = RunTrial(rig, config, views, folds, weigh_views,
+                              TrialSeed(seed, k, t));
         const std::lock_guard<std::mutex> lock(progress);
         std::cerr << "\rdome_monte_carlo: " << config.name << " dive " << ++done
                   << " of " << trials << std::flush;
@@ -266,11 +274,11 @@ int main(int argc, char** argv) {
     for (int t = 0; csv.is_open() && t < trials; ++t) {
       const Trial& r = results[t];
       for (int c = 0; r.failure.empty() && c < cameras; ++c) {
-        csv << config.name << "," << t << "," << c << "," << r.views_used
-            << "," << r.folds;
-        for (const Eigen::Vector3d* v : {&r.error[c], &r.sigma[c],
-                                         &r.sigma_noise[c],
-                                         &r.sigma_leave_out[c]}) {
+        csv << config.name << "," << t << "," << c << "," << r.views_used << ","
+            << r.folds;
+        for (const Eigen::Vector3d* v :
+             {&r.error[c], &r.sigma[c], &r.sigma_noise[c],
+              &r.sigma_leave_out[c]}) {
           for (int i = 0; i < 3; ++i) csv << "," << (*v)[i];
         }
         csv << "\n";

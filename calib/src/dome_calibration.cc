@@ -71,6 +71,8 @@ struct DomeFit {
   int warp_offset = -1;
   std::vector<double> view_ssr;  // per view, inliers, NaN when unused
   int num_outlier_views = 0;     // dropped whole (header)
+  // Per view, the weight of its corners (1 unless options.weigh_views).
+  std::vector<double> view_weight;
 };
 
 // A view whose inlier RMS exceeds this many times the median view's is an
@@ -81,6 +83,42 @@ struct DomeFit {
 // corners were 0.79 px RMS off against at most 0.11 px for the 13 others)
 // does.
 constexpr double kOutlierViewFactor = 4.0;
+
+// The bounds of a view's weight, relative to the median view's: a view's
+// variance estimate over its ~50 corners is good to ~15 %, and the
+// outlier-view rule leaves views within 4^2 = 16 times the median's
+// variance.
+constexpr double kMaxViewWeightRatio = 16.0;
+
+// Per view, the weight w_v = clamp(median_u s_u^2 / s_v^2, 1/16, 16) of
+// its corners, with s_v^2 = SSR_v / (2 m_v - 6) its inliers' residual
+// variance (m_v corners over the cameras, one pose); 1 for views without
+// inliers.
+std::vector<double> ViewWeights(const std::vector<double>& view_ssr,
+                                const std::vector<int>& view_corners) {
+  const size_t num_views = view_ssr.size();
+  std::vector<double> variance(num_views, std::nan(""));
+  std::vector<double> used;
+  for (size_t v = 0; v < num_views; ++v) {
+    const int dof = 2 * view_corners[v] - 6;
+    if (dof <= 0 || !std::isfinite(view_ssr[v])) continue;
+    variance[v] = view_ssr[v] / dof;
+    used.push_back(variance[v]);
+  }
+  std::vector<double> weights(num_views, 1.0);
+  if (used.empty()) return weights;
+  std::nth_element(used.begin(), used.begin() + used.size() / 2, used.end());
+  const double median = used[used.size() / 2];
+  if (!(median > 0.0)) return weights;
+  for (size_t v = 0; v < num_views; ++v) {
+    if (!std::isfinite(variance[v])) continue;
+    weights[v] = variance[v] > 0.0 ? std::clamp(median / variance[v],
+                                                1.0 / kMaxViewWeightRatio,
+                                                kMaxViewWeightRatio)
+                                   : kMaxViewWeightRatio;
+  }
+  return weights;
+}
 
 ceres::CostFunction* MakeDomeCost(const DomeProblem& problem,
                                   const DomeState& state,
@@ -119,14 +157,17 @@ std::vector<double*> DomeBlocks(const DomeProblem& problem, DomeState* state,
 
 // `replicate`: a leave-out replicate, refitted from the solution on its
 // inliers (no outlier rounds) without a covariance.
-StatusOr<DomeFit> FitDomeCandidate(const DomeProblem& description,
-                                   const std::vector<Corner>& start_corners,
-                                   const DomeState& start, bool board_warp,
-                                   const DomeCalibrationOptions& options,
-                                   bool replicate = false) {
+StatusOr<DomeFit> FitDomeCandidate(
+    const DomeProblem& description, const std::vector<Corner>& start_corners,
+    const DomeState& start, bool board_warp,
+    const DomeCalibrationOptions& options, bool replicate = false,
+    const std::vector<double>* view_weights = nullptr) {
   DomeFit fit;
   fit.state = start;
   fit.corners = start_corners;
+  fit.view_weight = view_weights != nullptr
+                        ? *view_weights
+                        : std::vector<double>(description.num_views, 1.0);
   if (!board_warp) {
     fit.state.warp = {0.0, 0.0};
     fit.state.air_warp = {0.0, 0.0};
@@ -141,10 +182,14 @@ StatusOr<DomeFit> FitDomeCandidate(const DomeProblem& description,
   const auto add_residuals = [&](double huber_px, ceres::Problem* problem) {
     for (const Corner& corner : fit.corners) {
       if (!corner.inlier) continue;
-      problem->AddResidualBlock(
-          MakeDomeCost(description, state, corner),
-          huber_px > 0.0 ? new ceres::HuberLoss(huber_px) : nullptr,
-          DomeBlocks(description, &state, corner));
+      ceres::LossFunction* loss =
+          huber_px > 0.0 ? new ceres::HuberLoss(huber_px) : nullptr;
+      const double weight = fit.view_weight[corner.view];
+      if (weight != 1.0) {
+        loss = new ceres::ScaledLoss(loss, weight, ceres::TAKE_OWNERSHIP);
+      }
+      problem->AddResidualBlock(MakeDomeCost(description, state, corner), loss,
+                                DomeBlocks(description, &state, corner));
     }
     if (problem->HasParameterBlock(&state.n_air)) {
       problem->SetParameterBlockConstant(&state.n_air);
@@ -245,6 +290,29 @@ StatusOr<DomeFit> FitDomeCandidate(const DomeProblem& description,
       }
     }
   }
+  // The views weighed by their own corner noise (options.weigh_views), and
+  // the solution refitted from where it is.
+  if (!replicate && options.weigh_views) {
+    std::vector<double> ssr(num_views, std::nan(""));
+    std::vector<int> counts(num_views, 0);
+    for (const Corner& corner : fit.corners) {
+      if (!corner.inlier) continue;
+      const Eigen::Vector2d e = residual(corner);
+      if (!e.allFinite()) continue;
+      ssr[corner.view] =
+          (std::isnan(ssr[corner.view]) ? 0.0 : ssr[corner.view]) +
+          e.squaredNorm();
+      ++counts[corner.view];
+    }
+    fit.view_weight = ViewWeights(ssr, counts);
+    rejection.max_outlier_rounds = 0;
+    problem = std::make_unique<ceres::Problem>();
+    RCM_RETURN_IF_ERROR(internal::FitWithOutlierRejection(
+        rejection,
+        internal::BoardSolverOptions(options.max_num_iterations,
+                                     options.num_threads),
+        add_residuals, residual, &fit.corners, problem.get()));
+  }
   if (options.estimate_n && (state.n <= RefractiveCamera::kMinIndex + 1e-9 ||
                              state.n >= RefractiveCamera::kMaxIndex - 1e-9)) {
     std::ostringstream message;
@@ -307,7 +375,16 @@ StatusOr<DomeFit> FitDomeCandidate(const DomeProblem& description,
         "the decentering's covariance cannot be computed (the views do "
         "not determine it: add views at other distances and angles)");
   }
-  fit.covariance = covariance * (fit.pixel_sigma * fit.pixel_sigma);
+  // The covariance of the weighted problem scaled by its residual
+  // variance sum_v w_v SSR_v / dof (the pixel variance without weights).
+  double weighted_ssr = 0.0;
+  for (const CornerResidual& corner : fit.statistics.corners) {
+    if (corner.inlier && corner.residual.allFinite()) {
+      weighted_ssr +=
+          fit.view_weight[corner.view] * corner.residual.squaredNorm();
+    }
+  }
+  fit.covariance = covariance * (weighted_ssr / dof);
   return fit;
 }
 
@@ -579,7 +656,7 @@ StatusOr<DomeCalibration> CalibrateDome(
       }
       const StatusOr<DomeFit> refit = FitDomeCandidate(
           description, kept, fit.state, result.chosen == 1 && bowed, options,
-          /*replicate=*/true);
+          /*replicate=*/true, &fit.view_weight);
       if (!refit.ok()) {
         ++result.failed_folds;
         continue;
@@ -729,6 +806,12 @@ StatusOr<DomeCalibration> CalibrateDome(
   result.pixel_sigma = fit.pixel_sigma;
   result.num_parameters = fit.num_parameters;
   result.num_outlier_views = fit.num_outlier_views;
+  result.view_weights.assign(num_water_views, 0.0);
+  for (const Corner& corner : fit.corners) {
+    if (corner.inlier && corner.view < num_water_views) {
+      result.view_weights[corner.view] = fit.view_weight[corner.view];
+    }
+  }
 
   // The conventional model, the air lens model free, on the same corners.
   if (options.fit_conventional_model) {

@@ -93,13 +93,15 @@ inline DomeDive RenderDomeDive(const StereoRig& rig,
 
 // The decentering of `dive`'s domes, n held at the truth (default options
 // otherwise: the flat and bowed board candidates), without the
-// conventional fit; `folds` leave-out groups (DomeCalibrationOptions).
+// conventional fit; `folds` and `weigh_views` as DomeCalibrationOptions.
 inline StatusOr<DomeCalibration> CalibrateDomeDive(const DomeDive& dive,
                                                    const StereoRig& rig,
                                                    int num_threads = 2,
-                                                   int folds = 10) {
+                                                   int folds = 10,
+                                                   bool weigh_views = true) {
   DomeCalibrationOptions options;
   options.folds = folds;
+  options.weigh_views = weigh_views;
   options.n = kDomeDiveWaterIndex;
   options.fit_conventional_model = false;
   options.num_threads = num_threads;

@@ -144,6 +144,12 @@ TEST(CalibrateDomeCli, OneCameraGivesDecenteringAndDomeCamchain) {
             json["rms_px"].get<double>());
   EXPECT_FALSE(json["n_estimated"].get<bool>());
   EXPECT_EQ(json["candidates"].size(), 2u);
+  // One weight per view, each within [1/16, 16] of the median view's.
+  ASSERT_EQ(json["view_weights"].size(), json["views_used"].get<size_t>());
+  for (const nlohmann::json& weight : json["view_weights"]) {
+    EXPECT_GE(weight.get<double>(), 1.0 / 16.0);
+    EXPECT_LE(weight.get<double>(), 16.0);
+  }
   const Camchain written = ReadCamchain(dive.dir + "/water.yaml").value();
   ASSERT_EQ(written.cameras.size(), 1u);
   ASSERT_TRUE(written.cameras[0].dome.has_value());

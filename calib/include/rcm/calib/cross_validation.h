@@ -84,14 +84,16 @@ StatusOr<CrossValidation> CrossValidateStereo(
 // variance varies by sqrt(2 / (g - 1)) (47 % at g = 10), and a z score
 // over it is heavy-tailed (Student's t on g - 1 degrees of freedom). The
 // mean of the two variances halves that noise and keeps half of what
-// s_jk adds. Measured (z = error / sigma, its sd over the trials, the
-// issue's honest range [0.8, 1.3]):
+// s_jk adds. Measured (z = error / sigma, its sd over the trials; honest
+// is near 1), with the views weighed by their noise:
 //   - independent Gaussian corners (DomeCalibration.MonteCarlo*, 50
-//     trials): s_jk alone z sd up to 1.42, the mean 0.86-1.16;
+//     trials): s_c alone z sd 0.83-1.10, s_jk alone up to 1.42 (small
+//     sigmas from few replicates make large z), the mean 0.84-1.17;
 //   - rendered dives, the detector's errors (benchmarks/dome_monte_carlo,
-//     100 dives each of one camera and a pair): s_c alone up to 1.39
-//     (the pair), the larger of the two by a 95 % test 0.67-0.90 (50
-//     dives), the mean 0.84-1.02 (docs/dome.md has the held-out run).
+//     200 dives each of one camera and a pair): s_c alone 1.10-1.21, s_jk
+//     alone 1.07-1.43, the mean 0.99-1.12. Before the views were weighed
+//     s_c alone was 1.71 on a pair's x (50 dives), and the larger of the
+//     two by a 95 % test, the rule then, over-covered (0.67-0.90).
 // From fewer than kMinJackknifeReplicates replicates s_jk is too
 // heavy-tailed (infinite variance at g = 3) to be averaged, and the larger
 // of the two is taken.

@@ -16,6 +16,18 @@
 // whose inlier RMS exceeds 4 times the median view's is dropped whole (a
 // detector that failed on a steep or crowded board moves many corners by
 // less than the corner threshold, which misses them) and the rest refitted.
+// Then each view is weighed by its own corner noise (weigh_views) and the
+// solution refitted: with s_v^2 = SSR_v / (2 m_v - 6) the residual
+// variance of view v's m_v inlier corners (one pose),
+//   w_v = clamp(median_u s_u^2 / s_v^2, 1/16, 16).
+// A detector's corners are noisier where they crowd (a far or steep
+// board: on rendered dives 0.126 px RMS per axis under 8 px apart against
+// 0.023 px at 20-30 px), and unweighted, those views dominate the
+// decentering's error. On 200 rendered dives (benchmarks/dome_monte_carlo,
+// 14 views) weighing the views took the RMS error from (0.093, 0.068,
+// 0.212) mm to (0.050, 0.041, 0.111) for one camera and from (0.063,
+// 0.030, 0.070) to (0.026, 0.016, 0.040) for a pair, and the dives within
+// 0.2 mm on every component from 152 to 189 and from 194 to 200.
 //
 // Observability. A decentered dome bends a ray by an amount that depends
 // on how far the ray is from the dome's centre and on the distance to the
@@ -26,24 +38,22 @@
 // separate them. Both are reported: sigma_n and the correlation of n with
 // each decentering component.
 //
-// Uncertainty. cov = sigma^2 (J^T J)^-1 at the solution, sigma^2 =
-// SSR / (2 m - p) over the m inlier corners and p unknowns. It counts
-// independent corner noise only, and a detector's errors are shared
-// within a view (corners crowded on a steep or far board err alike). On
-// 50 rendered dives (benchmarks/dome_monte_carlo, 14 views) the covariance
-// sigma, with the outlier views dropped, was honest for one camera (z sd
-// 1.15, 0.86, 1.13) but too small for a pair (1.71, 1.34, 0.96: twice the
-// corners, the same shared errors). So the used views are also left out
-// in g = min(folds, V) groups, each replicate refitted from the solution
-// on its inliers, and the grouped jackknife
+// Uncertainty. cov = sigma^2 (J^T W J)^-1 at the solution, sigma^2 =
+// sum_v w_v SSR_v / (2 m - p) over the m inlier corners and p unknowns. It
+// counts independent corner noise only, and a detector's errors are also
+// shared within a view (corners crowded on a steep or far board err
+// alike; so may a board's bow that differs between views). So the used
+// views are also left out in g = min(folds, V) groups, each replicate
+// refitted from the solution on its inliers with the same weights, and
+// the grouped jackknife
 //   sigma_jk = sqrt((g - 1) / g * sum_k (x_k - mean x)^2)
 // counts them; the noise sigma of each component is the root mean square
 // of the two, sqrt((sigma_c^2 + sigma_jk^2) / 2) (JackknifeNoiseSigma,
-// cross_validation.h, which says why and how it was measured; from fewer
-// than 5 replicates the larger of the two). The larger of the two by a
-// 95 % test, the rule before, over-covered (z sd 0.67-0.90); the
-// jackknife alone was too noisy on independent noise (z sd up to 1.42).
-// n's sigma is made the same way from its own leave-out.
+// cross_validation.h, which says why; from fewer than 5 replicates the
+// larger of the two). On the 200 rendered dives its z sd is 0.99-1.03 for
+// one camera and 0.99-1.12 for a pair; on independent Gaussian corners
+// 0.84-1.17 (DomeCalibration.MonteCarlo*). n's sigma is made the same way
+// from its own leave-out.
 //
 // Candidates. Real boards are rarely flat, so two models are fitted, the
 // board flat and bowed (when estimate_board_warp), as the flat-port path does
@@ -91,6 +101,9 @@ struct DomeCalibrationOptions {
   // Evidence (t statistic over the views) above which the flat board is
   // ruled out.
   double evidence_sigmas = 3.0;
+  // Weigh each view by its own corner noise (header): 1 / its residual
+  // variance, relative to the median view's, within [1/16, 16].
+  bool weigh_views = true;
   // Leave-views-out groups of the chosen model's sigma (header); 0: none,
   // else >= 2 (min(folds, V) groups).
   int folds = 10;
@@ -180,6 +193,9 @@ struct DomeCalibration {
   int num_outliers = 0;
   int num_parameters = 0;
   int num_outlier_views = 0;  // views dropped whole (header)
+  // Per input view, the weight of its corners relative to the median
+  // view's (header; 1 without weigh_views), 0 when the view is not used.
+  std::vector<double> view_weights;
 
   // The conventional fit (the air model's lens free, no dome) of the same
   // corners, per camera for one camera, of the pair for two.
