@@ -3,6 +3,7 @@
 
 #include <gflags/gflags.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -350,6 +351,7 @@ int RunCalibrateDome(const Subcommand& command,
   json["corners"] = result->num_inliers + result->num_outliers;
   json["outliers"] = result->num_outliers;
   json["outlier_views"] = result->num_outlier_views;
+  json["view_weights"] = result->view_weights;
   json["conventional"] = {
       {"model", std::string(LensModelName(conventional.model))},
       {"ok", conventional.ok},
@@ -405,6 +407,18 @@ int RunCalibrateDome(const Subcommand& command,
   std::printf("%d views used, %d corners, %d outliers\n",
               result->num_views_used,
               result->num_inliers + result->num_outliers, result->num_outliers);
+  double lightest = 0.0, heaviest = 0.0;
+  for (double weight : result->view_weights) {
+    if (weight <= 0.0) continue;
+    lightest = lightest > 0.0 ? std::min(lightest, weight) : weight;
+    heaviest = std::max(heaviest, weight);
+  }
+  if (heaviest > 0.0) {
+    std::printf(
+        "views weighed by their corner noise: %.2f to %.2f of the median "
+        "view's weight (view_weights in the report)\n",
+        lightest, heaviest);
+  }
   for (int c = 0; c < num_cameras; ++c) {
     std::printf(
         "cam%d: dome centre %s in the camera frame (rms %.4f px)\n", c,

@@ -309,6 +309,8 @@ calib::DomeCalibrationOptions DomeOptionsFrom(const py::kwargs& kwargs,
       DoubleOption("n", &o.n),
       BoolOption("estimate_board_warp", &o.estimate_board_warp),
       DoubleOption("evidence_sigmas", &o.evidence_sigmas),
+      BoolOption("weigh_views", &o.weigh_views),
+      IntOption("folds", &o.folds),
       DoubleOption("huber_px", &o.huber_px),
       DoubleOption("outlier_sigmas", &o.outlier_sigmas),
       DoubleOption("min_outlier_threshold_px", &o.min_outlier_threshold_px),
@@ -945,7 +947,9 @@ decentering (K, 3), decentering_sigma (K, 3), n, sigma_n, rms_px,
 pixel_sigma, evidence, plausible), chosen (index), rule (one line),
 board_warp_estimated, board_warp and board_warp_sigma (meters),
 cam0_from_target (per input view 4x4 meters or None), num_views_used,
-num_inliers, num_outliers, num_parameters, notes.
+num_inliers, num_outliers, num_parameters, num_outlier_views (dropped
+whole), view_weights (V,) (per input view, its corners' weight relative to
+the median view's; 0 when not used), notes.
 )doc")
       .def_property_readonly("decentering",
                              [](const DomeResult& r) {
@@ -1083,6 +1087,15 @@ num_inliers, num_outliers, num_parameters, notes.
       .def_property_readonly(
           "num_parameters",
           [](const DomeResult& r) { return r.calibration.num_parameters; })
+      .def_property_readonly(
+          "num_outlier_views",
+          [](const DomeResult& r) { return r.calibration.num_outlier_views; })
+      .def_property_readonly("view_weights",
+                             [](const DomeResult& r) {
+                               const std::vector<double>& w =
+                                   r.calibration.view_weights;
+                               return py::array_t<double>(w.size(), w.data());
+                             })
       .def_readonly("notes", &DomeResult::notes)
       .def("__repr__", [](const DomeResult& r) {
         std::ostringstream text;
@@ -1101,7 +1114,9 @@ num_inliers, num_outliers, num_parameters, notes.
 Options (keywords, C++ rcm::calib::DomeCalibrationOptions): estimate_n
 (False: n held), n (the medium's index, held or the start, default 1.333),
 estimate_board_warp (True: the bowed board beside the flat one),
-evidence_sigmas (3), huber_px (1), outlier_sigmas (5),
+evidence_sigmas (3), weigh_views (True: each view weighed by its own
+corner noise), folds (10: the leave-views-out groups of the sigma; 0:
+the covariance alone), huber_px (1), outlier_sigmas (5),
 min_outlier_threshold_px (2), max_outlier_rounds (3), max_num_iterations
 (200), min_corners_per_view (6), fit_conventional_model (True),
 num_threads (2).

@@ -175,6 +175,9 @@ def test_calibration_recovers_the_decentering(lens):
     assert not result.n_estimated
     assert result.rms_px < EXACT
     assert result.num_views_used == 12
+    assert result.view_weights.shape == (12,)
+    assert np.all((result.view_weights >= 1 / 16)
+                  & (result.view_weights <= 16))
     assert result.conventional_rms_px is None or result.conventional_rms_px > 0
     assert result.conventional["ok"] == (result.conventional_rms_px
                                          is not None)
@@ -233,3 +236,21 @@ def test_bad_input(lens):
         rcm.calibrate_dome_from_corners(target, [None] * 3, lens,
                                         acrylic_dome(), n=3.0)
     one_line(error)
+
+
+def test_calibration_options_weigh_views_and_folds(lens):
+    target = rcm.CalibrationTarget.checkerboard(9, 6, 0.04)
+    truth = (-0.001, 0.002, 0.008)
+    camera = rcm.DomePortCamera(lens, acrylic_dome(truth), 1.333)
+    views, _ = dome_views(camera, target, 8, seed=5)
+    # Unweighted views and no leave-out: the same exact answer.
+    result = rcm.calibrate_dome_from_corners(target, views, lens,
+                                             acrylic_dome(), n=1.333,
+                                             weigh_views=False, folds=0)
+    np.testing.assert_allclose(result.decentering[0], truth, rtol=0,
+                               atol=EXACT)
+    np.testing.assert_array_equal(result.view_weights, np.ones(8))
+    with pytest.raises(ValueError) as error:
+        rcm.calibrate_dome_from_corners(target, views, lens, acrylic_dome(),
+                                        folds=1)
+    assert "folds" in one_line(error)
