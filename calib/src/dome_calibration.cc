@@ -244,19 +244,38 @@ StatusOr<DomeFit> FitDomeCandidate(
       internal::BoardSolverOptions(options.max_num_iterations,
                                    options.num_threads),
       add_residuals, residual, &fit.corners, problem.get()));
-  // Outlier views (header): a view whose inlier RMS exceeds
-  // kOutlierViewFactor times the median view's is dropped whole, and the
-  // rest refitted.
-  if (!replicate) {
-    std::vector<double> squares(num_views, 0.0);
-    std::vector<int> counts(num_views, 0);
+  // Per view, the inliers' sum of squared residuals and their count (of
+  // those that project).
+  const auto view_sums = [&](std::vector<double>* squares,
+                             std::vector<int>* counts) {
+    squares->assign(num_views, 0.0);
+    counts->assign(num_views, 0);
     for (const Corner& corner : fit.corners) {
       if (!corner.inlier) continue;
       const Eigen::Vector2d e = residual(corner);
       if (!e.allFinite()) continue;
-      squares[corner.view] += e.squaredNorm();
-      ++counts[corner.view];
+      (*squares)[corner.view] += e.squaredNorm();
+      ++(*counts)[corner.view];
     }
+  };
+  // The final least squares again, from the solution, without new
+  // outlier rounds.
+  const auto refit = [&]() -> Status {
+    rejection.max_outlier_rounds = 0;
+    problem = std::make_unique<ceres::Problem>();
+    return internal::FitWithOutlierRejection(
+        rejection,
+        internal::BoardSolverOptions(options.max_num_iterations,
+                                     options.num_threads),
+        add_residuals, residual, &fit.corners, problem.get());
+  };
+  std::vector<double> squares;
+  std::vector<int> counts;
+  // Outlier views (header): a view whose inlier RMS exceeds
+  // kOutlierViewFactor times the median view's is dropped whole, and the
+  // rest refitted.
+  if (!replicate) {
+    view_sums(&squares, &counts);
     std::vector<double> view_rms(num_views, 0.0);
     std::vector<double> used_rms;
     for (int v = 0; v < num_views; ++v) {
@@ -279,39 +298,15 @@ StatusOr<DomeFit> FitDomeCandidate(
       for (int v = 0; v < num_views; ++v) {
         if (counts[v] > 0 && view_rms[v] > limit) ++fit.num_outlier_views;
       }
-      if (dropped) {
-        rejection.max_outlier_rounds = 0;
-        problem = std::make_unique<ceres::Problem>();
-        RCM_RETURN_IF_ERROR(internal::FitWithOutlierRejection(
-            rejection,
-            internal::BoardSolverOptions(options.max_num_iterations,
-                                         options.num_threads),
-            add_residuals, residual, &fit.corners, problem.get()));
-      }
+      if (dropped) RCM_RETURN_IF_ERROR(refit());
     }
   }
   // The views weighed by their own corner noise (options.weigh_views), and
   // the solution refitted from where it is.
   if (!replicate && options.weigh_views) {
-    std::vector<double> ssr(num_views, std::nan(""));
-    std::vector<int> counts(num_views, 0);
-    for (const Corner& corner : fit.corners) {
-      if (!corner.inlier) continue;
-      const Eigen::Vector2d e = residual(corner);
-      if (!e.allFinite()) continue;
-      ssr[corner.view] =
-          (std::isnan(ssr[corner.view]) ? 0.0 : ssr[corner.view]) +
-          e.squaredNorm();
-      ++counts[corner.view];
-    }
-    fit.view_weight = ViewWeights(ssr, counts);
-    rejection.max_outlier_rounds = 0;
-    problem = std::make_unique<ceres::Problem>();
-    RCM_RETURN_IF_ERROR(internal::FitWithOutlierRejection(
-        rejection,
-        internal::BoardSolverOptions(options.max_num_iterations,
-                                     options.num_threads),
-        add_residuals, residual, &fit.corners, problem.get()));
+    view_sums(&squares, &counts);
+    fit.view_weight = ViewWeights(squares, counts);
+    RCM_RETURN_IF_ERROR(refit());
   }
   if (options.estimate_n && (state.n <= RefractiveCamera::kMinIndex + 1e-9 ||
                              state.n >= RefractiveCamera::kMaxIndex - 1e-9)) {
