@@ -281,6 +281,23 @@ std::vector<std::optional<Rigid3d>> UsedViewPoses(
   return out;
 }
 
+Eigen::MatrixXd JackknifeCovariance(
+    const std::vector<Eigen::VectorXd>& samples) {
+  const int g = static_cast<int>(samples.size());
+  Eigen::VectorXd mean = Eigen::VectorXd::Zero(samples[0].size());
+  for (const Eigen::VectorXd& x : samples) mean += x;
+  mean /= g;
+  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(mean.size(), mean.size());
+  for (const Eigen::VectorXd& x : samples) {
+    sum += (x - mean) * (x - mean).transpose();
+  }
+  return (g - 1.0) / g * sum;
+}
+
+Eigen::VectorXd JackknifeSigma(const std::vector<Eigen::VectorXd>& samples) {
+  return JackknifeCovariance(samples).diagonal().cwiseSqrt();
+}
+
 namespace {
 
 // The one-sided 95 % quantile of chi-square with `dof` degrees of freedom

@@ -182,6 +182,14 @@ StereoCalibrationOptions ConventionalFitOptions(LensModelId model,
 double LeaveOutOrCovarianceSigma(double covariance_sigma,
                                  double leave_out_sigma, int replicates);
 
+// The grouped jackknife of g >= 2 replicates x_1..x_g of an estimate,
+// each with the same components:
+//   (g - 1) / g sum_k (x_k - mean)(x_k - mean)^T,
+// and its per-component standard deviations (the diagonal's roots).
+Eigen::MatrixXd JackknifeCovariance(
+    const std::vector<Eigen::VectorXd>& samples);
+Eigen::VectorXd JackknifeSigma(const std::vector<Eigen::VectorXd>& samples);
+
 // The target poses of the views `used`, nullopt for the others.
 std::vector<std::optional<Rigid3d>> UsedViewPoses(
     const std::vector<Pose>& poses, const std::vector<bool>& used);

@@ -92,8 +92,8 @@ constexpr double kMaxViewWeightRatio = 16.0;
 
 // Per view, the weight w_v = clamp(median_u s_u^2 / s_v^2, 1/16, 16) of
 // its corners, with s_v^2 = SSR_v / (2 m_v - 6) its inliers' residual
-// variance (m_v corners over the cameras, one pose); 1 for views without
-// inliers.
+// variance (m_v corners over the cameras, one pose, that project); 1 for
+// views without inliers.
 std::vector<double> ViewWeights(const std::vector<double>& view_ssr,
                                 const std::vector<int>& view_corners) {
   const size_t num_views = view_ssr.size();
@@ -101,7 +101,7 @@ std::vector<double> ViewWeights(const std::vector<double>& view_ssr,
   std::vector<double> used;
   for (size_t v = 0; v < num_views; ++v) {
     const int dof = 2 * view_corners[v] - 6;
-    if (dof <= 0 || !std::isfinite(view_ssr[v])) continue;
+    if (dof <= 0) continue;
     variance[v] = view_ssr[v] / dof;
     used.push_back(variance[v]);
   }
@@ -155,19 +155,20 @@ std::vector<double*> DomeBlocks(const DomeProblem& problem, DomeState* state,
   return blocks;
 }
 
-// `replicate`: a leave-out replicate, refitted from the solution on its
-// inliers (no outlier rounds) without a covariance.
+// `replicate_weights`, when given: a leave-out replicate with the full
+// fit's view weights, refitted from the solution on its inliers (no
+// outlier rounds, no outlier views, no new weights) without a covariance.
 StatusOr<DomeFit> FitDomeCandidate(
     const DomeProblem& description, const std::vector<Corner>& start_corners,
     const DomeState& start, bool board_warp,
-    const DomeCalibrationOptions& options, bool replicate = false,
-    const std::vector<double>* view_weights = nullptr) {
+    const DomeCalibrationOptions& options,
+    const std::vector<double>* replicate_weights = nullptr) {
+  const bool replicate = replicate_weights != nullptr;
   DomeFit fit;
   fit.state = start;
   fit.corners = start_corners;
-  fit.view_weight = view_weights != nullptr
-                        ? *view_weights
-                        : std::vector<double>(description.num_views, 1.0);
+  fit.view_weight = replicate ? *replicate_weights
+                              : std::vector<double>(description.num_views, 1.0);
   if (!board_warp) {
     fit.state.warp = {0.0, 0.0};
     fit.state.air_warp = {0.0, 0.0};
@@ -637,8 +638,8 @@ StatusOr<DomeCalibration> CalibrateDome(
     if (water_view_used[v]) used_views.push_back(v);
   }
   const int groups = std::min<int>(options.folds, used_views.size());
-  std::vector<std::vector<Eigen::Vector3d>> replicates(num_cameras);
-  std::vector<double> n_replicates;
+  // Per replicate: each camera's decentering, then n.
+  std::vector<Eigen::VectorXd> replicates;
   if (options.folds >= 2 && groups >= 2) {
     for (int g = 0; g < groups; ++g) {
       std::vector<bool> left_out(description.num_views, false);
@@ -651,47 +652,36 @@ StatusOr<DomeCalibration> CalibrateDome(
       }
       const StatusOr<DomeFit> refit = FitDomeCandidate(
           description, kept, fit.state, result.chosen == 1 && bowed, options,
-          /*replicate=*/true, &fit.view_weight);
+          &fit.view_weight);
       if (!refit.ok()) {
         ++result.failed_folds;
         continue;
       }
+      Eigen::VectorXd replicate(3 * num_cameras + 1);
       for (int c = 0; c < num_cameras; ++c) {
         const std::array<double, 3>& centre = refit->state.centre[c];
-        replicates[c].emplace_back(centre[0], centre[1], centre[2]);
+        replicate.segment<3>(3 * c) << centre[0], centre[1], centre[2];
       }
-      n_replicates.push_back(refit->state.n);
+      replicate[3 * num_cameras] = refit->state.n;
+      replicates.push_back(replicate);
     }
     result.folds = groups;
   }
-  const int num_replicates = static_cast<int>(n_replicates.size());
+  const int num_replicates = static_cast<int>(replicates.size());
   const bool leave_out = num_replicates >= 2;
-  // sqrt((g - 1) / g sum (x_k - mean x)^2) of each component.
-  const auto jackknife = [num_replicates](const std::vector<double>& x) {
-    double mean = 0.0;
-    for (double value : x) mean += value;
-    mean /= num_replicates;
-    double sum = 0.0;
-    for (double value : x) sum += (value - mean) * (value - mean);
-    return std::sqrt((num_replicates - 1.0) / num_replicates * sum);
-  };
+  const Eigen::VectorXd jackknife_sigma =
+      leave_out ? internal::JackknifeSigma(replicates)
+                : Eigen::VectorXd::Zero(3 * num_cameras + 1);
 
   for (int c = 0; c < num_cameras; ++c) {
     result.decentering.push_back(best.decentering[c]);
     const int o = fit.centre_offset[c];
     result.decentering_covariance.push_back(fit.covariance.block<3, 3>(o, o));
     Eigen::Vector3d noise = best.decentering_sigma[c];
-    Eigen::Vector3d leave_out_sigma = Eigen::Vector3d::Zero();
-    if (leave_out) {
-      for (int i = 0; i < 3; ++i) {
-        std::vector<double> component;
-        for (const Eigen::Vector3d& replicate : replicates[c]) {
-          component.push_back(replicate[i]);
-        }
-        leave_out_sigma[i] = jackknife(component);
-        noise[i] =
-            JackknifeNoiseSigma(noise[i], leave_out_sigma[i], num_replicates);
-      }
+    const Eigen::Vector3d leave_out_sigma = jackknife_sigma.segment<3>(3 * c);
+    for (int i = 0; leave_out && i < 3; ++i) {
+      noise[i] =
+          JackknifeNoiseSigma(noise[i], leave_out_sigma[i], num_replicates);
     }
     result.decentering_sigma_leave_out.push_back(leave_out_sigma);
     result.decentering_sigma_noise.push_back(noise);
@@ -730,7 +720,7 @@ StatusOr<DomeCalibration> CalibrateDome(
             : 0.0;
     double noise = best.sigma_n;
     if (leave_out) {
-      result.sigma_n_leave_out = jackknife(n_replicates);
+      result.sigma_n_leave_out = jackknife_sigma[3 * num_cameras];
       noise =
           JackknifeNoiseSigma(noise, result.sigma_n_leave_out, num_replicates);
     }

@@ -492,25 +492,6 @@ Eigen::Matrix<double, 7, 1> ReportedChange(
   return reported;
 }
 
-// (g - 1) / g sum_k (x_k - mean)(x_k - mean)^T: the jackknife covariance.
-Eigen::MatrixXd JackknifeCovariance(
-    const std::vector<Eigen::VectorXd>& samples) {
-  const int g = static_cast<int>(samples.size());
-  Eigen::VectorXd mean = Eigen::VectorXd::Zero(samples[0].size());
-  for (const Eigen::VectorXd& x : samples) mean += x;
-  mean /= g;
-  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(mean.size(), mean.size());
-  for (const Eigen::VectorXd& x : samples) {
-    sum += (x - mean) * (x - mean).transpose();
-  }
-  return (g - 1.0) / g * sum;
-}
-
-// sqrt((g - 1) / g * sum_k (x_k - mean x)^2), per component: its diagonal.
-Eigen::VectorXd JackknifeSigma(const std::vector<Eigen::VectorXd>& samples) {
-  return JackknifeCovariance(samples).diagonal().cwiseSqrt();
-}
-
 // One refit of sigma_n_lenses (header): camera `camera`'s lens moved by
 // `delta` = sqrt(l_i) e_i.
 struct LensPerturbation {
@@ -1269,11 +1250,11 @@ StatusOr<UnderwaterCalibration> CalibrateUnderwater(
       if (progress) progress(2 + k, total_steps);
     }
     if (samples.size() >= 2) {
-      leave_out.sigma = JackknifeSigma(samples);
-      leave_out.covariance = JackknifeCovariance(samples);
+      leave_out.sigma = internal::JackknifeSigma(samples);
+      leave_out.covariance = internal::JackknifeCovariance(samples);
       result.sigma_n_leave_out = leave_out.sigma[0];
       if (free.extrinsics) {
-        const Eigen::VectorXd sigma = JackknifeSigma(changes);
+        const Eigen::VectorXd sigma = internal::JackknifeSigma(changes);
         result.extrinsic_change.rotation_leave_out_sigma_deg = sigma.head<3>();
         result.extrinsic_change.angle_leave_out_sigma_deg = sigma[3];
         result.extrinsic_change.translation_leave_out_sigma_mm =
